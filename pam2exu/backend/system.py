@@ -1,0 +1,225 @@
+"""Translate a mechanism into an Exudyn system and solve its positions over time.
+
+Each solid becomes a ``NodeRigidBody2D`` (reference coordinates 0, initial coordinates
+x, y, fi, so node coordinates read PAM's values) with an ``ObjectRigidBody2D``. Each
+element adds its own items through ``Element.build(system)``, using the helpers below.
+Positions over time come from Exudyn's static solver, one load step per time step;
+actuators follow their laws through a pre-step function.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+import exudyn as exu
+from exudyn import itemInterface as items
+
+from ..errors import SolverError
+
+
+@dataclass
+class SolveSettings:
+    """Settings of Exudyn's static (position) solver.
+
+    Parameters
+    ----------
+    tolerance : float
+        Newton's absolute tolerance on the constraint residual, relative to the
+        mechanism's length scale.
+    max_iterations : int
+        Newton iterations per step before Exudyn subdivides the step.
+    dense : bool | None
+        Dense linear solver (None: dense up to 300 coordinates, sparse above).
+    verbose : int
+        Exudyn's solver output (0: quiet).
+    """
+
+    tolerance: float = 1e-13
+    max_iterations: int = 25
+    dense: bool | None = None
+    verbose: int = 0
+
+
+class ExudynSystem:
+    """The Exudyn system of one mechanism for one analysis.
+
+    Parameters
+    ----------
+    mech : Mechanism
+    forces : bool
+        Build masses, gravity and force elements (False: constraints only, for kinematics).
+    velocity_forces : bool
+        Include dampers' velocity terms (False for quasi-static analysis).
+    anchor_stiffness : float
+        If > 0, tie every coordinate to its initial guess by a spring of this stiffness
+        (per m², and per rad² times the length scale²): the assembled configuration is then
+        the one nearest to the guess when degrees of freedom are left free.
+    """
+
+    items = items
+
+    def __init__(self, mech, forces: bool = False, velocity_forces: bool = True,
+                 anchor_stiffness: float = 0.0):
+        exu.config.printToConsole = False
+        self.mech = mech
+        self.forces, self.velocity_forces = forces, velocity_forces
+        self.SC = exu.SystemContainer()
+        self.mbs = mbs = self.SC.AddSystem()
+        self.nodes, self.bodies = [], []
+        for s in mech.solids:
+            node = mbs.AddNode(items.NodeRigidBody2D(
+                referenceCoordinates=[0.0, 0.0, 0.0],
+                initialCoordinates=[float(s.x), float(s.y), float(s.fi)]))
+            mass, inertia = (float(s.mass), float(s.inertia)) if forces else (0.0, 0.0)
+            gx, gy = (float(c) for c in s.cog)
+            self.nodes.append(node)
+            self.bodies.append(mbs.AddObject(items.ObjectRigidBody2D(
+                nodeNumber=node, mass=mass, inertia=inertia + mass * (gx * gx + gy * gy))))
+        self._markers: dict = {}
+        self._ground = None
+        self.drivers: list = []          # (object, parameter, law)
+        self.objects: dict[str, list] = {el.name: [] for el in mech.elements}
+        for el in mech.elements:
+            if el.equations or forces:
+                el.build(self)
+        if forces and mech.gravity:
+            for s, body in zip(mech.solids, self.bodies):
+                if float(s.mass) > 0:
+                    marker = mbs.AddMarker(items.MarkerBodyMass(bodyNumber=body))
+                    mbs.AddLoad(items.LoadMassProportional(
+                        markerNumber=marker, loadVector=[0.0, -mech.gravity, 0.0]))
+        if anchor_stiffness > 0:
+            L2 = mech.scale() ** 2
+            q0 = mech.initial_q()
+            for i in range(len(mech.solids)):
+                for k in range(3):
+                    mbs.AddObject(items.ObjectConnectorCoordinateSpringDamper(
+                        markerNumbers=[self.ground_coordinate(), self.coordinate_marker(i, k)],
+                        stiffness=anchor_stiffness * (L2 if k == 2 else 1.0),
+                        offset=float(q0[3 * i + k])))
+        self.sensors = [mbs.AddSensor(items.SensorNode(
+            nodeNumber=n, storeInternal=True, writeToFile=False,
+            outputVariableType=exu.OutputVariableType.Coordinates)) for n in self.nodes]
+        mbs.Assemble()
+
+    # ---- helpers for Element.build ---------------------------------------------------------
+    def add(self, element, item, kind: str = "object"):
+        """Add an object (or a load, kind='load') for an element; returns its index."""
+        index = self.mbs.AddLoad(item) if kind == "load" else self.mbs.AddObject(item)
+        self.objects[element.name].append((kind, index))
+        return index
+
+    def point_marker(self, ref):
+        """MarkerBodyRigid at a point (PointRef, or a LineRef's defining point)."""
+        local = ref.local if hasattr(ref, "local") else ref.point
+        key = ("point", ref.solid, tuple(local))
+        if key not in self._markers:
+            self._markers[key] = self.mbs.AddMarker(items.MarkerBodyRigid(
+                bodyNumber=self.bodies[ref.solid], localPosition=[local[0], local[1], 0.0]))
+        return self._markers[key]
+
+    def coordinate_marker(self, solid: int, k: int):
+        """MarkerNodeCoordinate on x (0), y (1) or fi (2) of a solid."""
+        key = ("coordinate", solid, k)
+        if key not in self._markers:
+            self._markers[key] = self.mbs.AddMarker(items.MarkerNodeCoordinate(
+                nodeNumber=self.nodes[solid], coordinate=k))
+        return self._markers[key]
+
+    def ground_coordinate(self):
+        """A coordinate marker on a ground node (value 0)."""
+        if self._ground is None:
+            node = self.mbs.AddNode(items.NodePointGround())
+            self._ground = self.mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=node,
+                                                                         coordinate=0))
+        return self._ground
+
+    def relative_rotation_marker(self, reference: int, solid: int):
+        """fi_solid − fi_reference, continued past ±π by a NodeGenericData."""
+        s0, s1 = self.mech.solids[reference], self.mech.solids[solid]
+        data = self.mbs.AddNode(items.NodeGenericData(
+            numberOfDataCoordinates=1, initialCoordinates=[float(s1.fi) - float(s0.fi)]))
+        return self.mbs.AddMarker(items.MarkerBodiesRelativeRotationCoordinate(
+            bodyNumbers=[self.bodies[reference], self.bodies[solid]], nodeNumber=data,
+            axis0=[0.0, 0.0, 1.0]))
+
+    def drive(self, obj, parameter: str, law) -> None:
+        """Make an object's parameter follow law f(t) during position solves."""
+        self.drivers.append((obj, parameter, law))
+
+    # ---- solving ---------------------------------------------------------------------------
+    def coordinates(self) -> np.ndarray:
+        """Current ODE2 coordinates (x, y, fi per solid)."""
+        return np.asarray(self.mbs.systemData.GetODE2Coordinates())
+
+    def simulation_settings(self, settings: SolveSettings, redundant: bool):
+        ss = exu.SimulationSettings()
+        ss.solution.file.write = False
+        ss.solution.sensors.writePeriod = 0.0
+        ss.staticSolver.verboseMode = settings.verbose
+        newton = ss.staticSolver.newton
+        newton.absoluteTolerance = settings.tolerance * self.mech.scale()
+        newton.relativeTolerance = settings.tolerance
+        newton.maxIterations = settings.max_iterations
+        dense = settings.dense if settings.dense is not None else self.mech.nq <= 300
+        if redundant:
+            dense = True
+            ss.linearSolver.ignoreSingularJacobian = True
+        ss.linearSolver.solverType = (exu.LinearSolverType.EigenDense if dense
+                                      else exu.LinearSolverType.EigenSparse)
+        return ss
+
+    def solve_positions(self, times: np.ndarray, settings: SolveSettings | None = None,
+                        redundant: bool = False) -> tuple[np.ndarray, int]:
+        """Positions at times t_k = k·dt (k = 0…n−1), one static load step each.
+
+        Returns (q, n_solved): q has a row per time; when Exudyn stops early, the rows
+        after n_solved are NaN.
+
+        Exudyn's load step k ≥ 1 is solved at time k·dt; the laws are evaluated one
+        step earlier, so load step k gives time t_{k−1} (``loadStepStart`` cannot be < 0).
+        """
+        settings = settings or SolveSettings()
+        times = np.asarray(times, dtype=float)
+        n = len(times)
+        dt = float(times[1] - times[0]) if n > 1 else 1.0
+        tables = [(obj, par, law, law(times)[0]) for obj, par, law in self.drivers]
+        mbs = self.mbs
+
+        def pre_step(mbs, t):
+            tau = t - dt
+            k = int(round(tau / dt))
+            on_grid = 0 <= k < n and abs(tau - k * dt) <= 1e-6 * dt
+            for obj, par, law, values in tables:
+                mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid else law.value(tau))
+            return True
+
+        if tables:
+            mbs.SetPreStepUserFunction(pre_step)
+        ss = self.simulation_settings(settings, redundant)
+        ss.staticSolver.numberOfLoadSteps = n
+        ss.staticSolver.loadStepDuration = n * dt
+        error = None
+        try:
+            mbs.SolveStatic(ss)
+        except Exception as exc:  # Exudyn raises a bare RuntimeError/ValueError on failure
+            error = exc
+        data = [np.asarray(mbs.GetSensorStoredData(s)) for s in self.sensors]
+        q = np.full((n, 3 * len(self.nodes)), np.nan)
+        if data and len(data[0]) > 1:
+            t_rows = data[0][1:, 0] - dt          # row 0 is the unsolved initial state
+            k_rows = np.rint(t_rows / dt).astype(int)
+            on_grid = (np.abs(t_rows - k_rows * dt) <= 1e-6 * dt) & (k_rows >= 0) & (k_rows < n)
+            for i, d in enumerate(data):
+                q[k_rows[on_grid], 3 * i:3 * i + 3] = d[1:, 1:4][on_grid]
+        solved = int(np.argmin(np.isfinite(q).all(axis=1))) if not np.isfinite(q).all() else n
+        if error is None and solved < n:
+            error = RuntimeError("the static solver stopped early")
+        self.error = error
+        return q, solved
+
+
+def quiet() -> None:
+    """Silence Exudyn's console output."""
+    exu.config.printToConsole = False

@@ -1,0 +1,204 @@
+"""What every element declares: its anchors, its parameters, its outputs.
+
+An element class is the one place where everything about a PAM element lives:
+the keys it takes (checked by the model's validation), the constraint equations it
+adds (used by the native velocity and acceleration pass), the Exudyn items it becomes
+(``build``) and the output variables it reports under PAM's names (``outputs``).
+Nothing here imports Exudyn: ``build`` receives the backend's system builder.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..errors import closest
+from ..kinematics import Quantity, State
+from ..laws import LAW_ALIASES, LAWS, Law, law_names
+
+#: What an output needs from an analysis, in the order analyses can provide it.
+POSITION, VELOCITY, ACCELERATION, FORCE = "position", "velocity", "acceleration", "force"
+
+
+@dataclass(frozen=True)
+class Var:
+    """An output variable: PAM name, SI unit, what it needs, what it means."""
+
+    name: str
+    unit: str
+    level: str
+    meaning: str
+
+
+# --- parameter kinds: each returns an error message for a bad value, or None -------------
+
+def _is_number(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
+
+
+@dataclass(frozen=True)
+class Param:
+    """A key an element takes besides name, anc1 and anc2."""
+
+    kind: str            # "constants", "number", "law", "solid", "choice"
+    meaning: str
+    size: int = 4        # for constants: at most this many
+    choices: tuple = ()
+    required: bool = False
+
+    def problem(self, key: str, value: Any) -> str | None:
+        if value is None:
+            return f"'{key}' is required ({self.meaning})" if self.required else None
+        if self.kind == "constants":
+            values = list(value) if isinstance(value, (list, tuple, np.ndarray)) else [value]
+            if len(values) > self.size:
+                return (f"'{key}' has {len(values)} constants, at most {self.size} are allowed "
+                        f"({self.meaning})")
+            bad = [repr(v) for v in values if not _is_number(v)]
+            if bad:
+                return f"'{key}' must hold numbers, got {', '.join(bad)}"
+        elif self.kind == "number":
+            if isinstance(value, (list, tuple)) and len(value) == 1:
+                value = value[0]
+            if not _is_number(value):
+                return f"'{key}' must be a number ({self.meaning}), got {value!r}"
+        elif self.kind == "law":
+            if value not in LAWS and value not in LAW_ALIASES:
+                return (f"unknown law '{value}'{closest(value, law_names())}; "
+                        f"known laws: {', '.join(law_names())}")
+        elif self.kind == "choice":
+            if value not in self.choices:
+                return (f"'{key}' must be one of {', '.join(map(repr, self.choices))}, "
+                        f"got {value!r}{closest(value, self.choices)}")
+        elif self.kind == "solid" and not isinstance(value, str):
+            return f"'{key}' must be a solid name, got {value!r}"
+        return None
+
+
+def constants(value, size: int = 4) -> tuple[float, ...]:
+    """C as a tuple of floats, missing entries 0."""
+    values = list(value) if isinstance(value, (list, tuple, np.ndarray)) else [value]
+    values = [float(v) for v in values]
+    return tuple(values + [0.0] * (size - len(values)))
+
+
+def number(value) -> float:
+    if isinstance(value, (list, tuple)):
+        value = value[0]
+    return float(value)
+
+
+@dataclass(eq=False)
+class Element:
+    """Base of all PAM elements. Subclasses set the class variables below."""
+
+    name: str | None = None
+    anc1: str | None = None
+    anc2: str | None = None
+
+    #: type name in the model file, and PAM's Catalan name
+    type: ClassVar[str] = ""
+    alias: ClassVar[str] = ""
+    #: what anc1 and anc2 must name: "solid", "point" or "line" (one entry per anchor)
+    anchors: ClassVar[tuple[str, ...]] = ()
+    #: one line: what the element does
+    summary: ClassVar[str] = ""
+    #: keys besides name/anc1/anc2
+    params: ClassVar[dict[str, Param]] = {}
+    #: output variables, PAM names
+    outputs: ClassVar[tuple[Var, ...]] = ()
+    #: number of constraint equations it adds (0: a force element)
+    equations: ClassVar[int] = 0
+
+    #: 1-based position in the file's [[element]] array (set by the loader or the model)
+    position: int | None = field(default=None, repr=False, kw_only=True)
+
+    # ---- declaration -------------------------------------------------------------------
+    @classmethod
+    def keys(cls) -> list[str]:
+        """Every key the element accepts in the model file."""
+        return ["type", "name", *(f"anc{k + 1}" for k in range(len(cls.anchors))), *cls.params]
+
+    @property
+    def where(self) -> str:
+        at = f" #{self.position}" if self.position else ""
+        return f"[[element]]{at} '{self.name}' ({self.type})"
+
+    def problems(self, scope) -> list[str]:
+        """Every problem with this element's keys and references (empty when it is sound)."""
+        out = []
+        for k, kind in enumerate(("anc1", "anc2")):
+            value = getattr(self, kind)
+            if k < len(self.anchors):
+                if value is None:
+                    out.append(f"'{kind}' is missing: it must name a {self.anchors[k]}")
+                    continue
+                try:
+                    scope.resolve(self.anchors[k], value)
+                except LookupError as exc:
+                    out.append(f"{kind} = '{value}': {exc}")
+            elif value is not None:
+                out.append(f"a {self.type} takes no '{kind}' (remove it)")
+        for key, param in self.params.items():
+            message = param.problem(key, getattr(self, key))
+            if message:
+                out.append(message)
+            elif param.kind == "solid" and getattr(self, key) is not None:
+                try:
+                    scope.solid(getattr(self, key))
+                except LookupError as exc:
+                    out.append(f"{key} = '{getattr(self, key)}': {exc}")
+        if not out and len(self.anchors) == 2 and self.equations:
+            a, b = (scope.resolve(kind, getattr(self, f"anc{k + 1}"))
+                    for k, kind in enumerate(self.anchors))
+            if a.solid == b.solid:
+                out.append(f"anc1 and anc2 are on the same solid '{scope.solids[a.solid].name}': "
+                           "an element must join two different solids")
+        out += self.more_problems(scope) if not out else []
+        return out
+
+    def more_problems(self, scope) -> list[str]:
+        """Checks particular to one element type (after the generic ones passed)."""
+        return []
+
+    def bind(self, scope) -> None:
+        """Resolve anchors to references (``ref1``, ``ref2``): called once the model is valid."""
+        refs = [scope.resolve(kind, getattr(self, f"anc{k + 1}"))
+                for k, kind in enumerate(self.anchors)]
+        self.refs = tuple(refs)
+        self.ref1 = refs[0] if refs else None
+        self.ref2 = refs[1] if len(refs) > 1 else None
+
+    @property
+    def solids(self) -> tuple[int, ...]:
+        """Indices of the solids the element acts on."""
+        return tuple(r.solid for r in self.refs)
+
+    # ---- kinematics --------------------------------------------------------------------
+    def constraint(self, st: State) -> tuple[Quantity, Any]:
+        """(v, target): the equations v(q) − target(t) = 0, target a constant or a Law."""
+        raise NotImplementedError(f"{self.type} adds no constraint")
+
+    def compute(self, st: State, names: set[str]) -> dict[str, np.ndarray]:
+        """Position- and velocity-level outputs (force outputs come from the force analyses)."""
+        return {}
+
+    # ---- Exudyn ------------------------------------------------------------------------
+    def build(self, ex) -> None:
+        """Add this element's Exudyn items to ``ex`` (a backend.system.ExudynSystem)."""
+        raise NotImplementedError
+
+
+class Actuator(Element):
+    """An element whose constraint follows a time law f(t)."""
+
+    def time_law(self) -> Law:
+        """The law f(t) with this element's constants (subclasses have ``law`` and ``C``)."""
+        return Law(self.law, constants(self.C))
+
+    def compute(self, st, names):
+        f, df, _ = self.time_law()(st.t)
+        return {"f(t)": f, "Df(t)": df}

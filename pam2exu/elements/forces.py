@@ -1,0 +1,106 @@
+"""Force elements: applied torsor, linear and torsional spring-dampers."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from .base import FORCE, POSITION, VELOCITY, Element, Param, Var, constants
+
+
+@dataclass(eq=False)
+class Torsor(Element):
+    """Applied force (Fx, Fy) at a point and moment M, in global or solid axes."""
+
+    C: Any = (0.0, 0.0, 0.0)
+    axes: str = "global"
+
+    type = "torsor"
+    alias = "torsor"
+    anchors = ("point",)
+    summary = "applied force and moment, constant in the global frame or in the solid's frame"
+    params = {
+        "C": Param("constants", "[Fx, Fy, M] in N, N, N·m", size=3),
+        "axes": Param("choice", "basis of the components", choices=("global", "solid")),
+    }
+
+    def build(self, ex):
+        fx, fy, m = constants(self.C, 3)
+        marker = ex.point_marker(self.ref1)
+        solid_axes = self.axes == "solid"
+        if fx or fy:
+            ex.add(self, ex.items.LoadForceVector(markerNumber=marker, loadVector=[fx, fy, 0.0],
+                                                  bodyFixed=solid_axes), kind="load")
+        if m:
+            ex.add(self, ex.items.LoadTorqueVector(markerNumber=marker, loadVector=[0.0, 0.0, m],
+                                                   bodyFixed=solid_axes), kind="load")
+
+
+@dataclass(eq=False)
+class Spring(Element):
+    """F = C1 + C2 (ro − C3) + C4 Dro between two points, positive = attraction."""
+
+    C: Any = (0.0, 0.0, 0.0, 0.0)
+
+    type = "spring"
+    alias = "molla_amortidor_lineal"
+    anchors = ("point", "point")
+    summary = "F = C1 + C2 (ro - C3) + C4 Dro, positive = attraction"
+    params = {"C": Param("constants", "C1 [N], C2 [N/m], C3 [m], C4 [N·s/m]")}
+    outputs = (
+        Var("Força", "N", FORCE, "force of the spring-damper, positive = attraction"),
+        Var("ro", "m", POSITION, "distance between the points"),
+        Var("Dro", "m/s", VELOCITY, "its rate"),
+    )
+
+    def compute(self, st, names):
+        P, Q = (st.point(r.solid, r.local) for r in self.refs)
+        ro = (Q - P).norm()
+        out = {"ro": ro.value[:, 0]}
+        if ro.rate is not None:
+            out["Dro"] = ro.rate[:, 0]
+        return out
+
+    def build(self, ex):
+        c1, c2, c3, c4 = constants(self.C)
+        ex.add(self, ex.items.ObjectConnectorSpringDamper(
+            markerNumbers=[ex.point_marker(self.ref1), ex.point_marker(self.ref2)],
+            referenceLength=c3, stiffness=c2, damping=c4 if ex.velocity_forces else 0.0,
+            force=c1))
+
+
+@dataclass(eq=False)
+class TorsionalSpring(Element):
+    """Parell = C1 + C2 (fi_rel − C3) + C4 Dfi_rel, fi_rel = fi2 − fi1."""
+
+    C: Any = (0.0, 0.0, 0.0, 0.0)
+
+    type = "torsional_spring"
+    alias = "molla_amortidor_torsional"
+    anchors = ("solid", "solid")
+    summary = ("Parell = C1 + C2 (fi_rel - C3) + C4 Dfi_rel, positive counter-clockwise on "
+               "solid 1, clockwise on solid 2")
+    params = {"C": Param("constants", "C1 [N·m], C2 [N·m/rad], C3 [rad], C4 [N·m·s/rad]")}
+    outputs = (
+        Var("Parell", "N·m", FORCE, "torque, counter-clockwise on solid 1, clockwise on solid 2"),
+        Var("fi_rel", "rad", POSITION, "relative angle fi2 − fi1"),
+        Var("Dfi_rel", "rad/s", VELOCITY, "its rate"),
+    )
+
+    def compute(self, st, names):
+        rel = st.angle(self.ref2.solid) - st.angle(self.ref1.solid)
+        out = {"fi_rel": rel.value[:, 0]}
+        if rel.rate is not None:
+            out["Dfi_rel"] = rel.rate[:, 0]
+        return out
+
+    def build(self, ex):
+        c1, c2, c3, c4 = constants(self.C)
+        fi1, fi2 = (ex.coordinate_marker(r.solid, 2) for r in self.refs)
+        ex.add(self, ex.items.ObjectConnectorCoordinateSpringDamper(
+            markerNumbers=[fi1, fi2], stiffness=c2, offset=c3,
+            damping=c4 if ex.velocity_forces else 0.0))
+        if c1:
+            for ref, sign in ((self.ref1, 1.0), (self.ref2, -1.0)):
+                ex.add(self, ex.items.LoadTorqueVector(
+                    markerNumber=ex.point_marker(ref), loadVector=[0.0, 0.0, sign * c1]),
+                    kind="load")

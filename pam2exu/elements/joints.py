@@ -1,0 +1,200 @@
+"""Joints: fixed link, revolute, prismatic, pin-in-slot and gear transmission."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..kinematics import stack
+from .base import FORCE, Element, Param, Var, number
+
+
+@dataclass(eq=False)
+class Fixed(Element):
+    """The solid keeps its initial x, y, fi."""
+
+    type = "fixed"
+    alias = "enllac_fix"
+    anchors = ("solid",)
+    summary = "the solid keeps its initial x, y, fi"
+    outputs = (
+        Var("Fx", "N", FORCE, "force the solid receives, at its local origin, global x"),
+        Var("Fy", "N", FORCE, "force the solid receives, at its local origin, global y"),
+        Var("Mz", "N·m", FORCE, "moment the solid receives, counter-clockwise"),
+    )
+    equations = 3
+
+    def bind(self, scope):
+        super().bind(scope)
+        s = scope.solids[self.ref1.solid]
+        self.pose = np.array([float(s.x), float(s.y), float(s.fi)])
+
+    def constraint(self, st):
+        """q_k − q_k(0) = 0 for x, y, fi of the solid."""
+        return stack(*(st.coordinate(self.ref1.solid, k) for k in range(3))), self.pose
+
+    def build(self, ex):
+        ground = ex.ground_coordinate()
+        for k in range(3):
+            ex.add(self, ex.items.ObjectConnectorCoordinate(
+                markerNumbers=[ground, ex.coordinate_marker(self.ref1.solid, k)],
+                offset=float(self.pose[k])))
+
+
+@dataclass(eq=False)
+class Revolute(Element):
+    """Point anc1 of solid 1 and point anc2 of solid 2 coincide."""
+
+    type = "revolute"
+    alias = "articulacio"
+    anchors = ("point", "point")
+    summary = "the two points coincide"
+    outputs = (
+        Var("Fx", "N", FORCE, "force solid 1 exerts on solid 2 at the joint, global x"),
+        Var("Fy", "N", FORCE, "force solid 1 exerts on solid 2 at the joint, global y"),
+    )
+    equations = 2
+
+    def constraint(self, st):
+        """r2 − r1 = 0 (Exudyn's ObjectJointRevolute2D: p(marker1) − p(marker0))."""
+        p1, p2 = (st.point(r.solid, r.local) for r in self.refs)
+        return p2 - p1, 0.0
+
+    def build(self, ex):
+        ex.add(self, ex.items.ObjectJointRevolute2D(
+            markerNumbers=[ex.point_marker(self.ref1), ex.point_marker(self.ref2)]))
+
+
+def _on_line(st, guide, pin_solid, pin_local):
+    """(p_guide − p_pin) · n_guide: the pin's distance from the guide line, sign reversed."""
+    p_guide = st.point(guide.solid, guide.point)
+    n_guide = st.direction(guide.solid, guide.normal)
+    return (p_guide - st.point(pin_solid, pin_local)).dot(n_guide)
+
+
+@dataclass(eq=False)
+class Prismatic(Element):
+    """Line anc2 of solid 2 slides along line anc1 of solid 1."""
+
+    type = "prismatic"
+    alias = "prismatic"
+    anchors = ("line", "line")
+    summary = ("the two lines coincide: solid 2's defining point lies on line 1, and the "
+               "directions stay parallel")
+    outputs = (
+        Var("Fnormal", "N", FORCE, "force solid 1 exerts on solid 2, normal to solid 2's line"),
+        Var("Mz", "N·m", FORCE, "moment solid 1 exerts on solid 2, about the defining point "
+            "of solid 2's line"),
+    )
+    equations = 2
+
+    def constraint(self, st):
+        """(p1 − p2)·n1 = 0 and (A2 t2)·(A1 n1) = 0 (Exudyn's ObjectJointPrismatic2D, markers [2, 1])."""
+        line1, line2 = self.refs
+        parallel = st.direction(line2.solid, line2.direction).dot(
+            st.direction(line1.solid, line1.normal))
+        return stack(_on_line(st, line1, line2.solid, line2.point), parallel), 0.0
+
+    def build(self, ex):
+        line1, line2 = self.refs
+        ex.add(self, ex.items.ObjectJointPrismatic2D(
+            markerNumbers=[ex.point_marker(line2), ex.point_marker(line1)],
+            axisMarker0=[*line2.direction, 0.0], normalMarker1=[*line1.normal, 0.0],
+            constrainRotation=True))
+
+
+@dataclass(eq=False)
+class PinSlot(Element):
+    """Point anc2 (the pin) of solid 2 stays on line anc1 (the guide) of solid 1."""
+
+    type = "pin_slot"
+    alias = "piu_guia"
+    anchors = ("line", "point")
+    summary = "the pin stays on the guide"
+    outputs = (Var("Fnormal", "N", FORCE,
+                   "force the guide (solid 1) exerts on the pin (solid 2), normal to the guide"),)
+    equations = 1
+
+    def constraint(self, st):
+        """(p_guide − p_pin)·n_guide = 0 (ObjectJointPrismatic2D, markers [pin, guide])."""
+        guide, pin = self.refs
+        return _on_line(st, guide, pin.solid, pin.local), 0.0
+
+    def build(self, ex):
+        guide, pin = self.refs
+        ex.add(self, ex.items.ObjectJointPrismatic2D(
+            markerNumbers=[ex.point_marker(pin), ex.point_marker(guide)],
+            axisMarker0=[*guide.direction, 0.0], normalMarker1=[*guide.normal, 0.0],
+            constrainRotation=False))
+
+
+@dataclass(eq=False)
+class Transmission(Element):
+    """Gears: (fi2 − fi_arm) − T (fi1 − fi_arm) − C = 0."""
+
+    T: Any = None
+    C: Any = 0.0
+    arm: str | None = None
+
+    type = "transmission"
+    alias = "transmissio"
+    anchors = ("solid", "solid")
+    summary = "(fi2 - fi_arm) - T (fi1 - fi_arm) - C = 0, the arm hinged to both solids"
+    params = {
+        "T": Param("number", "transmission ratio", required=True),
+        "C": Param("number", "initial angle [rad]"),
+        "arm": Param("solid", "the solid both gears are hinged to (found when unambiguous)"),
+    }
+    outputs = (Var("Parell", "N·m", FORCE, "torque solid 2 receives from the transmission"),)
+    equations = 1
+
+    def more_problems(self, scope):
+        if self.arm is not None:
+            return []
+        arms = self.candidate_arms(scope)
+        s1, s2 = (scope.solids[scope.solid(a).solid].name for a in (self.anc1, self.anc2))
+        if not arms:
+            return [f"no arm found: no solid is hinged by revolute joints to both '{s1}' and "
+                    f"'{s2}'; add the joints or name the arm with arm = \"...\""]
+        if len(arms) > 1:
+            names = ", ".join(f"'{scope.solids[a].name}'" for a in arms)
+            return [f"the arm is ambiguous: {names} are each hinged to both '{s1}' and '{s2}'; "
+                    f"name it with arm = \"...\""]
+        return []
+
+    def candidate_arms(self, scope) -> list[int]:
+        """Solids hinged by revolute joints to both solid 1 and solid 2."""
+        hinged = {}
+        for el in scope.elements:
+            if isinstance(el, Revolute) and el is not self:
+                try:
+                    a, b = (scope.point(x).solid for x in (el.anc1, el.anc2))
+                except (LookupError, TypeError):
+                    continue
+                hinged.setdefault(a, set()).add(b)
+                hinged.setdefault(b, set()).add(a)
+        s1, s2 = scope.solid(self.anc1).solid, scope.solid(self.anc2).solid
+        return sorted(hinged.get(s1, set()) & hinged.get(s2, set()))
+
+    def bind(self, scope):
+        super().bind(scope)
+        self.arm_solid = (scope.solid(self.arm).solid if self.arm is not None
+                          else self.candidate_arms(scope)[0])
+        self.ratio, self.offset = number(self.T), number(self.C)
+
+    @property
+    def solids(self):
+        return (*super().solids, self.arm_solid)
+
+    def constraint(self, st):
+        """T (fi1 − fi_arm) − (fi2 − fi_arm) = −C (Exudyn's factor1·q[m1] − q[m0] = offset)."""
+        arm = st.angle(self.arm_solid)
+        rel1, rel2 = (st.angle(r.solid) - arm for r in self.refs)
+        return rel1 * self.ratio - rel2, -self.offset
+
+    def build(self, ex):
+        rel2 = ex.relative_rotation_marker(self.arm_solid, self.ref2.solid)
+        rel1 = ex.relative_rotation_marker(self.arm_solid, self.ref1.solid)
+        ex.add(self, ex.items.ObjectConnectorCoordinate(
+            markerNumbers=[rel2, rel1], factor1=self.ratio, offset=-self.offset))

@@ -1,0 +1,165 @@
+"""Planar rigid-body kinematics, vectorised over all time steps at once.
+
+The generalized coordinates of solid i are q[3i:3i+3] = (x, y, fi): the origin of its
+local frame and the angle of its x axis. A point fixed at s in the local frame is at
+r = R + A(fi) s. A *quantity* is anything built from points, directions and angles
+(differences, dot products, lengths) together with what the velocity and acceleration
+analyses need of it:
+
+    value   v(q)                        shape (n, d)
+    jac     dv/dq, per solid            {solid: (n, d, 3)}
+    rate    dv/dt = jac · qd            (n, d)      (only with velocities)
+    conv    d²v/dt² − jac · qdd         (n, d)      (only with velocities)
+
+so that a constraint v(q) − f(t) = 0 has C_t = −f', and Cq qdd = γ with γ = f'' − conv.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def rotate(fi, v):
+    """A(fi) v = (vx cos fi − vy sin fi, vx sin fi + vy cos fi), for arrays fi (n,) and v (2,)."""
+    c, s = np.cos(fi), np.sin(fi)
+    return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1]], axis=-1)
+
+
+def perp(w):
+    """Ω w = (−wy, wx): w turned 90° counter-clockwise (dA/dfi · s = Ω A s)."""
+    return np.stack([-w[..., 1], w[..., 0]], axis=-1)
+
+
+def dot(a, b):
+    """a · b over the last axis, keeping it: (n, d) · (n, d) -> (n, 1)."""
+    return np.sum(a * b, axis=-1, keepdims=True)
+
+
+@dataclass
+class Quantity:
+    """A vector-valued function of the coordinates with its derivatives (see module doc)."""
+
+    value: np.ndarray
+    jac: dict[int, np.ndarray] = field(default_factory=dict)
+    rate: np.ndarray | None = None
+    conv: np.ndarray | None = None
+
+    def __sub__(self, other: "Quantity") -> "Quantity":
+        """v = a − b."""
+        return self + other * -1.0
+
+    def __add__(self, other: "Quantity") -> "Quantity":
+        """v = a + b."""
+        jac = dict(self.jac)
+        for solid, block in other.jac.items():
+            jac[solid] = jac[solid] + block if solid in jac else block
+        return Quantity(self.value + other.value, jac, _add(self.rate, other.rate),
+                        _add(self.conv, other.conv))
+
+    def __mul__(self, k: float) -> "Quantity":
+        """v = k a for a constant k."""
+        return Quantity(self.value * k, {s: b * k for s, b in self.jac.items()},
+                        None if self.rate is None else self.rate * k,
+                        None if self.conv is None else self.conv * k)
+
+    def dot(self, other: "Quantity") -> "Quantity":
+        """v = a · b; v'' = a''·b + a·b'' + 2 a'·b'."""
+        a, b = self, other
+        jac = {}
+        for x, y in ((a, b), (b, a)):
+            for solid, block in x.jac.items():
+                term = np.einsum("nd,ndk->nk", y.value, block)[:, None, :]
+                jac[solid] = jac[solid] + term if solid in jac else term
+        rate = conv = None
+        if a.rate is not None:
+            rate = dot(a.rate, b.value) + dot(a.value, b.rate)
+            conv = dot(a.conv, b.value) + dot(a.value, b.conv) + 2.0 * dot(a.rate, b.rate)
+        return Quantity(dot(a.value, b.value), jac, rate, conv)
+
+    def norm(self) -> "Quantity":
+        """v = |a|; v' = e·a', v'' = e·a'' + (|a'|² − (e·a')²)/|a| with e = a/|a|."""
+        length = np.sqrt(dot(self.value, self.value))
+        e = self.value / length
+        jac = {s: np.einsum("nd,ndk->nk", e, b)[:, None, :] for s, b in self.jac.items()}
+        rate = conv = None
+        if self.rate is not None:
+            rate = dot(e, self.rate)
+            conv = dot(e, self.conv) + (dot(self.rate, self.rate) - rate * rate) / length
+        return Quantity(length, jac, rate, conv)
+
+    def rows(self, jacobian: np.ndarray, row: int) -> None:
+        """Write dv/dq into rows row… of a full Jacobian (n, m, 3·solids)."""
+        d = self.value.shape[1]
+        for solid, block in self.jac.items():
+            jacobian[:, row:row + d, 3 * solid:3 * solid + 3] += block
+
+
+def _add(a, b):
+    return None if a is None else a + b
+
+
+def stack(*quantities: Quantity) -> Quantity:
+    """The rows of several quantities, one after the other."""
+    n = quantities[0].value.shape[0]
+    dims = [q.value.shape[1] for q in quantities]
+    jac: dict[int, np.ndarray] = {}
+    offset = 0
+    for q, d in zip(quantities, dims):
+        for solid, block in q.jac.items():
+            if solid not in jac:
+                jac[solid] = np.zeros((n, sum(dims), 3))
+            jac[solid][:, offset:offset + d] += block
+        offset += d
+    cat = lambda xs: None if xs[0] is None else np.concatenate(xs, axis=1)  # noqa: E731
+    return Quantity(cat([q.value for q in quantities]), jac,
+                    cat([q.rate for q in quantities]), cat([q.conv for q in quantities]))
+
+
+class State:
+    """Coordinates q (n, 3·solids) at times t (n,), and optionally velocities qd."""
+
+    def __init__(self, t, q, qd=None):
+        self.t = np.atleast_1d(np.asarray(t, dtype=float))
+        self.q = np.atleast_2d(np.asarray(q, dtype=float))
+        self.qd = None if qd is None else np.atleast_2d(np.asarray(qd, dtype=float))
+        self.n = self.q.shape[0]
+
+    def coordinate(self, solid: int, k: int) -> Quantity:
+        """v = q[3 solid + k]: x (k=0), y (k=1) or fi (k=2) of a solid."""
+        col = 3 * solid + k
+        block = np.zeros((self.n, 1, 3))
+        block[:, 0, k] = 1.0
+        rate = conv = None
+        if self.qd is not None:
+            rate, conv = self.qd[:, col:col + 1], np.zeros((self.n, 1))
+        return Quantity(self.q[:, col:col + 1], {solid: block}, rate, conv)
+
+    def angle(self, solid: int) -> Quantity:
+        """v = fi of a solid."""
+        return self.coordinate(solid, 2)
+
+    def _rotated(self, solid: int, local, translate: bool) -> Quantity:
+        fi = self.q[:, 3 * solid + 2]
+        As = rotate(fi, np.asarray(local, dtype=float))
+        block = np.zeros((self.n, 2, 3))
+        if translate:
+            block[:, 0, 0] = block[:, 1, 1] = 1.0
+        block[:, :, 2] = perp(As)
+        value = As + self.q[:, 3 * solid:3 * solid + 2] if translate else As
+        rate = conv = None
+        if self.qd is not None:
+            w = self.qd[:, 3 * solid + 2:3 * solid + 3]
+            rate = w * perp(As)
+            if translate:
+                rate = rate + self.qd[:, 3 * solid:3 * solid + 2]
+            conv = -(w * w) * As
+        return Quantity(value, {solid: block}, rate, conv)
+
+    def point(self, solid: int, local) -> Quantity:
+        """v = R + A(fi) s: global position of the point s of a solid."""
+        return self._rotated(solid, local, translate=True)
+
+    def direction(self, solid: int, local) -> Quantity:
+        """v = A(fi) u: a vector u fixed to a solid, in the global basis."""
+        return self._rotated(solid, local, translate=False)

@@ -1,0 +1,120 @@
+"""Time laws of the actuators (PAM's "lleis temporals").
+
+Every law is a pure function of time giving f, f' and f'' at once, vectorised
+over NumPy arrays. Laws with breakpoints C1 < C2 take the right-hand limit at a
+breakpoint, so the value there describes the motion that follows.
+
+Each law is written against a small array namespace ``xp`` (``where``, ``cos``,
+``sin``) so the same expression serves NumPy and any other backend.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["Law", "LAWS", "LAW_ALIASES", "law_names"]
+
+
+def polynomial(t, C, xp=np):
+    """f = C1 + C2 t + C3 t² + C4 t³."""
+    c1, c2, c3, c4 = C
+    f = c1 + t * (c2 + t * (c3 + t * c4))
+    df = c2 + t * (2.0 * c3 + 3.0 * c4 * t)
+    ddf = 2.0 * c3 + 6.0 * c4 * t
+    return f, df, ddf
+
+
+def harmonic(t, C, xp=np):
+    """f = C1 + C2 cos(C3 t + C4)."""
+    c1, c2, c3, c4 = C
+    phase = c3 * t + c4
+    cos, sin = xp.cos(phase), xp.sin(phase)
+    return c1 + c2 * cos, -c2 * c3 * sin, -c2 * c3 * c3 * cos
+
+
+def _ramp_shape(u):
+    """s(u) = u."""
+    return u, 1.0 + 0.0 * u, 0.0 * u
+
+
+def _bezier_c1_shape(u):
+    """s(u) = 3u² − 2u³."""
+    return u * u * (3.0 - 2.0 * u), 6.0 * u * (1.0 - u), 6.0 - 12.0 * u
+
+
+def _bezier_c2_shape(u):
+    """s(u) = 6u⁵ − 15u⁴ + 10u³."""
+    u2 = u * u
+    return (u2 * u * (10.0 + u * (-15.0 + 6.0 * u)),
+            30.0 * u2 * (1.0 - u) ** 2,
+            60.0 * u * (1.0 - u) * (1.0 - 2.0 * u))
+
+
+def _transition(shape: Callable) -> Callable:
+    """f = C3 + (C4 − C3) s(u), u = (t − C1)/(C2 − C1) on C1 ≤ t < C2; C3 before, C4 from C2 on."""
+
+    def law(t, C, xp=np):
+        c1, c2, c3, c4 = C
+        span = c2 - c1
+        u = (t - c1) / span
+        s, ds, dds = shape(u)
+        rise = c4 - c3
+        before, inside = t < c1, t < c2
+        f = xp.where(before, c3, xp.where(inside, c3 + rise * s, c4))
+        df = xp.where(before, 0.0, xp.where(inside, rise * ds / span, 0.0))
+        ddf = xp.where(before, 0.0, xp.where(inside, rise * dds / (span * span), 0.0))
+        return f, df, ddf
+
+    law.__doc__ = _transition.__doc__.replace("s(u)", f"s(u) with {shape.__doc__}")
+    return law
+
+
+ramp = _transition(_ramp_shape)
+bezier_c1 = _transition(_bezier_c1_shape)
+bezier_c2 = _transition(_bezier_c2_shape)
+
+#: law name -> (function, needs C1 < C2)
+LAWS: dict[str, tuple[Callable, bool]] = {
+    "polynomial": (polynomial, False),
+    "harmonic": (harmonic, False),
+    "ramp": (ramp, True),
+    "bezier_c1": (bezier_c1, True),
+    "bezier_c2": (bezier_c2, True),
+}
+
+#: Catalan PAM names
+LAW_ALIASES = {"polinomica": "polynomial", "harmonica": "harmonic", "rampa": "ramp"}
+
+
+def law_names() -> list[str]:
+    """All accepted law names, canonical first."""
+    return [*LAWS, *LAW_ALIASES]
+
+
+@dataclass(frozen=True)
+class Law:
+    """A time law ``name`` with constants ``C = (C1, C2, C3, C4)``."""
+
+    name: str = "polynomial"
+    C: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "name", LAW_ALIASES.get(self.name, self.name))
+        C = tuple(float(c) for c in self.C)
+        object.__setattr__(self, "C", C + (0.0,) * (4 - len(C)))
+
+    def __call__(self, t, xp=np):
+        """(f, f', f'') at time(s) t [s]."""
+        if xp is np:
+            t = np.asarray(t, dtype=float)
+            f, df, ddf = LAWS[self.name][0](t, self.C, xp)
+            shape = np.shape(t)
+            return (np.broadcast_to(f, shape) * 1.0, np.broadcast_to(df, shape) * 1.0,
+                    np.broadcast_to(ddf, shape) * 1.0)
+        return LAWS[self.name][0](t, self.C, xp)
+
+    def value(self, t: float) -> float:
+        """f(t) for a scalar t, as a Python float (used in solver callbacks)."""
+        return float(self(t)[0])

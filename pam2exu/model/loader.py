@@ -1,0 +1,98 @@
+"""Reading a model file (TOML, the format of shared/spec/model-format.md)."""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from ..elements import ALIASES, ELEMENTS
+from ..errors import ModelError, Problem, closest
+from .model import Analysis, Model
+from .solid import Solid
+
+_MODEL_KEYS = ("name", "gravity")
+_SOLID_KEYS = ("name", "x", "y", "fi", "mass", "inertia", "cog", "points", "lines")
+_ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs")
+_TABLES = ("model", "solid", "element", "analysis")
+
+
+def load(path: str | Path) -> Model:
+    """Read a model file; raises ModelError naming the file and every problem in it."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ModelError(f"cannot read the model file: {exc.strerror}", str(path)) from None
+    return loads(text, source=str(path))
+
+
+def loads(text: str, source: str = "<string>") -> Model:
+    """Parse a model from TOML text (see ``load``)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(f"not valid TOML: {exc}", source) from None
+    problems: list[Problem] = []
+    for key in data:
+        if key not in _TABLES:
+            problems.append(Problem(f"[{key}]", f"unknown table{closest(key, _TABLES)}; "
+                                                f"a model has {', '.join(_TABLES)}"))
+    head = _table(data, "model", problems)
+    _unknown_keys(head, _MODEL_KEYS, "[model]", problems)
+    model = Model(name=head.get("name", Path(source).stem), gravity=head.get("gravity", 9.81),
+                  source=source)
+    for k, entry in enumerate(_array(data, "solid", problems), start=1):
+        where = f"[[solid]] #{k}" + (f" '{entry['name']}'" if "name" in entry else "")
+        _unknown_keys(entry, _SOLID_KEYS, where, problems)
+        if "name" not in entry:
+            problems.append(Problem(where, "'name' is missing"))
+        keys = {key: v for key, v in entry.items() if key in _SOLID_KEYS}
+        keys.setdefault("name", f"solid{k}")
+        model.add_solid(Solid(**keys, position=k))
+    for k, entry in enumerate(_array(data, "element", problems), start=1):
+        where = f"[[element]] #{k}" + (f" '{entry['name']}'" if "name" in entry else "")
+        kind = entry.get("type")
+        if kind is None:
+            problems.append(Problem(where, f"'type' is missing; one of {', '.join(ELEMENTS)}"))
+            continue
+        cls = ELEMENTS.get(ALIASES.get(kind, kind))
+        if cls is None:
+            problems.append(Problem(where, f"unknown element type '{kind}'"
+                                           f"{closest(kind, [*ELEMENTS, *ALIASES])}; known types: "
+                                           f"{', '.join(ELEMENTS)}"))
+            continue
+        bad = _unknown_keys(entry, cls.keys(), where + f" ({cls.type})", problems)
+        keys = {key: v for key, v in entry.items() if key != "type" and key not in bad}
+        model.add(cls(**keys, position=k))
+    table = _table(data, "analysis", problems)
+    _unknown_keys(table, _ANALYSIS_KEYS, "[analysis]", problems)
+    model.analysis = Analysis(**{k: v for k, v in table.items() if k in _ANALYSIS_KEYS})
+    problems += model.problems()
+    if problems:
+        raise ModelError(problems, source)
+    return model
+
+
+def _table(data, key, problems) -> dict:
+    value = data.get(key, {})
+    if not isinstance(value, dict):
+        problems.append(Problem(f"[{key}]", f"must be a table [{key}], not a value"))
+        return {}
+    return value
+
+
+def _array(data, key, problems) -> list[dict]:
+    value = data.get(key, [])
+    if isinstance(value, dict):
+        value = [value]
+    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+        problems.append(Problem(f"[[{key}]]", f"must be an array of tables [[{key}]]"))
+        return []
+    return value
+
+
+def _unknown_keys(entry: dict, allowed, where, problems) -> list[str]:
+    bad = [key for key in entry if key not in allowed]
+    for key in bad:
+        problems.append(Problem(where, f"unknown key '{key}'{closest(key, allowed)}; "
+                                       f"allowed keys: {', '.join(allowed)}"))
+    return bad

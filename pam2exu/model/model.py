@@ -1,0 +1,248 @@
+"""The model: solids, elements and analysis settings, built in Python or loaded from TOML.
+
+``Model.problems()`` collects every problem before any numerics; ``Model.mechanism()``
+returns the validated, resolved form the translation and the analyses work on.
+"""
+from __future__ import annotations
+
+import copy
+import math
+import numbers
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..elements import ALIASES, ELEMENTS, Element
+from ..errors import ModelError, Problem, closest
+from .solid import Scope, Solid
+
+#: analysis types of the contract
+ANALYSIS_TYPES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
+
+
+def _number(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
+
+
+@dataclass
+class Analysis:
+    """What to run: ``type``, the interval [0, ``t_end``] in ``steps`` intervals, ``outputs``."""
+
+    type: str = "kinematic"
+    t_end: float = 1.0
+    steps: int = 100
+    outputs: list[str] | None = None
+
+    def problems(self) -> list[str]:
+        out = []
+        if self.type not in ANALYSIS_TYPES:
+            out.append(f"unknown analysis type '{self.type}'{closest(self.type, ANALYSIS_TYPES)}; "
+                       f"known types: {', '.join(ANALYSIS_TYPES)}")
+        if not _number(self.t_end) or self.t_end <= 0:
+            out.append(f"t_end must be a positive number of seconds, got {self.t_end!r}")
+        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
+            out.append(f"steps must be a positive whole number, got {self.steps!r}")
+        if self.outputs is not None and (
+                isinstance(self.outputs, str)
+                or not all(isinstance(o, str) for o in self.outputs)):
+            out.append("outputs must be a list of names or patterns, e.g. [\"crank.*\", \"Fx\"]")
+        return out
+
+
+class Model:
+    """A PAM model: solids, elements and the analysis to run.
+
+    Examples
+    --------
+    >>> m = Model("pendulum", gravity=9.81)
+    >>> m.add_solid("ground", points={"O": [0, 0]})              # doctest: +ELLIPSIS
+    Solid(...)
+    >>> m.add_solid("bar", mass=1.0, points={"O": [0, 0]})       # doctest: +ELLIPSIS
+    Solid(...)
+    >>> m.add("fixed", anc1="ground").name
+    'fixed1'
+    """
+
+    def __init__(self, name: str = "model", gravity: float = 9.81, source: str | None = None):
+        self.name = name
+        self.gravity = gravity
+        self.source = source
+        self.solids: list[Solid] = []
+        self.elements: list[Element] = []
+        self.analysis = Analysis()
+
+    # ---- building ----------------------------------------------------------------------
+    def add_solid(self, solid: Solid | str, **keys) -> Solid:
+        """Add a solid (a Solid, or a name and its keys); returns it."""
+        if not isinstance(solid, Solid):
+            solid = Solid(solid, **keys)
+        if solid.position is None:
+            solid.position = len(self.solids) + 1
+        self.solids.append(solid)
+        return solid
+
+    def add(self, element: Element | str, **keys) -> Element:
+        """Add an element (an Element, or a type name or Catalan alias and its keys)."""
+        if isinstance(element, str):
+            kind = ALIASES.get(element, element)
+            if kind not in ELEMENTS:
+                raise ModelError(f"unknown element type '{element}'"
+                                 f"{closest(element, [*ELEMENTS, *ALIASES])}; known types: "
+                                 f"{', '.join(ELEMENTS)}", self.source)
+            element = ELEMENTS[kind](**keys)
+        if element.position is None:
+            element.position = len(self.elements) + 1
+        if element.name is None:
+            same = sum(1 for e in self.elements if e.type == element.type)
+            element.name = f"{element.type}{same + 1}"
+        self.elements.append(element)
+        return element
+
+    add_element = add
+
+    def __getitem__(self, name: str) -> Solid | Element:
+        for item in (*self.solids, *self.elements):
+            if item.name == name:
+                return item
+        raise KeyError(f"no solid or element '{name}'"
+                       f"{closest(name, [i.name for i in (*self.solids, *self.elements)])}")
+
+    # ---- validation --------------------------------------------------------------------
+    def problems(self) -> list[Problem]:
+        """Every problem in the model, in file order (empty when the model is sound)."""
+        out: list[Problem] = []
+        if not _number(self.gravity) or self.gravity < 0:
+            out.append(Problem("[model]", f"gravity is the magnitude along −y, a number ≥ 0; "
+                                          f"got {self.gravity!r}"))
+        seen: dict[str, str] = {}
+        for solid in self.solids:
+            out += [Problem(solid.where, m) for m in _solid_problems(solid)]
+            _unique(solid.name, solid.where, seen, out)
+        scope = Scope(self.solids)
+        scope.elements = self.elements
+        for el in self.elements:
+            _unique(el.name, el.where, seen, out)
+            out += [Problem(el.where, m) for m in el.problems(scope)]
+        out += [Problem("[analysis]", m) for m in self.analysis.problems()]
+        if not self.solids:
+            out.append(Problem("model", "there are no solids: add at least one [[solid]]"))
+        return out
+
+    def validate(self) -> None:
+        """Raise ModelError listing every problem, if there is any."""
+        problems = self.problems()
+        if problems:
+            raise ModelError(problems, self.source)
+
+    def mechanism(self) -> "Mechanism":
+        """The validated, resolved model (raises ModelError)."""
+        self.validate()
+        return Mechanism(self)
+
+
+def _unique(name, where, seen, out):
+    if not isinstance(name, str) or not name:
+        out.append(Problem(where, "name must be a non-empty string"))
+        return
+    if "." in name:
+        out.append(Problem(where, f"name '{name}' contains '.', which separates a solid "
+                                  "from its point or line: rename it"))
+    if name in seen:
+        out.append(Problem(where, f"name '{name}' is already used by {seen[name]}: "
+                                  "solids and elements share one namespace, rename one of them"))
+    else:
+        seen[name] = where
+
+
+def _pair(v) -> bool:
+    return isinstance(v, (list, tuple)) and len(v) == 2 and all(_number(x) for x in v)
+
+
+def _solid_problems(s: Solid) -> list[str]:
+    out = []
+    for key in ("x", "y", "fi", "mass", "inertia"):
+        if not _number(getattr(s, key)):
+            out.append(f"{key} must be a number, got {getattr(s, key)!r}")
+    for key in ("mass", "inertia"):
+        if _number(getattr(s, key)) and getattr(s, key) < 0:
+            out.append(f"{key} is negative ({getattr(s, key)}): it must be ≥ 0")
+    if not _pair(s.cog):
+        out.append(f"cog must be [x, y] in the local frame, got {s.cog!r}")
+    if not isinstance(s.points, dict):
+        out.append(f"points must be a table {{ A = [x, y] }}, got {s.points!r}")
+    else:
+        for name, p in s.points.items():
+            if not _pair(p):
+                out.append(f"point '{name}' must be [x, y], got {p!r}")
+    if not isinstance(s.lines, dict):
+        out.append(f"lines must be a table {{ l = {{ point = [x, y], angle = a }} }}, got {s.lines!r}")
+        return out
+    for name, line in s.lines.items():
+        if not isinstance(line, dict):
+            out.append(f"line '{name}' must be {{ point = [x, y], angle = a }}, got {line!r}")
+            continue
+        for key in line:
+            if key not in ("point", "angle"):
+                out.append(f"line '{name}' has an unknown key '{key}'{closest(key, ('point', 'angle'))}")
+        if "point" in line and not _pair(line["point"]):
+            out.append(f"line '{name}': point must be [x, y], got {line['point']!r}")
+        if "angle" in line and not _number(line["angle"]):
+            out.append(f"line '{name}': angle must be a number [rad], got {line['angle']!r}")
+    return out
+
+
+@dataclass
+class Mechanism:
+    """A validated model with its anchors resolved: what translation and analyses use.
+
+    The generalized coordinates are q = (x, y, fi) of each solid in order, so solid i
+    owns q[3i:3i+3].
+    """
+
+    model: Model
+    solids: list[Solid] = field(init=False)
+    elements: list[Element] = field(init=False)
+
+    def __post_init__(self):
+        self.solids = list(self.model.solids)
+        scope = Scope(self.solids)
+        scope.elements = self.model.elements
+        self.elements = [copy.copy(e) for e in self.model.elements]
+        for el in self.elements:
+            el.bind(scope)
+        self.constraints = [e for e in self.elements if e.equations]
+        rows, start = [], 0
+        for el in self.constraints:
+            rows.append(slice(start, start + el.equations))
+            start += el.equations
+        self.rows = rows
+        self.n_equations = start
+        self.index = scope.index
+
+    @property
+    def name(self) -> str:
+        return self.model.name
+
+    @property
+    def gravity(self) -> float:
+        return float(self.model.gravity)
+
+    @property
+    def nq(self) -> int:
+        return 3 * len(self.solids)
+
+    def initial_q(self):
+        """The initial guess q0 from the solids' x, y, fi."""
+        import numpy as np
+        return np.array([float(v) for s in self.solids for v in (s.x, s.y, s.fi)])
+
+    def owner_of_row(self, row: int) -> Element:
+        for el, rows in zip(self.constraints, self.rows):
+            if rows.start <= row < rows.stop:
+                return el
+        raise IndexError(row)
+
+    def scale(self) -> float:
+        """A length typical of the mechanism [m]: the largest point or pose offset, at least 1e-3."""
+        values = [abs(float(v)) for s in self.solids for v in (s.x, s.y)]
+        values += [abs(float(c)) for s in self.solids for p in s.points.values() for c in p]
+        return max([1e-3, *values])

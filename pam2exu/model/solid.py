@@ -1,0 +1,142 @@
+"""Solids and the anchors elements attach to (points, lines, solids)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..errors import closest
+
+
+@dataclass(eq=False)
+class Solid:
+    """A rigid solid: pose (x, y, fi) of its local frame, inertia, named points and lines.
+
+    Parameters
+    ----------
+    name : str
+        Unique name (shared namespace with elements).
+    x, y : float
+        Origin of the local frame [m]; an initial guess, or the pose of a fixed solid.
+    fi : float
+        Angle of the local x axis, counter-clockwise [rad].
+    mass : float
+        [kg]
+    inertia : float
+        Moment of inertia about the centre of mass G [kg·m²].
+    cog : (float, float)
+        G in the local frame [m].
+    points : dict
+        ``{name: [x, y]}`` in the local frame [m].
+    lines : dict
+        ``{name: {"point": [x, y], "angle": a}}`` in the local frame [m, rad].
+    """
+
+    name: str
+    x: float = 0.0
+    y: float = 0.0
+    fi: float = 0.0
+    mass: float = 0.0
+    inertia: float = 0.0
+    cog: Any = (0.0, 0.0)
+    points: dict = field(default_factory=dict)
+    lines: dict = field(default_factory=dict)
+    #: 1-based position in the file's [[solid]] array (set by the loader or the model)
+    position: int | None = field(default=None, repr=False)
+
+    @property
+    def where(self) -> str:
+        at = f" #{self.position}" if self.position else ""
+        return f"[[solid]]{at} '{self.name}'"
+
+
+@dataclass(frozen=True)
+class SolidRef:
+    """A whole solid, by index."""
+
+    solid: int
+    label: str
+
+
+@dataclass(frozen=True)
+class PointRef:
+    """A point fixed to a solid: local coordinates [m]."""
+
+    solid: int
+    local: tuple[float, float]
+    label: str
+
+
+@dataclass(frozen=True)
+class LineRef:
+    """A line fixed to a solid: defining point [m] and angle of its x direction [rad]."""
+
+    solid: int
+    point: tuple[float, float]
+    angle: float
+    label: str
+
+    @property
+    def direction(self) -> tuple[float, float]:
+        """Unit vector along the line, local frame: (cos a, sin a)."""
+        return (math.cos(self.angle), math.sin(self.angle))
+
+    @property
+    def normal(self) -> tuple[float, float]:
+        """Unit normal, the direction turned 90° counter-clockwise: (−sin a, cos a)."""
+        return (-math.sin(self.angle), math.cos(self.angle))
+
+
+class Scope:
+    """Resolves anchor strings ("solid", "solid.point", "solid.line") to references."""
+
+    def __init__(self, solids: list[Solid]):
+        self.solids = solids
+        self.index = {s.name: i for i, s in enumerate(solids)}
+
+    def solid(self, text: str) -> SolidRef:
+        name = str(text)
+        if name not in self.index:
+            raise LookupError(f"no solid '{name}'{closest(name, self.index)}")
+        return SolidRef(self.index[name], name)
+
+    def _split(self, text: str) -> tuple[int, Solid, str | None]:
+        text = str(text)
+        if text in self.index:
+            return self.index[text], self.solids[self.index[text]], None
+        solid_name, dot, item = text.partition(".")
+        if not dot or solid_name not in self.index:
+            raise LookupError(f"no solid '{solid_name}'{closest(solid_name, self.index)}")
+        i = self.index[solid_name]
+        return i, self.solids[i], item
+
+    def point(self, text: str) -> PointRef:
+        i, solid, item = self._split(text)
+        if item is None:
+            return PointRef(i, (0.0, 0.0), str(text))
+        if item not in solid.points:
+            hint = closest(item, solid.points)
+            if item in solid.lines:
+                hint = " (that is a line; a point is expected here)"
+            raise LookupError(f"solid '{solid.name}' has no point '{item}'{hint}; "
+                              f"its points are: {', '.join(solid.points) or 'none'}")
+        x, y = solid.points[item]
+        return PointRef(i, (float(x), float(y)), str(text))
+
+    def line(self, text: str) -> LineRef:
+        i, solid, item = self._split(text)
+        if item is None:
+            return LineRef(i, (0.0, 0.0), 0.0, str(text))
+        if item not in solid.lines:
+            hint = closest(item, solid.lines)
+            if item in solid.points:
+                hint = " (that is a point; a line is expected here)"
+            raise LookupError(f"solid '{solid.name}' has no line '{item}'{hint}; "
+                              f"its lines are: {', '.join(solid.lines) or 'none'}")
+        line = solid.lines[item]
+        px, py = line.get("point", (0.0, 0.0))
+        return LineRef(i, (float(px), float(py)), float(line.get("angle", 0.0)), str(text))
+
+    def resolve(self, kind: str, text: str):
+        """kind is 'solid', 'point' or 'line'."""
+        return getattr(self, kind)(text)
