@@ -1,0 +1,21 @@
+"""Assembly: the constraints solved at t = 0, by Exudyn; one row of x, y, fi per solid."""
+from __future__ import annotations
+
+from .common import Job, check_mobility, collect, positions
+
+#: stiffness tying each coordinate to its guess when degrees of freedom are free [N/m]
+GUESS_STIFFNESS = 1.0
+
+
+def assembly(job: Job):
+    """Solve C(q, 0) = 0 from the initial guess.
+
+    With free degrees of freedom, each coordinate is tied to its initial value by a soft
+    spring, so Exudyn finds the assembled configuration nearest to the guess (the spring
+    forces only select among solutions; the constraints are met exactly).
+    """
+    q0 = job.mech.initial_q()
+    mob = check_mobility(job, q0, need_driven=False)
+    stiffness = GUESS_STIFFNESS if mob.dof > 0 else 0.0
+    q = positions(job, redundant=mob.redundant > 0, anchor_stiffness=stiffness)
+    return collect(job, q)

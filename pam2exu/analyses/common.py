@@ -1,0 +1,212 @@
+"""What all analyses share: settings, output columns, Exudyn positions, self-checks."""
+from __future__ import annotations
+
+import time as _time
+import warnings
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..elements import ACCELERATION, FORCE, POSITION, VELOCITY, Var
+from ..errors import ModelError, Problem, SolverError, TranslationError
+from ..kinematics import State
+from ..model import Model, load
+from ..results import Results, select_columns
+from . import native
+
+#: the outputs of every solid
+SOLID_OUTPUTS = (
+    Var("x", "m", POSITION, "x of the local frame's origin"),
+    Var("y", "m", POSITION, "y of the local frame's origin"),
+    Var("fi", "rad", POSITION, "angle of the local x axis, counter-clockwise, never wrapped"),
+    Var("Dx", "m/s", VELOCITY, "dx/dt"),
+    Var("Dy", "m/s", VELOCITY, "dy/dt"),
+    Var("Dfi", "rad/s", VELOCITY, "dfi/dt"),
+    Var("DDx", "m/s²", ACCELERATION, "d²x/dt²"),
+    Var("DDy", "m/s²", ACCELERATION, "d²y/dt²"),
+    Var("DDfi", "rad/s²", ACCELERATION, "d²fi/dt²"),
+)
+
+#: what each analysis provides (as in PAM)
+LEVELS = {
+    "assembly": {POSITION},
+    "quasi_static": {POSITION, FORCE},
+    "kinematic": {POSITION, VELOCITY, ACCELERATION},
+    "kinetostatic": {POSITION, VELOCITY, ACCELERATION, FORCE},
+}
+
+#: constraint residual above this (× the length scale) means a wrong translation
+RESIDUAL_TOLERANCE = 1e-8
+
+
+class RedundancyWarning(UserWarning):
+    """Redundant (consistent) constraints: positions are unique, reactions are not."""
+
+
+@dataclass
+class Job:
+    """One analysis of one mechanism, with everything decided before the numerics."""
+
+    mech: object
+    analysis: str
+    times: np.ndarray
+    columns: list[str]
+    units: dict[str, str]
+    levels: set[str]
+    solver: object = None
+    warnings: list[str] = field(default_factory=list)
+    info: dict = field(default_factory=dict)
+
+
+def available_columns(mech, analysis: str) -> dict[str, Var]:
+    """Every column the analysis can produce, in order: solids, then elements."""
+    levels = LEVELS[analysis]
+    out = {}
+    for s in mech.solids:
+        for var in SOLID_OUTPUTS:
+            if var.level in levels:
+                out[f"{s.name}.{var.name}"] = var
+    if analysis == "assembly":
+        return out
+    for el in mech.elements:
+        for var in el.outputs:
+            if var.level in levels:
+                out[f"{el.name}.{var.name}"] = var
+    return out
+
+
+def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None) -> Job:
+    """Load and validate the model, apply the overrides, choose the columns."""
+    if not isinstance(model, Model):
+        model = load(model)
+    settings = replace(model.analysis, **{k: v for k, v in
+                                          dict(type=analysis, t_end=t_end, steps=steps,
+                                               outputs=outputs).items() if v is not None})
+    problems = [Problem("[analysis]", m) for m in settings.problems()]
+    if problems:
+        raise ModelError(problems, model.source)
+    mech = model.mechanism()
+    kind = settings.type
+    if kind == "assembly":
+        times = np.zeros(1)
+    else:
+        times = np.linspace(0.0, float(settings.t_end), int(settings.steps) + 1)
+    available = available_columns(mech, kind)
+    try:
+        columns = select_columns(list(available), settings.outputs)
+    except ModelError as exc:
+        raise ModelError(exc.problems, model.source) from None
+    levels = {available[c].level for c in columns} | {POSITION}
+    if ACCELERATION in levels:
+        levels.add(VELOCITY)
+    return Job(mech, kind, times, columns, {c: available[c].unit for c in columns}, levels,
+               solver)
+
+
+def check_mobility(job: Job, q0: np.ndarray, need_driven: bool) -> native.Mobility:
+    """Rank test before any Exudyn call; warns once about redundant constraints."""
+    mob = native.mobility(job.mech, float(job.times[0]), q0)
+    job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
+                    condition_number=mob.condition)
+    if need_driven:
+        native.require_driven(job.mech, mob, job.analysis)
+    if mob.redundant and mob.dof == 0:
+        names = ", ".join(f"'{n}'" for n in mob.redundant_elements)
+        text = (f"{mob.redundant} redundant constraint equation(s) among {names}: positions, "
+                f"velocities and accelerations are unique, the reactions of these elements "
+                f"are not (they are given as the minimum-norm solution)")
+        job.warnings.append(text)
+        warnings.warn(text, RedundancyWarning, stacklevel=3)
+    return mob
+
+
+def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.ndarray:
+    """Positions at every time from Exudyn's static solver; raises SolverError on failure."""
+    from ..backend import ExudynSystem, SolveSettings
+    mech = job.mech
+    start = _time.perf_counter()
+    system = ExudynSystem(mech, forces=False, anchor_stiffness=anchor_stiffness)
+    q, solved = system.solve_positions(job.times, job.solver or SolveSettings(),
+                                       redundant=redundant)
+    job.info["exudyn_seconds"] = _time.perf_counter() - start
+    if solved < len(job.times):
+        t = float(job.times[solved])
+        worst = native.worst_elements(mech, native.residuals(mech, [t], system.coordinates()[None])[0])
+        where = ", ".join(f"{name} {r:.3g}" for name, r in worst) or "none"
+        step = f"step {solved} of {len(job.times) - 1}" if job.analysis != "assembly" else "assembly"
+        raise SolverError(
+            f"Exudyn's static solver did not converge at t = {t:.6g} s ({step}). "
+            f"Constraints violated most there: {where}. "
+            "Try: an initial guess (x, y, fi of the solids) closer to an assembled position; "
+            "more steps, so the actuators move less per step; or check whether the mechanism "
+            "cannot close at this time or reaches a singular (dead-point) position. "
+            f"Exudyn said: {system.error}",
+            time=t, step=solved, elements=tuple(n for n, _ in worst))
+    check_residual(mech, job.times, q, job)
+    return q
+
+
+def check_residual(mech, t, q, job: Job | None = None) -> None:
+    """Self-check: pam2exu's own constraint equations hold at Exudyn's configuration."""
+    if mech.n_equations == 0:
+        return
+    res = native.residuals(mech, t, q)
+    worst = float(np.max(np.abs(res)))
+    if job is not None:
+        job.info["max_residual"] = worst
+    tol = RESIDUAL_TOLERANCE * mech.scale()
+    if worst > tol:
+        k = int(np.argmax(np.max(np.abs(res), axis=1)))
+        name, value = native.worst_elements(mech, res[k], 1)[0]
+        raise TranslationError(
+            f"internal error: at t = {t[k]:.6g} s Exudyn's configuration violates pam2exu's "
+            f"equations of element {name} by {value:.3g} (tolerance {tol:.1g}): the Exudyn "
+            "translation of this element is wrong. Please report it with the model file.")
+
+
+def velocities(job: Job, q: np.ndarray, redundant: bool):
+    """(qd, qdd) from the native pass; SolverError at a singular position."""
+    mech, t = job.mech, job.times
+    accelerations = ACCELERATION in job.levels
+    try:
+        with np.errstate(all="ignore"):
+            qd, qdd = native.rates(mech, t, q, accelerations, redundant)
+        bad = ~np.isfinite(qd).all(axis=1)
+        if qdd is not None:
+            bad |= ~np.isfinite(qdd).all(axis=1)
+        if bad.any():
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        k = native.first_singular(mech, t, q)
+        drivers = [f"'{e.name}'" for e in mech.constraints if hasattr(e, "time_law")]
+        raise SolverError(
+            f"at t = {t[k]:.6g} s (step {k}) the mechanism is at a singular (dead-point) "
+            f"position: the constraint Jacobian loses rank, so the actuator(s) "
+            f"{', '.join(drivers) or '(none)'} cannot drive it through this position and "
+            "velocities are not defined. Drive the mechanism by another member, or stop the "
+            "interval before this time.", time=float(t[k]), step=k) from None
+    return qd, qdd
+
+
+def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Results:
+    """The Results table of the chosen columns."""
+    mech, t = job.mech, job.times
+    wanted = set(job.columns)
+    values: dict[str, np.ndarray] = {}
+    for i, s in enumerate(mech.solids):
+        for k, var in enumerate(SOLID_OUTPUTS):
+            name = f"{s.name}.{var.name}"
+            if name in wanted:
+                source = (q, qd, qdd)[k // 3]
+                values[name] = source[:, 3 * i + k % 3]
+    st = State(t, q, qd if VELOCITY in job.levels else None)
+    for el in mech.elements:
+        names = {v.name for v in el.outputs if f"{el.name}.{v.name}" in wanted}
+        if names:
+            for var, v in el.compute(st, names).items():
+                if var in names:
+                    values[f"{el.name}.{var}"] = v
+    values.update(extra or {})
+    values = {k: v + 0.0 for k, v in values.items()}    # no negative zeros in tables
+    return Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
+                   mech.name, job.warnings, job.info)

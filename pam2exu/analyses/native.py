@@ -1,0 +1,163 @@
+"""The native pass: constraint equations, Jacobian, velocities and accelerations.
+
+Everything here is NumPy on all time steps at once (in chunks that bound memory):
+
+    C(q, t) = 0                 positions (solved by Exudyn, checked here)
+    Cq qd = −C_t                velocities
+    Cq qdd = γ                  accelerations, γ = f'' − conv (see kinematics)
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import MobilityError, Problem
+from ..kinematics import State
+from ..laws import Law
+
+#: bytes of Jacobian kept in memory at once (steps are processed in chunks)
+CHUNK_BYTES = 64 * 2**20
+
+
+@dataclass
+class Equations:
+    """C (n, m), Cq (n, m, nq), C_t (n, m) and γ (n, m; None without velocities)."""
+
+    residual: np.ndarray
+    jacobian: np.ndarray
+    c_t: np.ndarray
+    gamma: np.ndarray | None
+
+
+def _target(target, t, m):
+    """(f, f', f'') of a constraint's right-hand side, each (n, m) or broadcastable."""
+    if isinstance(target, Law):
+        f, df, ddf = target(t)
+        return f[:, None], df[:, None], ddf[:, None]
+    return np.broadcast_to(np.asarray(target, dtype=float), (m,)), 0.0, 0.0
+
+
+def equations(mech, st: State) -> Equations:
+    """All constraint equations of a mechanism at the states ``st``."""
+    n, m = st.n, mech.n_equations
+    residual, c_t = np.zeros((n, m)), np.zeros((n, m))
+    jacobian = np.zeros((n, m, mech.nq))
+    gamma = np.zeros((n, m)) if st.qd is not None else None
+    for el, rows in zip(mech.constraints, mech.rows):
+        v, target = el.constraint(st)
+        f, df, ddf = _target(target, st.t, el.equations)
+        residual[:, rows] = v.value - f
+        c_t[:, rows] = -np.broadcast_to(df, (n, el.equations))
+        v.rows(jacobian, rows.start)
+        if gamma is not None:
+            gamma[:, rows] = ddf - v.conv
+    return Equations(residual, jacobian, c_t, gamma)
+
+
+def residuals(mech, t, q) -> np.ndarray:
+    """Constraint residual C(q, t), (n, m)."""
+    return equations(mech, State(t, q)).residual
+
+
+def worst_elements(mech, residual_row: np.ndarray, count: int = 3) -> list[tuple[str, float]]:
+    """The elements whose equations are violated most in one residual row."""
+    scores = [(el, float(np.max(np.abs(residual_row[rows]))))
+              for el, rows in zip(mech.constraints, mech.rows)]
+    scores.sort(key=lambda s: -s[1])
+    return [(f"'{el.name}' ({el.type})", r) for el, r in scores[:count] if r > 0]
+
+
+def _solve(J, b, redundant):
+    """x with J x = b per step; least squares (exact when consistent) if redundant."""
+    if not redundant:
+        return np.linalg.solve(J, b[..., None])[..., 0]
+    return np.einsum("nij,nj->ni", np.linalg.pinv(J), b)
+
+
+def rates(mech, t, q, accelerations: bool, redundant: bool):
+    """(qd, qdd) at every step; qdd is None when not asked for."""
+    n = len(t)
+    qd = np.empty_like(q)
+    qdd = np.empty_like(q) if accelerations else None
+    chunk = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
+    for a in range(0, n, chunk):
+        s = slice(a, min(n, a + chunk))
+        eq = equations(mech, State(t[s], q[s]))
+        qd[s] = _solve(eq.jacobian, -eq.c_t, redundant)
+        if accelerations:
+            eq = equations(mech, State(t[s], q[s], qd[s]))
+            qdd[s] = _solve(eq.jacobian, eq.gamma, redundant)
+    return qd, qdd
+
+
+@dataclass
+class Mobility:
+    """Degrees of freedom and redundancy of the constraints at one configuration."""
+
+    dof: int
+    redundant: int
+    free_solids: list[str]
+    redundant_elements: list[str]
+    condition: float
+
+    def describe(self) -> str:
+        text = f"{self.dof} degree(s) of freedom left free by the actuators"
+        if self.redundant:
+            text += f", {self.redundant} redundant constraint equation(s)"
+        return text
+
+
+def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
+    """Rank test of Cq at (q, t): free degrees of freedom and redundant equations."""
+    J = equations(mech, State([t], q[None, :])).jacobian[0]
+    # scale the angle columns by the length scale so that all columns have units of length
+    J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
+    if J.shape[0] == 0:
+        return Mobility(mech.nq, 0, [s.name for s in mech.solids], [], np.inf)
+    U, s, Vt = np.linalg.svd(J)
+    tol = rtol * max(1.0, s[0] if s.size else 1.0)
+    rank = int(np.sum(s > tol))
+    dof, redundant = mech.nq - rank, J.shape[0] - rank
+    free = []
+    if dof:
+        null = Vt[rank:].T                           # (nq, dof)
+        weight = np.linalg.norm(null.reshape(len(mech.solids), 3, dof), axis=(1, 2))
+        free = [sv.name for sv, w in zip(mech.solids, weight) if w > 1e-6]
+    dependent = []
+    if redundant:
+        left = U[:, rank:]                           # (m, redundant)
+        weight = np.linalg.norm(left, axis=1)
+        for el, rows in zip(mech.constraints, mech.rows):
+            if np.max(weight[rows]) > 1e-6:
+                dependent.append(el.name)
+    condition = float(s[0] / s[rank - 1]) if rank else np.inf
+    return Mobility(dof, redundant, free, dependent, condition)
+
+
+def require_driven(mech, mob: Mobility, analysis: str) -> None:
+    """Raise MobilityError when some degree of freedom is not driven."""
+    if mob.dof <= 0:
+        return
+    solids = ", ".join(f"'{s}'" for s in mob.free_solids)
+    raise MobilityError(Problem(
+        f"{analysis} analysis",
+        f"the mechanism has {mob.dof} free degree(s) of freedom that no actuator drives: "
+        f"solid(s) {solids} can still move. Add an angular_actuator or linear_actuator "
+        f"(or a fixed link) for each free degree of freedom, or run an assembly analysis, "
+        f"which accepts free degrees of freedom."), mech.model.source)
+
+
+def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
+    """Index of the first step where Cq is (numerically) rank-deficient, else the last step."""
+    n = len(t)
+    chunk = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
+    for a in range(0, n, chunk):
+        s = slice(a, min(n, a + chunk))
+        J = equations(mech, State(t[s], q[s])).jacobian
+        sv = np.linalg.svd(J, compute_uv=False)
+        rank = np.sum(sv > rtol * sv[:, :1], axis=1)
+        bad = np.nonzero(rank < mech.nq)[0]
+        if bad.size:
+            return a + int(bad[0])
+    return n - 1
