@@ -111,8 +111,8 @@ class ExudynSystem:
         return index
 
     def point_marker(self, ref):
-        """MarkerBodyRigid at a point (PointRef, or a LineRef's defining point)."""
-        local = ref.local if hasattr(ref, "local") else ref.point
+        """MarkerBodyRigid at a point (PointRef, a LineRef's defining point, a SolidRef's origin)."""
+        local = getattr(ref, "local", getattr(ref, "point", (0.0, 0.0)))
         key = ("point", ref.solid, tuple(local))
         if key not in self._markers:
             self._markers[key] = self.mbs.AddMarker(items.MarkerBodyRigid(

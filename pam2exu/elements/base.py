@@ -66,7 +66,7 @@ class Param:
             if not _is_number(value):
                 return f"'{key}' must be a number ({self.meaning}), got {value!r}"
         elif self.kind == "law":
-            if value not in LAWS and value not in LAW_ALIASES:
+            if not isinstance(value, str) or (value not in LAWS and value not in LAW_ALIASES):
                 return (f"unknown law '{value}'{closest(value, law_names())}; "
                         f"known laws: {', '.join(law_names())}")
         elif self.kind == "choice":
@@ -194,6 +194,14 @@ class Element:
 
 class Actuator(Element):
     """An element whose constraint follows a time law f(t)."""
+
+    def more_problems(self, scope):
+        law = LAW_ALIASES.get(self.law, self.law)
+        c1, c2 = constants(self.C)[:2]
+        if LAWS[law][1] and not c1 < c2:
+            return [f"law '{self.law}' needs C1 < C2 (start and end of the motion, s), "
+                    f"got C1 = {c1:g}, C2 = {c2:g}"]
+        return []
 
     def time_law(self) -> Law:
         """The law f(t) with this element's constants (subclasses have ``law`` and ``C``)."""

@@ -54,7 +54,7 @@ def loads(text: str, source: str = "<string>") -> Model:
         if kind is None:
             problems.append(Problem(where, f"'type' is missing; one of {', '.join(ELEMENTS)}"))
             continue
-        cls = ELEMENTS.get(ALIASES.get(kind, kind))
+        cls = ELEMENTS.get(ALIASES.get(kind, kind)) if isinstance(kind, str) else None
         if cls is None:
             problems.append(Problem(where, f"unknown element type '{kind}'"
                                            f"{closest(kind, [*ELEMENTS, *ALIASES])}; known types: "

@@ -87,6 +87,11 @@ class LineRef:
         return (-math.sin(self.angle), math.cos(self.angle))
 
 
+def _table(value) -> dict:
+    """A solid's points or lines as a dict of str keys ({} when malformed: reported elsewhere)."""
+    return {str(k): v for k, v in value.items()} if isinstance(value, dict) else {}
+
+
 class Scope:
     """Resolves anchor strings ("solid", "solid.point", "solid.line") to references."""
 
@@ -114,28 +119,37 @@ class Scope:
         i, solid, item = self._split(text)
         if item is None:
             return PointRef(i, (0.0, 0.0), str(text))
-        if item not in solid.points:
-            hint = closest(item, solid.points)
-            if item in solid.lines:
+        points, lines = _table(solid.points), _table(solid.lines)
+        if item not in points:
+            hint = closest(item, points)
+            if item in lines:
                 hint = " (that is a line; a point is expected here)"
             raise LookupError(f"solid '{solid.name}' has no point '{item}'{hint}; "
-                              f"its points are: {', '.join(solid.points) or 'none'}")
-        x, y = solid.points[item]
-        return PointRef(i, (float(x), float(y)), str(text))
+                              f"its points are: {', '.join(points) or 'none'}")
+        try:
+            x, y = points[item]
+            return PointRef(i, (float(x), float(y)), str(text))
+        except (TypeError, ValueError):
+            raise LookupError(f"point '{item}' of solid '{solid.name}' is not [x, y]") from None
 
     def line(self, text: str) -> LineRef:
         i, solid, item = self._split(text)
         if item is None:
             return LineRef(i, (0.0, 0.0), 0.0, str(text))
-        if item not in solid.lines:
-            hint = closest(item, solid.lines)
-            if item in solid.points:
+        points, lines = _table(solid.points), _table(solid.lines)
+        if item not in lines:
+            hint = closest(item, lines)
+            if item in points:
                 hint = " (that is a point; a line is expected here)"
             raise LookupError(f"solid '{solid.name}' has no line '{item}'{hint}; "
-                              f"its lines are: {', '.join(solid.lines) or 'none'}")
-        line = solid.lines[item]
-        px, py = line.get("point", (0.0, 0.0))
-        return LineRef(i, (float(px), float(py)), float(line.get("angle", 0.0)), str(text))
+                              f"its lines are: {', '.join(lines) or 'none'}")
+        try:
+            line = lines[item]
+            px, py = line.get("point", (0.0, 0.0))
+            return LineRef(i, (float(px), float(py)), float(line.get("angle", 0.0)), str(text))
+        except (AttributeError, TypeError, ValueError):
+            raise LookupError(f"line '{item}' of solid '{solid.name}' is not "
+                              "{ point = [x, y], angle = a }") from None
 
     def resolve(self, kind: str, text: str):
         """kind is 'solid', 'point' or 'line'."""

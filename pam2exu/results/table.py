@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, closest
+from ..errors import ModelError, Problem, closest
 
 
 class Results:
@@ -125,8 +125,8 @@ def select_columns(columns: list[str], patterns) -> list[str]:
     for p in patterns:
         hits = [c for c in columns if fnmatch.fnmatchcase(c, _pattern(p))]
         if not hits and p != "t":
-            problems.append(f"output '{p}' matches no variable of this analysis"
-                            f"{closest(p, columns)}")
+            problems.append(Problem("outputs", f"'{p}' matches no variable of this analysis"
+                                               f"{closest(p, columns)}"))
         chosen.update(hits)
     if problems:
         raise ModelError(problems)
