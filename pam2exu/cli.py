@@ -32,11 +32,13 @@ def _parser() -> argparse.ArgumentParser:
                      help="columns to keep: names, 'solid.*', '*.Fx' or bare 'Fx'")
     run.add_argument("-o", "--output", metavar="OUT.csv", help="write all rows as CSV")
     run.add_argument("--verbose", action="store_true", help="show Exudyn's solver output")
-    run.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    run.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                     help=argparse.SUPPRESS)
 
     check = sub.add_parser("check", help="validate a model, print its mobility and elements")
     check.add_argument("model", help="model file (TOML)")
-    check.add_argument("--debug", action="store_true", help=argparse.SUPPRESS)
+    check.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                       help=argparse.SUPPRESS)
     return p
 
 

@@ -17,7 +17,7 @@ class Problem:
     message: str
 
     def __str__(self) -> str:
-        return f"{self.where}: {self.message}"
+        return f"{self.where}: {self.message}" if self.where else self.message
 
 
 class ModelError(Pam2ExuError):
@@ -29,7 +29,7 @@ class ModelError(Pam2ExuError):
     def __init__(self, problems: list[Problem] | Problem | str, source: str | None = None):
         if isinstance(problems, (Problem, str)):
             problems = [problems]
-        self.problems = [p if isinstance(p, Problem) else Problem("model", p) for p in problems]
+        self.problems = [p if isinstance(p, Problem) else Problem("", p) for p in problems]
         self.source = source
         super().__init__(self._text())
 

@@ -68,11 +68,17 @@ def worst_elements(mech, residual_row: np.ndarray, count: int = 3) -> list[tuple
     return [(f"'{el.name}' ({el.type})", r) for el, r in scores[:count] if r > 0]
 
 
-def _solve(J, b, redundant):
-    """x with J x = b per step; least squares (exact when consistent) if redundant."""
+def _solve(J, b, redundant, rtol=1e-12):
+    """x with J x = b per step: LU when square; x = V Σ⁻¹ Uᵀ b (exact when consistent) if redundant.
+
+    Raises LinAlgError where J has lost rank (a singular position).
+    """
     if not redundant:
         return np.linalg.solve(J, b[..., None])[..., 0]
-    return np.einsum("nij,nj->ni", np.linalg.pinv(J), b)
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    if np.any(s[:, -1] <= rtol * s[:, 0]):
+        raise np.linalg.LinAlgError("rank lost")
+    return np.einsum("nkq,nk->nq", Vt, np.einsum("nmk,nm->nk", U, b) / s)
 
 
 def rates(mech, t, q, accelerations: bool, redundant: bool):

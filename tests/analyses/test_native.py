@@ -1,0 +1,56 @@
+"""The native pass: each element's Jacobian and convective term against finite differences.
+
+Reference: along a path q(s) = q0 + v s + a s²/2, every constraint quantity g(q) has
+dg/ds = Cq v and d²g/ds² = Cq a + conv at s = 0. Central differences of g along the path
+(fourth-order stencils, step h = 1e-3, error O(h⁴)) are computed here independently of ``kinematics``'s derivatives.
+"""
+import numpy as np
+import pytest
+
+import pam2exu
+from pam2exu.analyses import native
+from pam2exu.kinematics import State
+
+
+@pytest.fixture(scope="module")
+def every(request):
+    return pam2exu.load(request.config.rootpath / "tests/data/every_element.toml").mechanism()
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_jacobian_rate_and_convective_term_match_finite_differences(every, seed):
+    rng = np.random.default_rng(seed)
+    q0 = every.initial_q() + 0.05 * rng.standard_normal(every.nq)
+    v, a = rng.standard_normal(every.nq), rng.standard_normal(every.nq)
+    h = 1e-3
+    path = lambda s: q0 + v * s + 0.5 * a * s * s  # noqa: E731
+    for el in every.constraints:
+        g = lambda s: el.constraint(State([0.0], path(s)[None]))[0].value[0]  # noqa: E731
+        g2, g1, g0, g_1, g_2 = (g(k * h) for k in (2, 1, 0, -1, -2))
+        dg = (8 * (g1 - g_1) - (g2 - g_2)) / (12 * h)
+        ddg = (-g2 + 16 * g1 - 30 * g0 + 16 * g_1 - g_2) / (12 * h * h)
+        quantity = el.constraint(State([0.0], q0[None], v[None]))[0]
+        J = np.zeros((1, el.equations, every.nq))
+        quantity.rows(J, 0)
+        scale = 1.0 + np.abs(ddg)
+        np.testing.assert_allclose(J[0] @ v, dg, atol=1e-9, err_msg=el.name)
+        np.testing.assert_allclose(quantity.rate[0], J[0] @ v, atol=1e-14, err_msg=el.name)
+        np.testing.assert_allclose((J[0] @ a + quantity.conv[0]) / scale, ddg / scale,
+                                   atol=1e-7, err_msg=el.name)
+
+
+def test_gamma_of_actuators_includes_the_law():
+    """Cq qdd = γ: for fi2 − fi1 = f(t) with everything else at rest, γ = f''(t)."""
+    m = pam2exu.Model("motor", gravity=0.0)
+    m.add_solid("ground")
+    m.add_solid("crank")
+    m.add("fixed", anc1="ground")
+    m.add("angular_actuator", name="motor", anc1="ground", anc2="crank", law="polynomial",
+          C=[0.0, 1.0, 2.0, 3.0])
+    mech = m.mechanism()
+    t = np.array([0.0, 0.5, 1.0])
+    q = np.zeros((3, 6))
+    eq = native.equations(mech, State(t, q, np.zeros_like(q)))
+    row = mech.rows[1].start
+    np.testing.assert_allclose(eq.gamma[:, row], 4.0 + 18.0 * t, rtol=1e-15)
+    np.testing.assert_allclose(eq.c_t[:, row], -(1.0 + 4.0 * t + 9.0 * t * t), rtol=1e-15)

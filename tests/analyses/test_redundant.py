@@ -1,0 +1,48 @@
+"""Redundant but consistent constraints still move (contract: "Degrees of freedom").
+
+Reference: a parallelogram with a fifth parallel bar, driven by crank1 with
+θ(t) = π/2 + 1.2 cos(2π t): all three cranks turn with θ and the coupler translates
+(fi = 0) on a circle of radius 0.3, so its origin is (0.3 cos θ, 0.3 sin θ).
+"""
+import numpy as np
+import pytest
+
+import pam2exu
+from pam2exu.analyses import RedundancyWarning
+
+
+@pytest.fixture(scope="module")
+def res(request):
+    with pytest.warns(RedundancyWarning, match="redundant constraint"):
+        return pam2exu.run(request.config.rootpath / "tests/data/parallelogram5.toml")
+
+
+def test_positions_velocities_accelerations_are_exact(res):
+    w = 2 * np.pi
+    th = np.pi / 2 + 1.2 * np.cos(w * res.t)
+    thd = -1.2 * w * np.sin(w * res.t)
+    thdd = -1.2 * w * w * np.cos(w * res.t)
+    for crank in ("crank1", "crank2", "crank3"):
+        np.testing.assert_allclose(res[f"{crank}.fi"], th, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(res[f"{crank}.Dfi"], thd, rtol=0, atol=1e-12 * w)
+        np.testing.assert_allclose(res[f"{crank}.DDfi"], thdd, rtol=0, atol=1e-11 * w * w)
+    np.testing.assert_allclose(res["coupler.fi"], 0.0, atol=1e-13)
+    np.testing.assert_allclose(res["coupler.x"], 0.3 * np.cos(th), atol=1e-13)
+    np.testing.assert_allclose(res["coupler.y"], 0.3 * np.sin(th), atol=1e-13)
+    np.testing.assert_allclose(res["coupler.DDx"], 0.3 * (-np.cos(th) * thd**2 - np.sin(th) * thdd),
+                               atol=1e-11 * 0.3 * w * w)
+
+
+def test_run_reports_the_redundancy(res):
+    assert res.info["redundant_equations"] == 1
+    assert res.info["dof"] == 0
+    assert any("'O3'" in w and "not" in w for w in res.warnings)
+
+
+def test_singular_position_of_a_redundant_mechanism_is_an_error(request):
+    """Driven through θ = π, all bars are collinear: Cq loses rank (a change point)."""
+    model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
+    model["motor"].law, model["motor"].C = "polynomial", [np.pi / 2, 2 * np.pi]
+    with pytest.warns(RedundancyWarning):
+        with pytest.raises(pam2exu.SolverError, match=r"t = 0\.25 s .*singular"):
+            pam2exu.run(model, steps=400)

@@ -1,0 +1,87 @@
+"""The command line: exit codes, one-paragraph errors on stderr, CSV output."""
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pam2exu.cli import main
+
+
+def test_run_writes_csv(examples, tmp_path, capsys):
+    out = tmp_path / "sc.csv"
+    code = main(["run", str(examples / "slider_crank.toml"), "--analysis", "kinematic",
+                 "--steps", "50", "--t-end", "0.1", "--outputs", "crank.*", "-o", str(out)])
+    assert code == 0
+    assert "wrote 51 rows" in capsys.readouterr().out
+    rows = list(csv.reader(open(out, encoding="utf-8")))
+    assert rows[0][:3] == ["t", "crank.x", "crank.y"]
+    data = np.array(rows[1:], dtype=float)
+    np.testing.assert_allclose(data[:, rows[0].index("crank.fi")], 10.0 * data[:, 0], atol=1e-14)
+
+
+def test_run_prints_summary(examples, capsys):
+    assert main(["run", str(examples / "slider_crank.toml"), "-a", "kinematic",
+                 "--steps", "10"]) == 0
+    out = capsys.readouterr().out
+    assert "kinematic analysis of 'slider-crank': 11 rows" in out
+    assert "slider.DDx" in out
+
+
+def test_model_error_exit_2_names_file_and_element(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[solid]]\nname = "a"\n[[element]]\ntype = "revolut"\nname = "j"\n')
+    assert main(["run", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pam2exu: model error: {bad}: [[element]] #1 'j'")
+    assert "did you mean 'revolute'" in err
+    assert "Traceback" not in err
+
+
+def test_solver_failure_exit_1(tmp_path, capsys):
+    """A rod (0.05) shorter than the crank (0.1): the loop cannot close once the crank turns."""
+    src = (Path(__file__).resolve().parents[1] / "examples" / "slider_crank.toml").read_text().replace("B = [0.3, 0.0] }", "B = [0.05, 0.0] }")
+    path = tmp_path / "short_rod.toml"
+    path.write_text(src)
+    assert main(["run", str(path), "-a", "kinematic", "--steps", "50"]) == 1
+    err = capsys.readouterr().err
+    assert "solver failure" in err and "did not converge at t =" in err
+    assert "Traceback" not in err
+
+
+def test_check_prints_mobility(examples, capsys):
+    assert main(["check", str(examples / "slider_crank.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "degrees of freedom not driven: 0" in out
+    assert "redundant constraint equations: 0" in out
+    assert "guide  prismatic" in out
+
+
+def test_check_names_free_solids(tmp_path, examples, capsys):
+    src = (examples / "slider_crank.toml").read_text()
+    src = src[:src.index('[[element]]\ntype = "angular_actuator"')]
+    path = tmp_path / "free.toml"
+    path.write_text(src)
+    assert main(["check", str(path)]) == 0
+    assert "degrees of freedom not driven: 1 (solids free to move: crank, rod, slider)" \
+        in capsys.readouterr().out
+
+
+def test_console_script_and_debug_traceback(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("not toml [")
+    r = subprocess.run([sys.executable, "-m", "pam2exu", "run", str(bad)], capture_output=True,
+                       text=True)
+    assert r.returncode == 2 and "not valid TOML" in r.stderr and "Traceback" not in r.stderr
+    r = subprocess.run([sys.executable, "-m", "pam2exu", "--debug", "run", str(bad)],
+                       capture_output=True, text=True)
+    assert "Traceback" in r.stderr
+
+
+@pytest.mark.parametrize("argv", [["run"], ["frobnicate"]])
+def test_bad_command_line_exit_2(argv):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
