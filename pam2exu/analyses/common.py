@@ -131,12 +131,18 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nd
     job.info["exudyn_seconds"] = _time.perf_counter() - start
     if solved < len(job.times):
         t = float(job.times[solved])
-        worst = native.worst_elements(mech, native.residuals(mech, [t], system.coordinates()[None])[0])
-        where = ", ".join(f"{name} {r:.3g}" for name, r in worst) or "none"
+        start = q[solved - 1] if solved > 0 else system.coordinates()
+        left = native.closest_violation(mech, t, start)
+        worst = [w for w in native.worst_elements(mech, left)
+                 if w[1] > RESIDUAL_TOLERANCE * mech.scale()]
+        where = (("the constraints cannot all hold; still violated at the closest "
+                  "configuration: " + ", ".join(f"{name} by {r:.3g}" for name, r in worst))
+                 if worst else "the constraints can hold there, so the Newton iteration "
+                               "diverged (a singular position or too large a step)")
         step = f"step {solved} of {len(job.times) - 1}" if job.analysis != "assembly" else "assembly"
         raise SolverError(
             f"Exudyn's static solver did not converge at t = {t:.6g} s ({step}). "
-            f"Constraints violated most there: {where}. "
+            f"At that time {where}. "
             "Try: an initial guess (x, y, fi of the solids) closer to an assembled position; "
             "more steps, so the actuators move less per step; or check whether the mechanism "
             "cannot close at this time or reaches a singular (dead-point) position. "

@@ -167,3 +167,21 @@ def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
         if bad.size:
             return a + int(bad[0])
     return n - 1
+
+
+def closest_violation(mech, t: float, q_start: np.ndarray) -> np.ndarray:
+    """Residual C(q*, t) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only).
+
+    The elements still violated at q* are those that cannot close at time t.
+    """
+    from scipy.optimize import least_squares
+
+    def fun(q):
+        return equations(mech, State([t], q[None])).residual[0]
+
+    def jac(q):
+        return equations(mech, State([t], q[None])).jacobian[0]
+
+    sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
+                        else "trf", max_nfev=200 * mech.nq, xtol=1e-14, ftol=1e-14)
+    return sol.fun
