@@ -60,9 +60,9 @@ def loads(text: str, source: str = "<string>") -> Model:
                                            f"{closest(kind, [*ELEMENTS, *ALIASES])}; known types: "
                                            f"{', '.join(ELEMENTS)}"))
             continue
-        bad = _unknown_keys(entry, cls.keys(), where + f" ({cls.type})", problems)
-        keys = {key: v for key, v in entry.items() if key != "type" and key not in bad}
-        model.add(cls(**keys, position=k))
+        keys = {key: v for key, v in entry.items() if key != "type" and key in cls.keys()}
+        added = model.add(cls(**keys, position=k))      # names it <type><n> when unnamed
+        _unknown_keys(entry, cls.keys(), added.where, problems)
     table = _table(data, "analysis", problems)
     _unknown_keys(table, _ANALYSIS_KEYS, "[analysis]", problems)
     model.analysis = Analysis(**{k: v for k, v in table.items() if k in _ANALYSIS_KEYS})
