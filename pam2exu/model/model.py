@@ -8,7 +8,7 @@ from __future__ import annotations
 import copy
 import math
 import numbers
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 from ..elements import ALIASES, ELEMENTS, Element
@@ -74,6 +74,11 @@ class Model:
     def add_solid(self, solid: Solid | str, **keys) -> Solid:
         """Add a solid (a Solid, or a name and its keys); returns it."""
         if not isinstance(solid, Solid):
+            allowed = [f.name for f in fields(Solid)]
+            unknown = [k for k in keys if k not in allowed]
+            if unknown:
+                raise ModelError([f"a solid has no key '{k}'{closest(k, allowed)}" for k in unknown],
+                                 self.source)
             solid = Solid(solid, **keys)
         if solid.position is None:
             solid.position = len(self.solids) + 1
@@ -88,7 +93,13 @@ class Model:
                 raise ModelError(f"unknown element type '{element}'"
                                  f"{closest(element, [*ELEMENTS, *ALIASES])}; known types: "
                                  f"{', '.join(ELEMENTS)}", self.source)
-            element = ELEMENTS[kind](**keys)
+            cls = ELEMENTS[kind]
+            unknown = [k for k in keys if k not in {f.name for f in fields(cls)}]
+            if unknown:
+                raise ModelError([f"a {kind} has no key '{k}'{closest(k, cls.keys())}; its keys "
+                                  f"are: {', '.join(cls.keys()[1:])}" for k in unknown],
+                                 self.source)
+            element = cls(**keys)
         if element.position is None:
             element.position = len(self.elements) + 1
         if element.name is None:

@@ -869,3 +869,11 @@ def test_python_api_builds_the_same_model_as_the_file():
     assert a.nq == b.nq == 12 and a.n_equations == b.n_equations == 12
     assert [e.refs for e in a.elements] == [e.refs for e in b.elements]
     assert a.initial_q().tolist() == b.initial_q().tolist()
+
+
+def test_python_api_unknown_keywords_are_model_errors():
+    m = pam2exu.Model("api")
+    with pytest.raises(ModelError, match="a solid has no key 'mas' \\(did you mean 'mass'\\?\\)"):
+        m.add_solid("g", mas=1.0)
+    with pytest.raises(ModelError, match="a revolute has no key 'anc3' \\(did you mean 'anc2'\\?\\)"):
+        m.add("revolute", anc1="a.O", anc3="b.O")
