@@ -133,11 +133,11 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nd
         t = float(job.times[solved])
         start = q[solved - 1] if solved > 0 else system.coordinates()
         left = native.closest_violation(mech, t, start)
-        worst = [w for w in native.worst_elements(mech, left)
+        worst = [w for w in native.worst_elements(mech, left, len(mech.constraints))
                  if w[1] > RESIDUAL_TOLERANCE * mech.scale()]
         where = (("the constraints cannot all hold; still violated at the closest "
                   "configuration: " + ", ".join(f"{name} by {r:.3g}" for name, r in worst))
-                 if worst else "the constraints can hold there, so the Newton iteration "
+                 if worst else "the constraints can all hold, so the Newton iteration "
                                "diverged (a singular position or too large a step)")
         step = f"step {solved} of {len(job.times) - 1}" if job.analysis != "assembly" else "assembly"
         raise SolverError(

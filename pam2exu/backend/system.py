@@ -16,6 +16,7 @@ import exudyn as exu
 from exudyn import itemInterface as items
 
 from ..errors import SolverError
+from ..kinematics import State
 
 
 @dataclass
@@ -26,7 +27,7 @@ class SolveSettings:
     ----------
     tolerance : float
         Newton's absolute tolerance on the constraint residual, relative to the
-        mechanism's length scale.
+        mechanism's length scale (never below the round-off floor, ``ExudynSystem.roundoff``).
     max_iterations : int
         Newton iterations per step before Exudyn subdivides the step.
     dense : bool | None
@@ -153,13 +154,29 @@ class ExudynSystem:
         """Current ODE2 coordinates (x, y, fi per solid)."""
         return np.asarray(self.mbs.systemData.GetODE2Coordinates())
 
-    def simulation_settings(self, settings: SolveSettings, redundant: bool):
+    def roundoff(self, tables) -> float:
+        """The residual below which Newton cannot go: 16 ulps of the largest equation term.
+
+        Angles are never wrapped, so the angle equations (actuators, transmissions) add up
+        terms that grow with every turn: about the largest |q0| or law value over the run,
+        times the largest angle coefficient of the constraint Jacobian (a gear ratio).
+        """
+        q0 = self.mech.initial_q()
+        st = State([0.0], q0[None])
+        gain = max([1.0, *(float(np.max(np.abs(block[..., 2])))
+                           for el in self.mech.constraints
+                           for block in el.constraint(st)[0].jac.values())])
+        size = max([1.0, *np.abs(q0), *(float(np.max(np.abs(v))) for *_, v in tables)])
+        return 16.0 * np.finfo(float).eps * size * gain
+
+    def simulation_settings(self, settings: SolveSettings, redundant: bool,
+                            roundoff: float = 0.0):
         ss = exu.SimulationSettings()
         ss.solution.file.write = False
         ss.solution.sensors.writePeriod = 0.0
         ss.staticSolver.verboseMode = settings.verbose
         newton = ss.staticSolver.newton
-        newton.absoluteTolerance = settings.tolerance * self.mech.scale()
+        newton.absoluteTolerance = max(settings.tolerance * self.mech.scale(), roundoff)
         newton.relativeTolerance = settings.tolerance
         newton.maxIterations = settings.max_iterations
         dense = settings.dense if settings.dense is not None else self.mech.nq <= 300
@@ -197,7 +214,7 @@ class ExudynSystem:
 
         if tables:
             mbs.SetPreStepUserFunction(pre_step)
-        ss = self.simulation_settings(settings, redundant)
+        ss = self.simulation_settings(settings, redundant, self.roundoff(tables))
         ss.staticSolver.numberOfLoadSteps = n
         ss.staticSolver.loadStepDuration = n * dt
         error = None

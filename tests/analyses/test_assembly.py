@@ -1,0 +1,149 @@
+"""Assembly analysis: closed-form poses, free degrees of freedom, and the errors.
+
+The reference pose of the four-bar (examples/four_bar.toml: crank a = 0.1, coupler b = 0.35,
+rocker c = 0.3, ground d = 0.4, pivots O2 = (0, 0), O4 = (d, 0)) is the circle intersection:
+A = a e(θ), D = O4 − A, δ = |D|, coupler angle φ = atan2(D) + acos((b² + δ² − c²)/(2 b δ))
+(law of cosines in the triangle A-B-O4; the + sign is the mode with the coupler above the
+line A-O4, the example's mode), B = A + b e(φ), rocker angle ψ = atan2(B − O4).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pam2exu
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+a, b, c, d = 0.1, 0.35, 0.3, 0.4
+SOLIDS = ("ground", "crank", "coupler", "rocker")
+
+
+def four_bar_pose(theta):
+    """(φ, ψ) of the coupler and the rocker at crank angle θ, coupler above A-O4 (see the
+    module docstring)."""
+    A = a * np.array([math.cos(theta), math.sin(theta)])
+    D = np.array([d, 0.0]) - A
+    delta = math.hypot(*D)
+    phi = math.atan2(D[1], D[0]) + math.acos((b * b + delta**2 - c * c) / (2 * b * delta))
+    B = A + b * np.array([math.cos(phi), math.sin(phi)])
+    return phi, math.atan2(B[1], B[0] - d)
+
+
+def joint_gaps(res):
+    """|r2 − r1| of the four revolutes, computed here from the assembled x, y, fi."""
+    def point(solid, local):
+        x, y, fi = (float(res[f"{solid}.{v}"][0]) for v in ("x", "y", "fi"))
+        return np.array([x + math.cos(fi) * local[0] - math.sin(fi) * local[1],
+                         y + math.sin(fi) * local[0] + math.cos(fi) * local[1]])
+    pairs = {"O2": (point("ground", (0, 0)), point("crank", (0, 0))),
+             "A": (point("crank", (a, 0)), point("coupler", (0, 0))),
+             "B": (point("coupler", (b, 0)), point("rocker", (c, 0))),
+             "O4": (point("ground", (d, 0)), point("rocker", (0, 0)))}
+    return {k: float(np.linalg.norm(p - q)) for k, (p, q) in pairs.items()}
+
+
+def test_four_bar_assembles_from_a_poor_guess():
+    """Guesses off by up to 0.6 rad and 0.1 m, still nearer the coupler-above mode: the
+    assembly is the closed-form pose at θ = f(0) = 0 (A = (a, 0), φ = 0.94797, ψ = 1.89594),
+    one row, x, y, fi of every solid and nothing else."""
+    m = pam2exu.load(EXAMPLES / "four_bar.toml")
+    m["crank"].fi = 0.5
+    m["coupler"].x, m["coupler"].y, m["coupler"].fi = 0.0, 0.1, 0.3
+    m["rocker"].x, m["rocker"].y, m["rocker"].fi = 0.45, 0.05, 1.3
+    res = pam2exu.run(m, analysis="assembly")
+    assert len(res) == 1 and res.t.tolist() == [0.0]
+    assert res.columns == [f"{s}.{v}" for s in SOLIDS for v in ("x", "y", "fi")]
+    phi, psi = four_bar_pose(0.0)
+    expected = {"ground": (0, 0, 0), "crank": (0, 0, 0), "coupler": (a, 0, phi),
+                "rocker": (d, 0, psi)}
+    for s, pose in expected.items():
+        for v, value in zip(("x", "y", "fi"), pose):
+            assert res[f"{s}.{v}"][0] == pytest.approx(value, abs=1e-10), f"{s}.{v}"
+
+
+def free_four_bar(theta, perturbation=0.0):
+    """The four-bar without its motor (one free degree of freedom), the guess the
+    closed-form pose at crank angle θ, every x, y, fi moved by ``perturbation``."""
+    m = pam2exu.load(EXAMPLES / "four_bar.toml")
+    m.elements = [el for el in m.elements if el.name != "motor"]
+    phi, psi = four_bar_pose(theta)
+    pose = {"crank": (0.0, 0.0, theta), "coupler": (a * math.cos(theta), a * math.sin(theta), phi),
+            "rocker": (d, 0.0, psi)}
+    for s, (x, y, fi) in pose.items():
+        m[s].x, m[s].y, m[s].fi = x + perturbation, y - perturbation, fi + perturbation
+    return m, pose
+
+
+def test_free_mechanism_assembled_guess_stays_put():
+    """Without the motor the four-bar has one free degree of freedom: assembly accepts it.
+    An already assembled guess (crank at 0.7 rad) is a solution nearest to itself, so it
+    comes back unchanged."""
+    m, pose = free_four_bar(0.7)
+    res = pam2exu.run(m, analysis="assembly")
+    assert res.info["dof"] == 1
+    for s, values in pose.items():
+        for v, value in zip(("x", "y", "fi"), values):
+            assert res[f"{s}.{v}"][0] == pytest.approx(value, abs=1e-12), f"{s}.{v}"
+
+
+def test_free_mechanism_assembles_near_the_guess():
+    """A guess 0.02 (m and rad) off the assembled pose at crank angle 0.7: the constraints
+    hold to 1e-12 m (joint gaps computed here), the result is the closed-form pose at its
+    own crank angle, in the guessed mode, and within 0.05 of the guess in every coordinate."""
+    m, pose = free_four_bar(0.7, perturbation=0.02)
+    res = pam2exu.run(m, analysis="assembly")
+    gaps = joint_gaps(res)
+    assert max(gaps.values()) <= 1e-12, gaps
+    theta = float(res["crank.fi"][0])
+    phi, psi = four_bar_pose(theta)
+    assert res["coupler.fi"][0] == pytest.approx(phi, abs=1e-10)
+    assert res["rocker.fi"][0] == pytest.approx(psi, abs=1e-10)
+    for s in pose:
+        for v in ("x", "y", "fi"):
+            assert abs(res[f"{s}.{v}"][0] - getattr(m[s], v)) < 0.05, f"{s}.{v}"
+
+
+def test_four_bar_that_cannot_close_names_its_joints():
+    """Coupler b = 0.1 with the crank at θ = π: δ = |O4 − A| = d + a = 0.5 > b + c = 0.4,
+    so the loop cannot close (by 0.1 m). The SolverError names the loop's four revolutes,
+    whose constraints stay violated, and not the fixed link or the motor, which can hold."""
+    m = pam2exu.load(EXAMPLES / "four_bar.toml")
+    m["coupler"].points["B"] = [0.1, 0.0]
+    m["motor"].C = [math.pi, 2 * math.pi, 0.0, 0.0]
+    m["crank"].fi = math.pi
+    with pytest.raises(pam2exu.SolverError, match=r"cannot all hold.*'O2' \(revolute\)") as info:
+        pam2exu.run(m, analysis="assembly")
+    message = str(info.value)
+    for joint in ("O2", "A", "B", "O4"):
+        assert f"'{joint}' (revolute)" in message
+    assert "'motor'" not in message and "'base'" not in message
+    assert {name.split("'")[1] for name in info.value.elements} == {"O2", "A", "B", "O4"}
+    assert info.value.time == 0.0
+
+
+def test_kinematic_on_an_underdriven_model_names_the_free_solids():
+    """The four-bar without its motor: kinematic needs every degree of freedom driven, so
+    it raises MobilityError naming crank, coupler and rocker (the solids that can move)."""
+    m, _ = free_four_bar(0.0)
+    with pytest.raises(pam2exu.MobilityError, match=r"1 free degree.*'crank', 'coupler', 'rocker'"):
+        pam2exu.run(m, analysis="kinematic", steps=10)
+
+
+def test_underdriven_names_only_the_free_solids():
+    """The driven four-bar plus a pendulum hinged to the ground and not driven: one free
+    degree of freedom, and only the pendulum is named (the four-bar is driven)."""
+    m = pam2exu.load(EXAMPLES / "four_bar.toml")
+    m["ground"].points["H"] = [0.2, -0.3]
+    m.add_solid("pendulum", x=0.2, y=-0.3, fi=-1.5, points={"O": [0.0, 0.0]})
+    m.add("revolute", name="hinge", anc1="ground.H", anc2="pendulum.O")
+    free = r"solid\(s\) 'pendulum' can still move"
+    with pytest.raises(pam2exu.MobilityError, match=free) as info:
+        pam2exu.run(m, analysis="kinematic", steps=10)
+    assert "'crank'" not in str(info.value)
+    # assembly accepts it, and the pendulum stays where it was put
+    res = pam2exu.run(m, analysis="assembly")
+    assert res["pendulum.fi"][0] == pytest.approx(-1.5, abs=1e-12)
+    assert res["coupler.fi"][0] == pytest.approx(four_bar_pose(0.0)[0], abs=1e-10)
