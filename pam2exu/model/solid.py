@@ -115,38 +115,39 @@ class Scope:
         i = self.index[solid_name]
         return i, self.solids[i], item
 
-    def point(self, text: str) -> PointRef:
+    def _find(self, text: str, kind: str):
+        """(index, solid, item name, item value) for "solid.item" of a kind 'point' or 'line';
+        the item is None for a bare solid name (its origin or its x axis)."""
         i, solid, item = self._split(text)
         if item is None:
+            return i, solid, None, None
+        tables = {"point": _table(solid.points), "line": _table(solid.lines)}
+        other = "line" if kind == "point" else "point"
+        if item not in tables[kind]:
+            hint = closest(item, tables[kind])
+            if item in tables[other]:
+                hint = f" (that is a {other}; a {kind} is expected here)"
+            raise LookupError(f"solid '{solid.name}' has no {kind} '{item}'{hint}; "
+                              f"its {kind}s are: {', '.join(tables[kind]) or 'none'}")
+        return i, solid, item, tables[kind][item]
+
+    def point(self, text: str) -> PointRef:
+        i, solid, item, value = self._find(text, "point")
+        if item is None:
             return PointRef(i, (0.0, 0.0), str(text))
-        points, lines = _table(solid.points), _table(solid.lines)
-        if item not in points:
-            hint = closest(item, points)
-            if item in lines:
-                hint = " (that is a line; a point is expected here)"
-            raise LookupError(f"solid '{solid.name}' has no point '{item}'{hint}; "
-                              f"its points are: {', '.join(points) or 'none'}")
         try:
-            x, y = points[item]
+            x, y = value
             return PointRef(i, (float(x), float(y)), str(text))
         except (TypeError, ValueError):
             raise LookupError(f"point '{item}' of solid '{solid.name}' is not [x, y]") from None
 
     def line(self, text: str) -> LineRef:
-        i, solid, item = self._split(text)
+        i, solid, item, value = self._find(text, "line")
         if item is None:
             return LineRef(i, (0.0, 0.0), 0.0, str(text))
-        points, lines = _table(solid.points), _table(solid.lines)
-        if item not in lines:
-            hint = closest(item, lines)
-            if item in points:
-                hint = " (that is a point; a line is expected here)"
-            raise LookupError(f"solid '{solid.name}' has no line '{item}'{hint}; "
-                              f"its lines are: {', '.join(lines) or 'none'}")
         try:
-            line = lines[item]
-            px, py = line.get("point", (0.0, 0.0))
-            return LineRef(i, (float(px), float(py)), float(line.get("angle", 0.0)), str(text))
+            px, py = value.get("point", (0.0, 0.0))
+            return LineRef(i, (float(px), float(py)), float(value.get("angle", 0.0)), str(text))
         except (AttributeError, TypeError, ValueError):
             raise LookupError(f"line '{item}' of solid '{solid.name}' is not "
                               "{ point = [x, y], angle = a }") from None
