@@ -15,7 +15,6 @@ import numpy as np
 import exudyn as exu
 from exudyn import itemInterface as items
 
-from ..errors import SolverError
 from ..kinematics import State
 
 
@@ -236,7 +235,3 @@ class ExudynSystem:
         self.error = error
         return q, solved
 
-
-def quiet() -> None:
-    """Silence Exudyn's console output."""
-    exu.config.printToConsole = False

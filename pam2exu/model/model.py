@@ -9,7 +9,6 @@ import copy
 import math
 import numbers
 from dataclasses import dataclass, field, fields
-from typing import Any
 
 from ..elements import ALIASES, ELEMENTS, Element
 from ..errors import ModelError, Problem, closest
