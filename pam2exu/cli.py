@@ -46,9 +46,6 @@ def _run(args) -> int:
     from .analyses import run
     from .backend import SolveSettings
     solver = SolveSettings(verbose=1 if args.verbose else 0)
-    if args.verbose:
-        import exudyn
-        exudyn.config.printToConsole = True
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # warnings are carried in res.warnings
         res = run(args.model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,

@@ -85,3 +85,12 @@ def test_bad_command_line_exit_2(argv):
     with pytest.raises(SystemExit) as exc:
         main(argv)
     assert exc.value.code == 2
+
+
+def test_exudyn_console_quiet_unless_verbose(examples, capfd):
+    assert main(["run", str(examples / "four_bar.toml"), "--steps", "3"]) == 0
+    quiet = capfd.readouterr().out
+    assert main(["run", str(examples / "four_bar.toml"), "--steps", "3", "--verbose"]) == 0
+    loud = capfd.readouterr().out
+    assert quiet.startswith("kinematic analysis")
+    assert len(loud) > len(quiet) and "STATIC" in loud.upper()

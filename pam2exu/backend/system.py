@@ -217,10 +217,13 @@ class ExudynSystem:
         ss.staticSolver.numberOfLoadSteps = n
         ss.staticSolver.loadStepDuration = n * dt
         error = None
+        exu.config.printToConsole = settings.verbose > 0
         try:
             mbs.SolveStatic(ss)
         except Exception as exc:  # Exudyn raises a bare RuntimeError/ValueError on failure
             error = exc
+        finally:
+            exu.config.printToConsole = False
         data = [np.asarray(mbs.GetSensorStoredData(s)) for s in self.sensors]
         q = np.full((n, 3 * len(self.nodes)), np.nan)
         if data and len(data[0]) > 1:
