@@ -55,9 +55,19 @@ def equations(mech, st: State) -> Equations:
     return Equations(residual, jacobian, c_t, gamma)
 
 
+def chunks(mech, n: int):
+    """Slices of the n steps, each small enough that its Jacobian fits in CHUNK_BYTES."""
+    size = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
+    return (slice(a, min(n, a + size)) for a in range(0, n, size))
+
+
 def residuals(mech, t, q) -> np.ndarray:
     """Constraint residual C(q, t), (n, m)."""
-    return equations(mech, State(t, q)).residual
+    t, q = np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(q)
+    out = np.empty((len(t), mech.n_equations))
+    for s in chunks(mech, len(t)):
+        out[s] = equations(mech, State(t[s], q[s])).residual
+    return out
 
 
 def worst_elements(mech, residual_row: np.ndarray, count: int = 3) -> list[tuple[str, float]]:
@@ -86,9 +96,7 @@ def rates(mech, t, q, accelerations: bool, redundant: bool):
     n = len(t)
     qd = np.empty_like(q)
     qdd = np.empty_like(q) if accelerations else None
-    chunk = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
-    for a in range(0, n, chunk):
-        s = slice(a, min(n, a + chunk))
+    for s in chunks(mech, n):
         eq = equations(mech, State(t[s], q[s]))
         qd[s] = _solve(eq.jacobian, -eq.c_t, redundant)
         if accelerations:
@@ -157,15 +165,13 @@ def require_driven(mech, mob: Mobility, analysis: str) -> None:
 def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
     """Index of the first step where Cq is (numerically) rank-deficient, else the last step."""
     n = len(t)
-    chunk = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
-    for a in range(0, n, chunk):
-        s = slice(a, min(n, a + chunk))
+    for s in chunks(mech, n):
         J = equations(mech, State(t[s], q[s])).jacobian
         sv = np.linalg.svd(J, compute_uv=False)
         rank = np.sum(sv > rtol * sv[:, :1], axis=1)
         bad = np.nonzero(rank < mech.nq)[0]
         if bad.size:
-            return a + int(bad[0])
+            return s.start + int(bad[0])
     return n - 1
 
 
