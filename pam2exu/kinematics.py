@@ -163,3 +163,42 @@ class State:
     def direction(self, solid: int, local) -> Quantity:
         """v = A(fi) u: a vector u fixed to a solid, in the global basis."""
         return self._rotated(solid, local, translate=False)
+
+
+def cross(a, b):
+    """a × b = ax by − ay bx (the z component), over the last axis: (n, 2) × (n, 2) -> (n,)."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def generalized_force(point: Quantity, force) -> dict[int, np.ndarray]:
+    """Q = Jᵀ F: a force F (n, 2) applied at a point (a Quantity of value (n, 2)), per solid.
+
+    For a point of solid i, Q_i = (Fx, Fy, (A s) × F): the force and its moment about the
+    origin of the solid's frame.
+    """
+    return {s: np.einsum("nd,ndk->nk", force, block) for s, block in point.jac.items()}
+
+
+def torque(solid: int, moment) -> dict[int, np.ndarray]:
+    """Q = (0, 0, M): a pure moment M (n,) on a solid."""
+    moment = np.asarray(moment, dtype=float)
+    out = np.zeros((moment.shape[0], 3))
+    out[:, 2] = moment
+    return {solid: out}
+
+
+def move_wrench(wrench, origin, point):
+    """(F, M_p) with M_p = M_O − (p − O) × F: a wrench (n, 3) about O moved to the point p."""
+    out = np.array(wrench, dtype=float, copy=True)
+    out[:, 2] -= cross(point - origin, wrench[:, :2])
+    return out
+
+
+def to_basis(wrench, direction):
+    """The wrench (n, 3) with its force in the basis whose x axis is the unit vector ``direction``."""
+    ex, ey = direction[:, 0], direction[:, 1]
+    out = np.empty_like(wrench)
+    out[:, 0] = ex * wrench[:, 0] + ey * wrench[:, 1]
+    out[:, 1] = -ey * wrench[:, 0] + ex * wrench[:, 1]
+    out[:, 2] = wrench[:, 2]
+    return out

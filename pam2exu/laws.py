@@ -118,3 +118,7 @@ class Law:
     def value(self, t: float) -> float:
         """f(t) for a scalar t, as a Python float (used in solver callbacks)."""
         return float(self(t)[0])
+
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times where f' or f'' may jump: C1 and C2 of the transition laws, none otherwise."""
+        return self.C[:2] if LAWS[self.name][1] else ()

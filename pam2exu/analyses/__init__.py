@@ -3,11 +3,14 @@ from __future__ import annotations
 
 from ..errors import ModelError, Problem
 from .assembly import assembly
-from .common import RedundancyWarning, prepare
+from .common import ConsistencyWarning, RedundancyWarning, prepare
 from .kinematic import kinematic
+from .kinetostatic import kinetostatic
+from .quasi_static import quasi_static
 
 #: analysis type -> function(Job) -> Results
-ANALYSES = {"assembly": assembly, "kinematic": kinematic}
+ANALYSES = {"assembly": assembly, "quasi_static": quasi_static, "kinematic": kinematic,
+            "kinetostatic": kinetostatic}
 
 
 def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None):
@@ -18,7 +21,8 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None)
     model : Model or path
         A model, or the path of a model file.
     analysis : str, optional
-        'assembly' or 'kinematic' (default: the model's [analysis] type).
+        'assembly', 'quasi_static', 'kinematic' or 'kinetostatic' (default: the
+        model's [analysis] type).
     t_end : float, optional
         End of the interval [s].
     steps : int, optional
@@ -36,4 +40,4 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None)
     return ANALYSES[job.analysis](job)
 
 
-__all__ = ["ANALYSES", "run", "RedundancyWarning"]
+__all__ = ["ANALYSES", "run", "RedundancyWarning", "ConsistencyWarning"]

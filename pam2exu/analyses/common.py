@@ -1,6 +1,8 @@
 """What all analyses share: settings, output columns, Exudyn positions, self-checks."""
 from __future__ import annotations
 
+import os
+import sys
 import time as _time
 import warnings
 from dataclasses import dataclass, field, replace
@@ -41,6 +43,10 @@ RESIDUAL_TOLERANCE = 1e-8
 
 class RedundancyWarning(UserWarning):
     """Redundant (consistent) constraints: positions are unique, reactions are not."""
+
+
+class ConsistencyWarning(UserWarning):
+    """A physics check after an analysis (the power balance) did not hold."""
 
 
 @dataclass
@@ -97,6 +103,8 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
     except ModelError as exc:
         raise ModelError(exc.problems, model.source) from None
     levels = {available[c].level for c in columns} | {POSITION}
+    if FORCE in levels and kind == "kinetostatic":
+        levels.add(ACCELERATION)                 # the inertia forces need qdd
     if ACCELERATION in levels:
         levels.add(VELOCITY)
     return Job(mech, kind, times, columns, {c: available[c].unit for c in columns}, levels,
@@ -104,30 +112,53 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
 
 
 def check_mobility(job: Job, q0: np.ndarray, need_driven: bool) -> native.Mobility:
-    """Rank test before any Exudyn call; warns once about redundant constraints."""
+    """Rank test at the initial guess, before any Exudyn call (``warn_redundant`` follows
+    once positions are solved)."""
     mob = native.mobility(job.mech, float(job.times[0]), q0)
     job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
                     condition_number=mob.condition)
     if need_driven:
         native.require_driven(job.mech, mob, job.analysis)
-    if mob.redundant and mob.dof == 0:
-        names = ", ".join(f"'{n}'" for n in mob.redundant_elements)
-        text = (f"{mob.redundant} redundant constraint equation(s) among {names}: positions, "
-                f"velocities and accelerations are unique, the reactions of these elements "
-                f"are not (they are given as the minimum-norm solution)")
-        job.warnings.append(text)
-        warnings.warn(text, RedundancyWarning, stacklevel=3)
     return mob
 
 
-def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.ndarray:
-    """Positions at every time from Exudyn's static solver; raises SolverError on failure."""
+def warn_redundant(job: Job, q: np.ndarray) -> None:
+    """Warn once about redundant constraints, naming the elements of the self-stress found
+    at the first solved configuration (where the rank test is exact)."""
+    mob = native.mobility(job.mech, float(job.times[0]), q)
+    if not mob.redundant or mob.dof:
+        return
+    names = ", ".join(f"'{n}'" for n in mob.redundant_elements)
+    text = (f"{mob.redundant} redundant constraint equation(s) among {names}: positions, "
+            f"velocities and accelerations are unique, the reactions of these elements "
+            f"are not (they are given as the minimum-norm solution)")
+    warn(job, text, RedundancyWarning)
+
+
+def warn(job: Job, text: str, category) -> None:
+    """Keep a warning with the results and issue it at the caller's line outside pam2exu."""
+    job.warnings.append(text)
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_code.co_filename.startswith(package):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(text, category, stacklevel=level)
+
+
+def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
+              forces: bool = False):
+    """Positions at every time from Exudyn's static solver; raises SolverError on failure.
+
+    With ``forces`` the Exudyn system also has the masses, gravity and force elements
+    (without dampers), and its multipliers are kept: returns (q, system) then, else q.
+    """
     from ..backend import ExudynSystem, SolveSettings
     mech = job.mech
     start = _time.perf_counter()
-    system = ExudynSystem(mech, forces=False, anchor_stiffness=anchor_stiffness)
+    system = ExudynSystem(mech, forces=forces, velocity_forces=False,
+                          anchor_stiffness=anchor_stiffness)
     q, solved = system.solve_positions(job.times, job.solver or SolveSettings(),
-                                       redundant=redundant)
+                                       redundant=redundant, multipliers=forces)
     job.info["exudyn_seconds"] = _time.perf_counter() - start
     if solved < len(job.times):
         t = float(job.times[solved])
@@ -149,7 +180,9 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nd
             f"Exudyn said: {system.error}",
             time=t, step=solved, elements=tuple(n for n, _ in worst))
     check_residual(mech, job.times, q, job)
-    return q
+    if redundant:
+        warn_redundant(job, q[0])
+    return (q, system) if forces else q
 
 
 def check_residual(mech, t, q, job: Job | None = None) -> None:

@@ -74,8 +74,10 @@ class ExudynSystem:
             mass, inertia = (float(s.mass), float(s.inertia)) if forces else (0.0, 0.0)
             gx, gy = (float(c) for c in s.cog)
             self.nodes.append(node)
+            # Exudyn's inertia is about the node (the frame origin), G is centerOfMass
             self.bodies.append(mbs.AddObject(items.ObjectRigidBody2D(
-                nodeNumber=node, mass=mass, inertia=inertia + mass * (gx * gx + gy * gy))))
+                nodeNumber=node, mass=mass, inertia=inertia + mass * (gx * gx + gy * gy),
+                centerOfMass=[gx, gy] if forces else [0.0, 0.0])))
         self._markers: dict = {}
         self._ground = None
         self.drivers: list = []          # (object, parameter, law)
@@ -148,6 +150,16 @@ class ExudynSystem:
         """Make an object's parameter follow law f(t) during position solves."""
         self.drivers.append((obj, parameter, law))
 
+    def ae_rows(self, element) -> list[int]:
+        """Exudyn's AE (multiplier) indices of an element, in the order of its native rows.
+
+        A pin_slot's ObjectJointPrismatic2D without rotation keeps a second, unused
+        multiplier (always 0): it is left out.
+        """
+        rows = [i for kind, obj in self.objects[element.name] if kind == "object"
+                for i in self.mbs.systemData.GetObjectLTGAE(obj)]
+        return rows[:element.equations]
+
     # ---- solving ---------------------------------------------------------------------------
     def coordinates(self) -> np.ndarray:
         """Current ODE2 coordinates (x, y, fi per solid)."""
@@ -173,6 +185,7 @@ class ExudynSystem:
         ss = exu.SimulationSettings()
         ss.solution.file.write = False
         ss.solution.sensors.writePeriod = 0.0
+        ss.staticSolver.useLoadFactor = False      # loads in full at every step, no ramp
         ss.staticSolver.verboseMode = settings.verbose
         newton = ss.staticSolver.newton
         newton.absoluteTolerance = max(settings.tolerance * self.mech.scale(), roundoff)
@@ -187,11 +200,14 @@ class ExudynSystem:
         return ss
 
     def solve_positions(self, times: np.ndarray, settings: SolveSettings | None = None,
-                        redundant: bool = False) -> tuple[np.ndarray, int]:
+                        redundant: bool = False,
+                        multipliers: bool = False) -> tuple[np.ndarray, int]:
         """Positions at times t_k = k·dt (k = 0…n−1), one static load step each.
 
         Returns (q, n_solved): q has a row per time; when Exudyn stops early, the rows
-        after n_solved are NaN.
+        after n_solved are NaN. With ``multipliers``, Exudyn's Lagrange multipliers of
+        every step are kept in ``self.multipliers`` (n, AE size); in the static solver
+        they satisfy f + Cqᵀ λ = 0, f the applied generalized forces.
 
         Exudyn's load step k ≥ 1 is solved at time k·dt; the laws are evaluated one
         step earlier, so load step k gives time t_{k−1} (``loadStepStart`` cannot be < 0).
@@ -213,6 +229,18 @@ class ExudynSystem:
 
         if tables:
             mbs.SetPreStepUserFunction(pre_step)
+        self.multipliers = None
+        if multipliers:
+            lam = self.multipliers = np.full((n, mbs.systemData.AEsize()), np.nan)
+            get = mbs.systemData.GetAECoordinates
+
+            def post_step(mbs, t):
+                k = int(round(t / dt)) - 1
+                if 0 <= k < n:
+                    lam[k] = get()
+                return True
+
+            mbs.SetPostStepUserFunction(post_step)
         ss = self.simulation_settings(settings, redundant, self.roundoff(tables))
         ss.staticSolver.numberOfLoadSteps = n
         ss.staticSolver.loadStepDuration = n * dt

@@ -4,6 +4,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from ..laws import LAWS, Law
 from .base import FORCE, POSITION, VELOCITY, Actuator, Param, Var
 
@@ -29,6 +31,7 @@ class AngularActuator(Actuator):
         Var("Df(t)", "rad/s", VELOCITY, "its first derivative"),
     )
     equations = 1
+    wrench = (None, None, "Mz")
 
     def constraint(self, st):
         """fi2 − fi1 − f(t) = 0 (Exudyn's ObjectConnectorCoordinate q[m1] − q[m0] − offset)."""
@@ -60,6 +63,13 @@ class LinearActuator(Actuator):
         Var("Df(t)", "m/s", VELOCITY, "its first derivative"),
     )
     equations = 1
+    wrench = ("Força", None, None)
+
+    def report_frame(self, st):
+        """At Q, x from P to Q (so that a positive force pushes Q away from P)."""
+        P, Q = (st.point(r.solid, r.local).value for r in self.refs)
+        d = Q - P
+        return Q, d / np.linalg.norm(d, axis=1, keepdims=True)
 
     def constraint(self, st):
         """|Q − P| − f(t) = 0 (Exudyn's ObjectConnectorDistance)."""

@@ -91,6 +91,24 @@ def number(value) -> float:
     return float(value)
 
 
+@dataclass
+class Load:
+    """What a force element does at the states ``st`` (every array has a row per state).
+
+    force:       generalized force on each solid it acts on, {solid: (n, 3)}: Fx, Fy and
+                 the moment about the solid's frame origin
+    outputs:     its force outputs under PAM's names (e.g. ``Força``)
+    potential:   V(q) when the force derives from a potential (springs), else None: then
+                 its whole power counts as work done from outside (torsors)
+    dissipation: power removed by its velocity terms (dampers), ≥ 0 for C4 ≥ 0
+    """
+
+    force: dict[int, np.ndarray]
+    outputs: dict[str, np.ndarray] = field(default_factory=dict)
+    potential: np.ndarray | None = None
+    dissipation: np.ndarray | None = None
+
+
 @dataclass(eq=False)
 class Element:
     """Base of all PAM elements. Subclasses set the class variables below."""
@@ -112,6 +130,10 @@ class Element:
     outputs: ClassVar[tuple[Var, ...]] = ()
     #: number of constraint equations it adds (0: a force element)
     equations: ClassVar[int] = 0
+    #: a constraint element's reaction, as reported: the names of the (force x, force y,
+    #: moment) components of the wrench it applies to its receiving solid, in its reporting
+    #: frame (``report_frame``); None marks a component that is zero by construction
+    wrench: ClassVar[tuple[str | None, str | None, str | None]] = ()
 
     #: 1-based position in the file's [[element]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
@@ -185,6 +207,27 @@ class Element:
     def compute(self, st: State, names: set[str]) -> dict[str, np.ndarray]:
         """Position- and velocity-level outputs (force outputs come from the force analyses)."""
         return {}
+
+    # ---- forces ------------------------------------------------------------------------
+    @property
+    def receiver(self) -> int:
+        """The solid whose received wrench is reported (solid 2 unless stated otherwise)."""
+        return self.ref2.solid
+
+    def report_frame(self, st: State) -> tuple[np.ndarray, np.ndarray]:
+        """(point (n, 2), unit x axis (n, 2)) where and in which basis the wrench is reported.
+
+        Default: the receiving solid's origin, global basis.
+        """
+        s = self.receiver
+        return st.q[:, 3 * s:3 * s + 2], np.broadcast_to([1.0, 0.0], (st.n, 2))
+
+    def loads(self, st: State, damping: bool) -> Load | None:
+        """A force element's action at the states ``st`` (None for constraint elements).
+
+        damping: include the velocity-dependent (C4) terms; ``st`` then has velocities.
+        """
+        return None
 
     # ---- Exudyn ------------------------------------------------------------------------
     def build(self, ex) -> None:

@@ -4,7 +4,23 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from .base import FORCE, POSITION, VELOCITY, Element, Param, Var, constants
+import numpy as np
+
+from ..kinematics import generalized_force, rotate, torque
+from .base import FORCE, POSITION, VELOCITY, Element, Load, Param, Var, constants
+
+
+def _add(forces: dict, more: dict) -> dict:
+    """Sum of two {solid: generalized force} dictionaries."""
+    out = dict(forces)
+    for solid, q in more.items():
+        out[solid] = out[solid] + q if solid in out else q
+    return out
+
+
+def _from_potential(coordinate, value) -> dict:
+    """Q = −F ∂c/∂q: a force F (n,) that tends to decrease the scalar quantity c."""
+    return {s: -value[:, None] * block[:, 0, :] for s, block in coordinate.jac.items()}
 
 
 @dataclass(eq=False)
@@ -22,6 +38,17 @@ class Torsor(Element):
         "C": Param("constants", "[Fx, Fy, M] in N, N, N·m", size=3),
         "axes": Param("choice", "basis of the components", choices=("global", "solid")),
     }
+
+    def loads(self, st, damping):
+        """Q = Jᵀ F + (0, 0, M), with F = A(fi) (Fx, Fy) in solid axes."""
+        fx, fy, m = constants(self.C, 3)
+        solid, local = self.ref1.solid, self.ref1.local
+        if self.axes == "solid":
+            force = rotate(st.q[:, 3 * solid + 2], np.array([fx, fy]))
+        else:
+            force = np.broadcast_to([fx, fy], (st.n, 2))
+        return Load(_add(generalized_force(st.point(solid, local), force),
+                         torque(solid, np.full(st.n, m))))
 
     def build(self, ex):
         fx, fy, m = constants(self.C, 3)
@@ -52,13 +79,33 @@ class Spring(Element):
         Var("Dro", "m/s", VELOCITY, "its rate"),
     )
 
-    def compute(self, st, names):
+    def distance(self, st):
+        """ro = |Q − P|, as a Quantity."""
         P, Q = (st.point(r.solid, r.local) for r in self.refs)
-        ro = (Q - P).norm()
+        return (Q - P).norm()
+
+    def compute(self, st, names):
+        ro = self.distance(st)
         out = {"ro": ro.value[:, 0]}
         if ro.rate is not None:
             out["Dro"] = ro.rate[:, 0]
         return out
+
+    def loads(self, st, damping):
+        """F = C1 + C2 (ro − C3) + C4 Dro attracts P and Q: Q = −F ∂ro/∂q.
+
+        V = C1 ro + C2 (ro − C3)²/2; the damper dissipates C4 Dro².
+        """
+        c1, c2, c3, c4 = constants(self.C)
+        ro = self.distance(st)
+        r = ro.value[:, 0]
+        force = c1 + c2 * (r - c3)
+        dissipation = None
+        if damping:
+            force = force + c4 * ro.rate[:, 0]
+            dissipation = c4 * ro.rate[:, 0] ** 2
+        return Load(_from_potential(ro, force), {"Força": force},
+                    c1 * r + 0.5 * c2 * (r - c3) ** 2, dissipation)
 
     def build(self, ex):
         c1, c2, c3, c4 = constants(self.C)
@@ -86,12 +133,32 @@ class TorsionalSpring(Element):
         Var("Dfi_rel", "rad/s", VELOCITY, "its rate"),
     )
 
+    def relative_angle(self, st):
+        """fi_rel = fi2 − fi1, as a Quantity."""
+        return st.angle(self.ref2.solid) - st.angle(self.ref1.solid)
+
     def compute(self, st, names):
-        rel = st.angle(self.ref2.solid) - st.angle(self.ref1.solid)
+        rel = self.relative_angle(st)
         out = {"fi_rel": rel.value[:, 0]}
         if rel.rate is not None:
             out["Dfi_rel"] = rel.rate[:, 0]
         return out
+
+    def loads(self, st, damping):
+        """Parell on solid 1, −Parell on solid 2: Q = −Parell ∂fi_rel/∂q.
+
+        V = C1 fi_rel + C2 (fi_rel − C3)²/2; the damper dissipates C4 Dfi_rel².
+        """
+        c1, c2, c3, c4 = constants(self.C)
+        rel = self.relative_angle(st)
+        r = rel.value[:, 0]
+        parell = c1 + c2 * (r - c3)
+        dissipation = None
+        if damping:
+            parell = parell + c4 * rel.rate[:, 0]
+            dissipation = c4 * rel.rate[:, 0] ** 2
+        return Load(_from_potential(rel, parell), {"Parell": parell},
+                    c1 * r + 0.5 * c2 * (r - c3) ** 2, dissipation)
 
     def build(self, ex):
         c1, c2, c3, c4 = constants(self.C)

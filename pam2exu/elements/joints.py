@@ -24,6 +24,11 @@ class Fixed(Element):
         Var("Mz", "N·m", FORCE, "moment the solid receives, counter-clockwise"),
     )
     equations = 3
+    wrench = ("Fx", "Fy", "Mz")
+
+    @property
+    def receiver(self):
+        return self.ref1.solid
 
     def bind(self, scope):
         super().bind(scope)
@@ -55,6 +60,11 @@ class Revolute(Element):
         Var("Fy", "N", FORCE, "force solid 1 exerts on solid 2 at the joint, global y"),
     )
     equations = 2
+    wrench = ("Fx", "Fy", None)
+
+    def report_frame(self, st):
+        """At the joint, global basis."""
+        return st.point(self.ref2.solid, self.ref2.local).value, super().report_frame(st)[1]
 
     def constraint(self, st):
         """r2 − r1 = 0 (Exudyn's ObjectJointRevolute2D: p(marker1) − p(marker0))."""
@@ -88,6 +98,13 @@ class Prismatic(Element):
             "of solid 2's line"),
     )
     equations = 2
+    wrench = (None, "Fnormal", "Mz")
+
+    def report_frame(self, st):
+        """At the defining point of solid 2's line, x along that line (its own sense)."""
+        line2 = self.ref2
+        return (st.point(line2.solid, line2.point).value,
+                st.direction(line2.solid, line2.direction).value)
 
     def constraint(self, st):
         """(p1 − p2)·n1 = 0 and (A2 t2)·(A1 n1) = 0 (Exudyn's ObjectJointPrismatic2D, markers [2, 1])."""
@@ -115,6 +132,13 @@ class PinSlot(Element):
     outputs = (Var("Fnormal", "N", FORCE,
                    "force the guide (solid 1) exerts on the pin (solid 2), normal to the guide"),)
     equations = 1
+    wrench = (None, "Fnormal", None)
+
+    def report_frame(self, st):
+        """At the pin, x along the guide."""
+        guide, pin = self.refs
+        return (st.point(pin.solid, pin.local).value,
+                st.direction(guide.solid, guide.direction).value)
 
     def constraint(self, st):
         """(p_guide − p_pin)·n_guide = 0 (ObjectJointPrismatic2D, markers [pin, guide])."""
@@ -148,6 +172,7 @@ class Transmission(Element):
     }
     outputs = (Var("Parell", "N·m", FORCE, "torque solid 2 receives from the transmission"),)
     equations = 1
+    wrench = (None, None, "Parell")
 
     def more_problems(self, scope):
         if self.arm is not None:

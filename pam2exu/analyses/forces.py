@@ -1,0 +1,259 @@
+"""The native force pass: applied and inertia forces, multipliers, reactions, power balance.
+
+With q = (x, y, fi) per solid, the equations of motion of the constrained solids read
+
+    Q_inertia = Q_applied + Cqᵀ λ          Q_inertia = M(q) qdd + (centrifugal terms)
+
+so the constraint forces Cqᵀ λ follow from one linear solve per step once q, qd, qdd are
+known (inverse dynamics; quasi-statics is the same with Q_inertia = 0). These λ are the
+static solver's multipliers of Exudyn (f + Cqᵀ λ = 0), so both can be compared directly.
+
+An element's reaction is the part of Cqᵀ λ that its own rows give to its receiving solid
+(a wrench about that solid's origin), moved to the element's reporting point and turned
+into its reporting basis (``Element.wrench``, ``Element.report_frame``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..elements.base import Load
+from ..errors import TranslationError
+from ..kinematics import State, generalized_force, move_wrench, to_basis
+from . import native
+
+#: a reaction component that is zero by construction must be below this × the element's force scale
+ZERO_COMPONENT_TOLERANCE = 1e-9
+
+
+# ---- applied forces ----------------------------------------------------------------------
+
+def gravity(mech, st: State) -> Load:
+    """Weight (0, −m g) at each solid's G; V = Σ m g y_G."""
+    force, potential = {}, np.zeros(st.n)
+    for i, s in enumerate(mech.solids):
+        m = float(s.mass)
+        if m > 0 and mech.gravity:
+            G = st.point(i, [float(c) for c in s.cog])
+            weight = np.broadcast_to([0.0, -m * mech.gravity], (st.n, 2))
+            force.update(generalized_force(G, weight))
+            potential += m * mech.gravity * G.value[:, 1]
+    return Load(force, {}, potential)
+
+
+@dataclass
+class Applied:
+    """The applied forces of a mechanism at its states (rows).
+
+    force:       Q_applied (n, nq): gravity, torsors, springs (and dampers)
+    outputs:     the force elements' outputs, by column name (``spring1.Força``)
+    potential:   V (n,), gravity and springs
+    dissipation: power removed by the dampers (n,)
+    external:    generalized force of the loads without a potential (torsors), (n, nq)
+    """
+
+    force: np.ndarray
+    outputs: dict[str, np.ndarray]
+    potential: np.ndarray
+    dissipation: np.ndarray
+    external: np.ndarray
+
+
+def applied_forces(mech, st: State, damping: bool) -> Applied:
+    """Sum the loads of gravity and of every force element (dampers only if ``damping``)."""
+    n = st.n
+    out = Applied(np.zeros((n, mech.nq)), {}, np.zeros(n), np.zeros(n), np.zeros((n, mech.nq)))
+    loads = [(None, gravity(mech, st))] + [(el, el.loads(st, damping)) for el in mech.elements]
+    for el, load in loads:
+        if load is None:
+            continue
+        target = out.force if load.potential is not None else out.external
+        for solid, q in load.force.items():
+            target[:, 3 * solid:3 * solid + 3] += q
+        if load.potential is not None:
+            out.potential += load.potential
+        if load.dissipation is not None:
+            out.dissipation += load.dissipation
+        out.outputs.update({f"{el.name}.{k}": v for k, v in load.outputs.items()})
+    out.force += out.external
+    return out
+
+
+def inertia_forces(mech, st: State, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(Q_inertia (n, nq), kinetic energy (n,)): m a_G at G and J_G α, for every solid.
+
+    a_G = R̈ + α Ω(A c) − ω² A c,  Q = Jᵀ(m a_G) + (0, 0, J_G α),  T = ½ m v_G² + ½ J_G ω².
+    """
+    Q, T = np.zeros((st.n, mech.nq)), np.zeros(st.n)
+    for i, s in enumerate(mech.solids):
+        m, J = float(s.mass), float(s.inertia)
+        if m == 0 and J == 0:
+            continue
+        cols = slice(3 * i, 3 * i + 3)
+        G = st.point(i, [float(c) for c in s.cog])
+        block = G.jac[i]
+        a_G = np.einsum("ndk,nk->nd", block, qdd[:, cols]) + G.conv
+        Q[:, cols] += np.einsum("nd,ndk->nk", m * a_G, block)
+        Q[:, 3 * i + 2] += J * qdd[:, 3 * i + 2]
+        w = st.qd[:, 3 * i + 2]
+        T += 0.5 * m * np.sum(G.rate**2, axis=1) + 0.5 * J * w * w
+    return Q, T
+
+
+# ---- reactions ---------------------------------------------------------------------------
+
+def element_wrench(el, st: State, lam: np.ndarray, jacobian=None) -> np.ndarray:
+    """The wrench (n, 3) an element's multipliers λ (n, k) apply to its receiving solid.
+
+    Force and moment about the solid's origin come from Cqᵀ λ restricted to the element's
+    rows and the solid's columns; they are then moved to the reporting point and turned
+    into the reporting basis (x, y, moment).
+    """
+    s = el.receiver
+    if jacobian is None:
+        jacobian = el.constraint(st)[0].jac
+    block = jacobian.get(s)
+    if block is None:
+        return np.zeros((st.n, 3))
+    wrench = np.einsum("nkj,nk->nj", block, lam)
+    point, direction = el.report_frame(st)
+    return to_basis(move_wrench(wrench, st.q[:, 3 * s:3 * s + 2], point), direction)
+
+
+def reported(el) -> list[int]:
+    """Indices of the wrench components an element reports."""
+    return [k for k, name in enumerate(el.wrench) if name is not None]
+
+
+def reactions(mech, st: State, lam: np.ndarray) -> dict[str, np.ndarray]:
+    """Every constraint element's reported reaction components, by column name.
+
+    The components that are zero by construction (the tangential force of a prismatic
+    or pin_slot, the moment at a revolute…) are checked to be zero.
+    """
+    out = {}
+    for el, rows in zip(mech.constraints, mech.rows):
+        wrench = element_wrench(el, st, lam[:, rows])
+        scale = (np.max(np.abs(wrench[:, :2]), initial=0.0)
+                 + np.max(np.abs(wrench[:, 2]), initial=0.0) / mech.scale())
+        for k, name in enumerate(el.wrench):
+            if name is not None:
+                out[f"{el.name}.{name}"] = wrench[:, k]
+                continue
+            size = np.max(np.abs(wrench[:, k]), initial=0.0) / (mech.scale() if k == 2 else 1.0)
+            if size > ZERO_COMPONENT_TOLERANCE * scale + 1e-300:
+                what = ("moment" if k == 2 else
+                        "force along x" if k == 0 else "force along y")
+                raise TranslationError(
+                    f"internal error: the reaction of element '{el.name}' ({el.type}) has a "
+                    f"{what} of relative size {size / scale:.2g} in its reporting frame, where "
+                    "it must be zero. Please report it with the model file.")
+    return out
+
+
+def _report_matrix(mech, st: State) -> np.ndarray:
+    """B (n, m, m): the reported reaction components of each element per unit multiplier.
+
+    Block-diagonal, one square block per element (each reports as many components as it
+    has equations).
+    """
+    B = np.zeros((st.n, mech.n_equations, mech.n_equations))
+    for el, rows in zip(mech.constraints, mech.rows):
+        jac = el.constraint(st)[0].jac
+        keep = reported(el)
+        for j in range(el.equations):
+            unit = np.zeros((st.n, el.equations))
+            unit[:, j] = 1.0
+            B[:, rows, rows.start + j] = element_wrench(el, st, unit, jac)[:, keep]
+    return B
+
+
+def multipliers(mech, st: State, rhs: np.ndarray, redundant: bool,
+                jacobian: np.ndarray | None = None, rcond: float = 1e-10) -> np.ndarray:
+    """λ (n, m) with Cqᵀ λ = rhs at every step.
+
+    Redundant constraints: of all solutions, the one whose reported reaction components
+    R = B λ have the least sum of squares: R = (Cqᵀ B⁻¹)⁺ rhs, λ = B⁻¹ R.
+    """
+    if jacobian is None:
+        jacobian = native.equations(mech, st).jacobian
+    A = np.swapaxes(jacobian, 1, 2)                      # Cqᵀ, (n, nq, m)
+    if not redundant:
+        return np.linalg.solve(A, rhs[..., None])[..., 0]
+    B = _report_matrix(mech, st)
+    AB = np.swapaxes(np.linalg.solve(np.swapaxes(B, 1, 2), np.swapaxes(A, 1, 2)), 1, 2)
+    R = np.einsum("nmq,nq->nm", np.linalg.pinv(AB, rcond=rcond), rhs)
+    return np.linalg.solve(B, R[..., None])[..., 0]
+
+
+def equilibrium_residual(mech, st: State, lam: np.ndarray, rhs: np.ndarray,
+                         jacobian: np.ndarray | None = None) -> np.ndarray:
+    """Cqᵀ λ − rhs (n, nq)."""
+    if jacobian is None:
+        jacobian = native.equations(mech, st).jacobian
+    return np.einsum("nmq,nm->nq", jacobian, lam) - rhs
+
+
+# ---- power balance -----------------------------------------------------------------------
+
+@dataclass
+class PowerBalance:
+    """Σ actuator power = dE/dt + damper dissipation − torsor power, checked by central
+    differences of E = T + V on the time grid.
+
+    error:     max |residual| over the checked steps [W]
+    tolerance: the central difference's own error, estimated from the same difference
+               over twice the step (Richardson), plus round-off [W]
+    checked:   number of steps checked (those whose stencil crosses a law breakpoint are not)
+    """
+
+    error: float
+    tolerance: float
+    checked: int
+
+    @property
+    def ok(self) -> bool:
+        return self.error <= self.tolerance
+
+
+def power_balance(mech, t: np.ndarray, actuator_power: np.ndarray, energy: np.ndarray,
+                  dissipation: np.ndarray, external_power: np.ndarray) -> PowerBalance | None:
+    """Check the power balance at the steps k = 2 … n−3 (None with fewer than 5 steps)."""
+    n = len(t)
+    if n < 5:
+        return None
+    dt = float(t[1] - t[0])
+    k = np.arange(2, n - 2)
+    d1 = (energy[k + 1] - energy[k - 1]) / (2 * dt)
+    d2 = (energy[k + 2] - energy[k - 2]) / (4 * dt)
+    keep = np.ones(len(k), dtype=bool)
+    for el in mech.constraints:
+        if hasattr(el, "time_law"):
+            for b in el.time_law().breakpoints():
+                keep &= ~((t[k - 2] < b) & (b <= t[k + 2]))
+    if not keep.any():
+        return PowerBalance(0.0, 0.0, 0)
+    residual = actuator_power[k] - (d1 + dissipation[k] - external_power[k])
+    residual, d1, d2 = residual[keep], d1[keep], d2[keep]
+    truncation = np.max(np.abs(d2 - d1)) / 3.0         # error of d1 ≈ (d2 − d1)/3
+    size = max(np.max(np.abs(actuator_power)), np.max(np.abs(d1)),
+               np.max(np.abs(dissipation)), np.max(np.abs(external_power)))
+    roundoff = 1e3 * np.finfo(float).eps * np.max(np.abs(energy)) / dt
+    tolerance = 10.0 * truncation + 1e-9 * size + roundoff
+    return PowerBalance(float(np.max(np.abs(residual))), float(tolerance), int(keep.sum()))
+
+
+def actuator_power(mech, st: State, outputs: dict[str, np.ndarray]) -> np.ndarray:
+    """Σ (actuator force or torque) × Df(t): Mz·Df of angular, Força·Df of linear actuators."""
+    power = np.zeros(st.n)
+    for el in mech.constraints:
+        if hasattr(el, "time_law"):
+            name = next(n for n in el.wrench if n is not None)
+            power += outputs[f"{el.name}.{name}"] * el.time_law()(st.t)[1]
+    return power
+
+
+__all__ = ["Applied", "PowerBalance", "applied_forces", "actuator_power",
+           "element_wrench", "equilibrium_residual", "gravity", "inertia_forces",
+           "multipliers", "power_balance", "reactions"]

@@ -1,0 +1,64 @@
+"""Kinetostatic analysis (inverse dynamics): the kinematic analysis, then every force."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..elements import FORCE
+from ..kinematics import State
+from . import forces, native
+from .common import (ConsistencyWarning, Job, check_mobility, collect, positions, velocities,
+                     warn)
+
+
+def kinetostatic(job: Job):
+    """Everything of kinematic, plus every reaction, spring force and actuator force.
+
+    Contract: positions from Exudyn's static solver, qd and qdd natively (as kinematic);
+    then at every step Cqᵀ λ = Q_inertia − Q_applied is solved natively (inertia from the
+    mass at G and the inertia about G; gravity, torsors, springs and dampers applied), and
+    the reactions are read from λ (``forces.reactions``). The power balance is checked.
+    """
+    mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
+    redundant = mob.redundant > 0
+    q = positions(job, redundant)
+    qd, qdd = velocities(job, q, redundant)
+    extra = inverse_dynamics(job, q, qd, qdd, redundant) if FORCE in job.levels else {}
+    return collect(job, q, qd, qdd, extra)
+
+
+def inverse_dynamics(job: Job, q, qd, qdd, redundant: bool) -> dict[str, np.ndarray]:
+    """Reactions, spring and actuator forces at every step, then the power balance check."""
+    mech, t = job.mech, job.times
+    n = len(t)
+    out: dict[str, np.ndarray] = {}
+    energy, dissipation, external = np.zeros(n), np.zeros(n), np.zeros(n)
+    for s in native.chunks(mech, n):
+        st = State(t[s], q[s], qd[s])
+        applied = forces.applied_forces(mech, st, damping=True)
+        inertia, kinetic = forces.inertia_forces(mech, st, qdd[s])
+        lam = forces.multipliers(mech, st, inertia - applied.force, redundant)
+        for name, v in {**forces.reactions(mech, st, lam), **applied.outputs}.items():
+            out.setdefault(name, np.empty(n))[s] = v
+        energy[s] = kinetic + applied.potential
+        dissipation[s] = applied.dissipation
+        external[s] = np.sum(applied.external * qd[s], axis=1)
+    power = forces.actuator_power(mech, State(t, q), out)
+    check_power_balance(job, power, energy, dissipation, external)
+    return out
+
+
+def check_power_balance(job: Job, power, energy, dissipation, external) -> None:
+    """Σ actuator power = dE/dt + dissipation − torsor power; warns when it does not hold."""
+    balance = forces.power_balance(job.mech, job.times, power, energy, dissipation, external)
+    if balance is None:
+        job.info["power_balance"] = "not checked (fewer than 5 steps)"
+        return
+    job.info.update(power_balance_error=balance.error,
+                    power_balance_tolerance=balance.tolerance,
+                    power_balance_steps=balance.checked)
+    if not balance.ok:
+        text = (f"power balance not met: Σ actuator power differs from d(kinetic + potential "
+                f"energy)/dt + damper dissipation − torsor power by up to {balance.error:.3g} W "
+                f"(tolerance {balance.tolerance:.3g} W from the finite difference's own "
+                f"error). The forces may be wrong; please report it with the model file.")
+        warn(job, text, ConsistencyWarning)
