@@ -139,7 +139,7 @@ def warn(job: Job, text: str, category) -> None:
     """Keep a warning with the results and issue it at the caller's line outside pam2exu."""
     job.warnings.append(text)
     package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame, level = sys._getframe(1), 1
+    frame, level = sys._getframe(1), 2
     while frame is not None and frame.f_code.co_filename.startswith(package):
         frame, level = frame.f_back, level + 1
     warnings.warn(text, category, stacklevel=level)
