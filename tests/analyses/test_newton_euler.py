@@ -122,18 +122,18 @@ def law_polynomial(t, C):
 def slider_crank_params(**over):
     """The slider-crank of the tests. Centres of mass off the origins and off the x axes,
     nonzero inertias, a heavy ground, a torsor on the rod, a motor that accelerates."""
-    p = dict(
-        gravity=9.81,
-        ground=dict(pose=(0.0, 0.0, 0.0), mass=5.0, inertia=0.2, cog=(0.15, -0.1),
-                    O=(0.0, 0.0), rail_point=(0.0, 0.03), rail_angle=0.0),
-        crank=dict(mass=1.2, inertia=0.004, cog=(0.04, 0.01), r=0.1),
-        rod=dict(mass=2.0, inertia=0.02, cog=(0.12, -0.02), l=0.3, T=(0.2, 0.03)),
-        slider=dict(mass=0.8, inertia=0.001, cog=(0.01, 0.02), B=(0.015, 0.01),
-                    axis_point=(-0.02, -0.005), axis_angle=0.0, sense=+1),
-        torsor=dict(C=(15.0, -25.0, 3.0), axes="global"),
-        motor=dict(C=(0.3, 6.0, 2.0, 0.0)),
-        t_end=1.0, steps=200,
-    )
+    p = {
+        "gravity": 9.81,
+        "ground": {"pose": (0.0, 0.0, 0.0), "mass": 5.0, "inertia": 0.2, "cog": (0.15, -0.1),
+                   "O": (0.0, 0.0), "rail_point": (0.0, 0.03), "rail_angle": 0.0},
+        "crank": {"mass": 1.2, "inertia": 0.004, "cog": (0.04, 0.01), "r": 0.1},
+        "rod": {"mass": 2.0, "inertia": 0.02, "cog": (0.12, -0.02), "l": 0.3, "T": (0.2, 0.03)},
+        "slider": {"mass": 0.8, "inertia": 0.001, "cog": (0.01, 0.02), "B": (0.015, 0.01),
+                   "axis_point": (-0.02, -0.005), "axis_angle": 0.0, "sense": +1},
+        "torsor": {"C": (15.0, -25.0, 3.0), "axes": "global"},
+        "motor": {"C": (0.3, 6.0, 2.0, 0.0)},
+        "t_end": 1.0, "steps": 200,
+    }
     for key, value in over.items():
         if isinstance(value, dict):
             p[key] = {**p[key], **value}
@@ -175,17 +175,17 @@ def kinematics(p, t):
     P = (col(K, k) + s * u[:, None], ds * u[:, None], dds * u[:, None])
     slider_origin = (P[0] - col(rot(fi_s, sl["axis_point"]), k), P[1], P[2])
     bodies = {
-        "ground": dict(q=(col(g0, k), Z, Z), fi=(gam + z, z, z)),
-        "crank": dict(q=(Ok, Z, Z), fi=(thg, dth, ddth)),
-        "rod": dict(q=A, fi=(phi, dphi, ddphi)),
-        "slider": dict(q=slider_origin, fi=(fi_s + z, z, z)),
+        "ground": {"q": (col(g0, k), Z, Z), "fi": (gam + z, z, z)},
+        "crank": {"q": (Ok, Z, Z), "fi": (thg, dth, ddth)},
+        "rod": {"q": A, "fi": (phi, dphi, ddphi)},
+        "slider": {"q": slider_origin, "fi": (fi_s + z, z, z)},
     }
     for name, b in bodies.items():
         b["G"] = rigid_point(*b["q"], *b["fi"], p[name]["cog"])
-    pts = dict(O=Ok, A=A[0], B=rigid_point(*A, phi, dphi, ddphi, (l, 0.0))[0], P=P[0],
-               T=rigid_point(*A, phi, dphi, ddphi, p["rod"]["T"]),
-               nu_s=col(n(fi_s + sl["axis_angle"]), k), g0=col(g0, k),
-               B_slider=rigid_point(*slider_origin, fi_s + z, z, z, sl["B"])[0])
+    pts = {"O": Ok, "A": A[0], "B": rigid_point(*A, phi, dphi, ddphi, (l, 0.0))[0], "P": P[0],
+               "T": rigid_point(*A, phi, dphi, ddphi, p["rod"]["T"]),
+               "nu_s": col(n(fi_s + sl["axis_angle"]), k), "g0": col(g0, k),
+               "B_slider": rigid_point(*slider_origin, fi_s + z, z, z, sl["B"])[0]}
     return bodies, pts, (th, dth, ddth)
 
 
@@ -419,14 +419,14 @@ VARIANTS = {
     # ground at the global origin, slider's line along the rail, torsor in global axes
     "global_torsor": slider_crank_params(),
     # the same, torsor components constant in the rod's frame
-    "solid_torsor": slider_crank_params(torsor=dict(axes="solid")),
+    "solid_torsor": slider_crank_params(torsor={"axes": "solid"}),
     # ground moved and turned, pivot and rail off its origin, rail inclined, the slider's
     # line pointing against the rail (Fnormal, Mz in the slider line's own basis)
     "moved_ground_reversed_line": slider_crank_params(
-        ground=dict(pose=(0.05, -0.02, 0.25), O=(0.02, -0.01), rail_point=(0.01, 0.03),
-                    rail_angle=0.1),
-        slider=dict(axis_angle=math.pi, sense=-1),
-        torsor=dict(C=(-10.0, 20.0, -2.0), axes="solid")),
+        ground={"pose": (0.05, -0.02, 0.25), "O": (0.02, -0.01), "rail_point": (0.01, 0.03),
+                "rail_angle": 0.1},
+        slider={"axis_angle": math.pi, "sense": -1},
+        torsor={"C": (-10.0, 20.0, -2.0), "axes": "solid"}),
 }
 
 
@@ -438,7 +438,7 @@ def fd(y, h):
 
 
 def energies(p, t):
-    bodies, pts, (th, dth, _) = kinematics(p, t)
+    bodies, pts, (_th, dth, _) = kinematics(p, t)
     Tk = sum(0.5 * p[b]["mass"] * dot(bodies[b]["G"][1], bodies[b]["G"][1])
              + 0.5 * p[b]["inertia"] * bodies[b]["fi"][1] ** 2 for b in bodies)
     V = sum(p[b]["mass"] * p["gravity"] * bodies[b]["G"][0][1] for b in bodies)

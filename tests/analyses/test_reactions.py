@@ -27,7 +27,7 @@ quasi_static: equilibrium at each configuration, no inertia and no C4 (damper) t
 kinetostatic: inertia (mass at G, inertia I_G about G) and the C4 terms included.
 
 Notation: e(a) = (cos a, sin a), n(a) = e(a + π/2) = (−sin a, cos a), R(a) the rotation
-by a, a × b = a_x b_y − a_y b_x (the z component), Ω d = n-rotation of d by +90°. For a
+by a, a × b = a_x b_y − a_y b_x (the z component), Ω d = d turned by +90°. For a
 solid turning about a fixed point J with d = G − J: a_G = θ'' Ω d − θ'² d, and
 Σ M_J = I_J θ'' with I_J = I_G + m |d|². For a translating solid (no rotation):
 Σ M_D = (G − D) × m a_G about any point D. Gravity g along −y.
@@ -122,9 +122,9 @@ def assert_closes(a, b, scale):
 
 # ---- 1. pendulum: fixed, revolute, angular_actuator, torsional_spring (solid 2 = ground) ---
 
-PEND = dict(r0=(0.2, -0.1), fi0=0.4, m0=3.0, c0=(0.15, -0.05), J=(-0.1, 0.25),
-            m=1.2, IG=0.004, cg=(0.08, 0.03),
-            motor=(0.3, 2.0, 1.5, -0.4), twist=(0.2, 1.5, -0.3, 0.05))
+PEND = {"r0": (0.2, -0.1), "fi0": 0.4, "m0": 3.0, "c0": (0.15, -0.05), "J": (-0.1, 0.25),
+        "m": 1.2, "IG": 0.004, "cg": (0.08, 0.03),
+        "motor": (0.1, 0.5, 0.4, -0.3), "twist": (0.2, 1.5, -0.3, 0.05)}
 
 
 def pendulum_model():
@@ -188,7 +188,8 @@ def test_pendulum_fixed_revolute_motor_torsional_spring(analysis):
     """Crank (m = 1.2, I_G = 0.004, G at cg = (0.08, 0.03) in its frame) hinged by its
     origin to the point J = (−0.1, 0.25) of a ground posed at r0 = (0.2, −0.1),
     fi0 = 0.4 (fixed link "base"), ground mass m0 = 3 at c0 = (0.15, −0.05). The motor
-    ground → crank sets θ = fi0 + f(t), f = 0.3 + 2 t + 1.5 t² − 0.4 t³. A torsional
+    ground → crank sets θ = fi0 + f(t), f = 0.1 + 0.5 t + 0.4 t² − 0.3 t³
+    (θ from 0.5 to 1.1 rad). A torsional
     spring-damper crank → ground (solid 1 = the crank, so the reversed sense is checked):
     fi_rel = fi0 − θ = −f, Dfi_rel = −f', Parell_s = C1 + C2 (fi_rel − C3) + C4 Dfi_rel
     (no C4 term in quasi_static), counter-clockwise on the crank (solid 1), clockwise
@@ -256,8 +257,8 @@ def test_pendulum_fixed_revolute_motor_torsional_spring(analysis):
 
 # ---- 2. slider on an inclined prismatic guide, pushed by a linear actuator -----------------
 
-SLIDE = dict(alpha=0.5, p1=(0.1, 0.05), m=2.0, IG=0.01, cg=(0.01, 0.04), D=(0.02, 0.0),
-             law=(0.2, 0.3, -0.4, 0.1))
+SLIDE = {"alpha": 0.5, "p1": (0.1, 0.05), "m": 2.0, "IG": 0.01, "cg": (0.01, 0.04),
+         "D": (0.02, 0.0), "law": (0.2, 0.3, -0.4, 0.1)}
 
 
 def slider_model():
@@ -371,9 +372,9 @@ def test_inclined_slider_prismatic_linear_actuator(analysis):
 
 # ---- 3. Scotch yoke: pin_slot, prismatic, revolute, spring-damper ------------------------
 
-YOKE = dict(r=0.05, K=(-0.25, 0.0), mc=0.5, Ic=2.0e-4, cgc=(0.02, 0.01),
-            my=0.8, Iy=3.0e-3, cgy=(0.03, 0.06), motor=(0.2, 3.0, 1.0, 0.0),
-            spring=(3.0, 200.0, 0.2, 4.0))
+YOKE = {"r": 0.05, "K": (-0.25, 0.0), "mc": 0.5, "Ic": 2.0e-4, "cgc": (0.02, 0.01),
+        "my": 0.8, "Iy": 3.0e-3, "cgy": (0.03, 0.06), "motor": (0.2, 3.0, 1.0, 0.0),
+        "spring": (3.0, 200.0, 0.2, 4.0)}
 
 
 def yoke_model():
@@ -406,7 +407,8 @@ def yoke_model():
         inertia = {p['Iy']!r}
         cog = {list(p['cgy'])!r}
         points = {{ Y = [0.0, 0.0] }}
-        lines = {{ axis = {{ point = [0.0, 0.0], angle = 0.0 }}, slot = {{ point = [0.0, 0.0], angle = {math.pi / 2!r} }} }}
+        lines.axis = {{ point = [0.0, 0.0], angle = 0.0 }}
+        lines.slot = {{ point = [0.0, 0.0], angle = {math.pi / 2!r} }}
 
         [[element]]
         type = "fixed"
@@ -491,7 +493,6 @@ def test_scotch_yoke_pin_slot_spring(analysis):
         dth, ddth = 0 * t, 0 * t
     r, g, mc, my = p["r"], GRAV, p["mc"], p["my"]
     z = 0 * t
-    Q = r * e(th)
     xY = r * np.cos(th)
     dxY = -r * np.sin(th) * dth
     ddxY = -r * np.cos(th) * dth**2 - r * np.sin(th) * ddth
@@ -530,8 +531,9 @@ def test_scotch_yoke_pin_slot_spring(analysis):
 
 # ---- 4. gear pair on the ground: transmission, torsional spring, torsor ------------------
 
-GEARS = dict(G1=(0.1, 0.05), G2=(0.2, 0.05), m1=0.6, I1=1.1e-3, m2=0.3, I2=2.4e-4,
-             T=-1.5, C=0.1, M=0.7, motor=(0.0, 2.0, 3.0, -1.0), twist=(0.1, 0.8, 0.2, 0.03))
+GEARS = {"G1": (0.1, 0.05), "G2": (0.2, 0.05), "m1": 0.6, "I1": 1.1e-3, "m2": 0.3,
+         "I2": 2.4e-4, "T": -1.5, "C": 0.1, "M": 0.7, "motor": (0.0, 2.0, 3.0, -1.0),
+         "twist": (0.1, 0.8, 0.2, 0.03)}
 
 
 def gears_model():
