@@ -25,3 +25,26 @@ def test_example_runs(path):
     assert len(assembled) == 1
     for s in model.solids:
         assert assembled[f"{s.name}.fi"][0] == pytest.approx(res[f"{s.name}.fi"][0], abs=1e-12)
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("analysis", ["quasi_static", "kinetostatic"])
+def test_example_force_analyses_pass_their_checks(path, analysis):
+    """Every example runs the force analyses with every check met and no warning."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = pam2exu.run(path, analysis=analysis, steps=100)
+    assert np.isfinite(res.to_numpy()).all()
+    assert not res.warnings
+    if analysis == "quasi_static":
+        assert res.info["equilibrium_error"] < 1e-12
+    else:
+        assert res.info["power_balance_error"] <= res.info["power_balance_tolerance"]
+
+
+def test_examples_own_analysis_runs():
+    """Each example runs as declared (the contract's slider-crank is kinetostatic)."""
+    for path in EXAMPLES:
+        res = pam2exu.run(path)
+        assert res.analysis == pam2exu.load(path).analysis.type

@@ -98,9 +98,25 @@ class Results:
         if len(self.columns) > max_rows:
             lines.append(f"… and {len(self.columns) - max_rows} more columns (write them all "
                          f"with -o results.csv)")
+        checks = self.checks()
+        if checks:
+            lines += ["", "checks: " + "; ".join(checks)]
         for w in self.warnings:
             lines.append(f"warning: {w}")
         return "\n".join(lines)
+
+    def checks(self) -> list[str]:
+        """The consistency checks the analysis ran, one phrase each (from ``info``)."""
+        info, out = self.info, []
+        if "max_residual" in info:
+            out.append(f"constraint residual {info['max_residual']:.1e} m")
+        if "equilibrium_error" in info:
+            out.append(f"Exudyn's multipliers vs native equilibrium {info['equilibrium_error']:.1e}"
+                       " (relative)")
+        if "power_balance_error" in info:
+            out.append(f"power balance {info['power_balance_error']:.2g} W "
+                       f"(finite-difference tolerance {info['power_balance_tolerance']:.2g} W)")
+        return out
 
     def __repr__(self) -> str:
         return (f"<Results {self.analysis} '{self.model}': {len(self)} rows × "

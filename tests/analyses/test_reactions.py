@@ -686,3 +686,70 @@ def test_gear_pair_quasi_static_signs():
     np.testing.assert_allclose(res["base.Mz"], -0.7 + GRAV * (p["m1"] * p["G1"][0]
                                                             + p["m2"] * p["G2"][0]), rtol=tol)
     np.testing.assert_allclose(res["twist.Parell"], 0.0, atol=tol)
+
+
+# ---- transmission with a moving arm (planetary train) ------------------------------------
+
+def _planetary(R=0.09, T=-2.0, m=0.4, J=2e-4):
+    """Sun and planet gears (T = −r_sun/r_planet) on an arm that turns about the sun's axis."""
+    model = pam2exu.Model("planetary", gravity=0.0)
+    model.add_solid("ground", points={"O": [0.0, 0.0]})
+    model.add_solid("sun", points={"O": [0.0, 0.0]})
+    model.add_solid("arm", points={"O": [0.0, 0.0], "P": [R, 0.0]})
+    model.add_solid("planet", x=R, mass=m, inertia=J, points={"C": [0.0, 0.0]})
+    model.add("fixed", name="base", anc1="ground")
+    model.add("revolute", name="arm_bearing", anc1="ground.O", anc2="arm.O")
+    model.add("revolute", name="sun_bearing", anc1="arm.O", anc2="sun.O")
+    model.add("revolute", name="planet_bearing", anc1="arm.P", anc2="planet.C")
+    model.add("transmission", name="mesh", anc1="sun", anc2="planet", T=T)
+    model.add("angular_actuator", name="sun_drive", anc1="ground", anc2="sun",
+              law="harmonic", C=[0.2, 0.8, 5.0, 0.3])
+    model.add("angular_actuator", name="arm_drive", anc1="ground", anc2="arm",
+              law="polynomial", C=[0.1, 1.5, 2.0, -0.7])
+    model.add("torsor", name="load", anc1="planet.C", C=[0.0, 0.0, 0.35])
+    return model
+
+
+@pytest.mark.parametrize("analysis", ["quasi_static", "kinetostatic"])
+def test_transmission_on_a_moving_arm(analysis):
+    """Planetary train: the arm turns, so the mesh's reaction (T − 1)·Parell loads it.
+
+    Free bodies (gravity off; sun and arm massless; planet mass m at its centre, inertia J;
+    torsor moment M on the planet; θs, θa the laws, θp = θa + T (θs − θa)):
+    - planet, moments about its centre (its bearing force passes through it):
+      J θp'' = Parell + M, so Parell = J θp'' − M (quasi-static: −M);
+    - planet, forces: m a_P = F, F = planet_bearing.(Fx, Fy) the force the arm exerts on
+      it, a_P = R (θa'' n(θa) − θa'² e(θa));
+    - sun, moments about O: sun_drive.Mz − T·Parell = 0 (its bearing passes no moment), so
+      sun_drive.Mz = T·Parell: with M > 0 at rest, Parell = −M and the sun's motor pushes
+      with −T·M = +2M, counter-clockwise, against the mesh;
+    - arm, moments about O: arm_drive.Mz + (T − 1)·Parell − R e(θa) × F = 0 (the planet
+      pushes back with −F at P).
+    """
+    R, T, m, J, M = 0.09, -2.0, 0.4, 2e-4, 0.35
+    res = pam2exu.run(_planetary(R, T, m, J), analysis=analysis, t_end=1.0, steps=60)
+    t = res.t
+    ths = 0.2 + 0.8 * np.cos(5.0 * t + 0.3)
+    dds = -0.8 * 25.0 * np.cos(5.0 * t + 0.3)
+    tha = 0.1 + 1.5 * t + 2.0 * t**2 - 0.7 * t**3
+    da, dda = 1.5 + 4.0 * t - 2.1 * t**2, 4.0 - 4.2 * t
+    np.testing.assert_allclose(res["planet.fi"], tha + T * (ths - tha), atol=1e-12)
+    dyn = analysis == "kinetostatic"
+    ddp = dda + T * (dds - dda) if dyn else 0.0 * t
+    e = np.column_stack([np.cos(tha), np.sin(tha)])
+    n = np.column_stack([-np.sin(tha), np.cos(tha)])
+    a_P = R * (dda[:, None] * n - (da**2)[:, None] * e) if dyn else 0.0 * e
+    parell = J * ddp - M
+    F = m * a_P
+    expected = {
+        "mesh.Parell": parell,
+        "sun_drive.Mz": T * parell,
+        "planet_bearing.Fx": F[:, 0], "planet_bearing.Fy": F[:, 1],
+        "arm_drive.Mz": -(T - 1.0) * parell + R * (e[:, 0] * F[:, 1] - e[:, 1] * F[:, 0]),
+        "sun_bearing.Fx": 0.0 * t, "sun_bearing.Fy": 0.0 * t,
+    }
+    for name, ref in expected.items():
+        scale = max(np.max(np.abs(ref)), M)
+        np.testing.assert_allclose(res[name], ref, rtol=0, atol=1e-9 * scale, err_msg=name)
+    if not dyn:
+        assert res["sun_drive.Mz"][0] == pytest.approx(2 * M, rel=1e-12)
