@@ -7,7 +7,7 @@ from ..elements import FORCE
 from ..errors import TranslationError
 from ..kinematics import State
 from . import forces, native
-from .common import Job, check_mobility, collect, positions
+from .common import Job, check_mobility, collect, positions, velocities
 
 #: Exudyn's multipliers must satisfy the native equilibrium to this, relative to the forces
 EQUILIBRIUM_TOLERANCE = 1e-9
@@ -20,13 +20,15 @@ def quasi_static(job: Job):
     damper terms) in the model, gives at each time the configuration and the Lagrange
     multipliers λ (f + Cqᵀ λ = 0); the reactions are read from λ (``forces.reactions``).
     The native equilibrium Cqᵀ λ = −Q_applied is checked at every step. With redundant
-    constraints λ is not unique: the reactions are the native minimum-norm solution.
+    constraints λ is not unique: the reactions are the native minimum-norm solution. A
+    singular (dead-point) position, where the reactions are not defined, is an error.
     """
     mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
     redundant = mob.redundant > 0
     if FORCE not in job.levels:
         return collect(job, positions(job, redundant))
     q, system = positions(job, redundant, forces=True)
+    velocities(job, q, redundant)      # raises at a singular position: reactions undefined
     mech, t = job.mech, job.times
     order = [i for el in mech.constraints for i in system.ae_rows(el)]
     lam_exudyn = system.multipliers[:, order]

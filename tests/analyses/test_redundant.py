@@ -46,3 +46,16 @@ def test_singular_position_of_a_redundant_mechanism_is_an_error(request):
     with pytest.warns(RedundancyWarning):
         with pytest.raises(pam2exu.SolverError, match=r"t = 0\.25 s .*singular"):
             pam2exu.run(model, steps=400)
+
+
+def test_quasi_static_through_a_singular_position_is_an_error(request):
+    """At the change point the reactions are undefined (Cq loses rank): quasi_static must
+    stop there, as kinematic does, even though Exudyn's solver, told to ignore the
+    singular Jacobian, passes it."""
+    model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
+    model["motor"].law, model["motor"].C = "polynomial", [np.pi / 2, 2 * np.pi]
+    model.gravity = 9.81
+    model["coupler"].mass = 1.0
+    with pytest.warns(RedundancyWarning):
+        with pytest.raises(pam2exu.SolverError, match=r"t = 0\.25 s .*singular"):
+            pam2exu.run(model, analysis="quasi_static", steps=400)
