@@ -89,10 +89,10 @@ class Quantity:
         return Quantity(length, jac, rate, conv)
 
     def rows(self, jacobian: np.ndarray, row: int) -> None:
-        """Write dv/dq into rows row… of a full Jacobian (n, m, 3·solids)."""
+        """Write dv/dq into rows row… of a full Jacobian (n, m, 3·solids), zero there before."""
         d = self.value.shape[1]
         for solid, block in self.jac.items():
-            jacobian[:, row:row + d, 3 * solid:3 * solid + 3] += block
+            jacobian[:, row:row + d, 3 * solid:3 * solid + 3] = block
 
 
 def _add(a, b):

@@ -38,21 +38,23 @@ def _target(target, t, m):
     return np.broadcast_to(np.asarray(target, dtype=float), (m,)), 0.0, 0.0
 
 
-def equations(mech, st: State) -> Equations:
-    """All constraint equations of a mechanism at the states ``st``."""
+def equations(mech, st: State, jacobian: bool = True) -> Equations:
+    """All constraint equations of a mechanism at the states ``st`` (without ``jacobian``,
+    Cq is not assembled: ``Equations.jacobian`` is None)."""
     n, m = st.n, mech.n_equations
     residual, c_t = np.zeros((n, m)), np.zeros((n, m))
-    jacobian = np.zeros((n, m, mech.nq))
+    jac = np.zeros((n, m, mech.nq)) if jacobian else None
     gamma = np.zeros((n, m)) if st.qd is not None else None
     for el, rows in zip(mech.constraints, mech.rows):
         v, target = el.constraint(st)
         f, df, ddf = _target(target, st.t, el.equations)
         residual[:, rows] = v.value - f
         c_t[:, rows] = -np.broadcast_to(df, (n, el.equations))
-        v.rows(jacobian, rows.start)
+        if jac is not None:
+            v.rows(jac, rows.start)
         if gamma is not None:
             gamma[:, rows] = ddf - v.conv
-    return Equations(residual, jacobian, c_t, gamma)
+    return Equations(residual, jac, c_t, gamma)
 
 
 def chunks(mech, n: int):
@@ -66,7 +68,7 @@ def residuals(mech, t, q) -> np.ndarray:
     t, q = np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(q)
     out = np.empty((len(t), mech.n_equations))
     for s in chunks(mech, len(t)):
-        out[s] = equations(mech, State(t[s], q[s])).residual
+        out[s] = equations(mech, State(t[s], q[s]), jacobian=False).residual
     return out
 
 
@@ -100,8 +102,8 @@ def rates(mech, t, q, accelerations: bool, redundant: bool):
         eq = equations(mech, State(t[s], q[s]))
         qd[s] = _solve(eq.jacobian, -eq.c_t, redundant)
         if accelerations:
-            eq = equations(mech, State(t[s], q[s], qd[s]))
-            qdd[s] = _solve(eq.jacobian, eq.gamma, redundant)
+            gamma = equations(mech, State(t[s], q[s], qd[s]), jacobian=False).gamma
+            qdd[s] = _solve(eq.jacobian, gamma, redundant)
     return qd, qdd
 
 
