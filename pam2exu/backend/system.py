@@ -66,11 +66,23 @@ class ExudynSystem:
         self.forces, self.velocity_forces = forces, velocity_forces
         self.SC = exu.SystemContainer()
         self.mbs = mbs = self.SC.AddSystem()
+        # constraints-only systems model a solid held by a fixed link as Exudyn ground at
+        # its pose: fewer coordinates and equations (the fixed link's reaction is not
+        # needed from Exudyn then)
+        self.grounded = set() if forces else {el.ref1.solid for el in mech.elements
+                                              if el.grounds}
         self.nodes, self.bodies = [], []
-        for s in mech.solids:
+        for i, s in enumerate(mech.solids):
+            x, y, fi = float(s.x), float(s.y), float(s.fi)
+            if i in self.grounded:
+                c, sn = np.cos(fi), np.sin(fi)
+                self.nodes.append(None)
+                self.bodies.append(mbs.AddObject(items.ObjectGround(
+                    referencePosition=[x, y, 0.0],
+                    referenceRotation=[[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]])))
+                continue
             node = mbs.AddNode(items.NodeRigidBody2D(
-                referenceCoordinates=[0.0, 0.0, 0.0],
-                initialCoordinates=[float(s.x), float(s.y), float(s.fi)]))
+                referenceCoordinates=[0.0, 0.0, 0.0], initialCoordinates=[x, y, fi]))
             mass, inertia = (float(s.mass), float(s.inertia)) if forces else (0.0, 0.0)
             gx, gy = (float(c) for c in s.cog)
             self.nodes.append(node)
@@ -83,7 +95,7 @@ class ExudynSystem:
         self.drivers: list = []          # (object, parameter, law)
         self.objects: dict[str, list] = {el.name: [] for el in mech.elements}
         for el in mech.elements:
-            if el.equations or forces:
+            if (el.equations or forces) and not (el.grounds and el.ref1.solid in self.grounded):
                 el.build(self)
         if forces and mech.gravity:
             for s, body in zip(mech.solids, self.bodies):
@@ -95,14 +107,15 @@ class ExudynSystem:
             L2 = mech.scale() ** 2
             q0 = mech.initial_q()
             for i in range(len(mech.solids)):
-                for k in range(3):
+                for k in range(3 if i not in self.grounded else 0):
                     mbs.AddObject(items.ObjectConnectorCoordinateSpringDamper(
                         markerNumbers=[self.ground_coordinate(), self.coordinate_marker(i, k)],
                         stiffness=anchor_stiffness * (L2 if k == 2 else 1.0),
                         offset=float(q0[3 * i + k])))
-        self.sensors = [mbs.AddSensor(items.SensorNode(
+        self.sensors = {i: mbs.AddSensor(items.SensorNode(
             nodeNumber=n, storeInternal=True, writeToFile=False,
-            outputVariableType=exu.OutputVariableType.Coordinates)) for n in self.nodes]
+            outputVariableType=exu.OutputVariableType.Coordinates))
+            for i, n in enumerate(self.nodes) if n is not None}
         mbs.Assemble()
 
     # ---- helpers for Element.build ---------------------------------------------------------
@@ -122,12 +135,24 @@ class ExudynSystem:
         return self._markers[key]
 
     def coordinate_marker(self, solid: int, k: int):
-        """MarkerNodeCoordinate on x (0), y (1) or fi (2) of a solid."""
+        """MarkerNodeCoordinate on x (0), y (1) or fi (2) of a solid.
+
+        On a grounded solid it reads 0, not the pose: see ``coordinate_shift``.
+        """
+        if solid in self.grounded:
+            return self.ground_coordinate()
         key = ("coordinate", solid, k)
         if key not in self._markers:
             self._markers[key] = self.mbs.AddMarker(items.MarkerNodeCoordinate(
                 nodeNumber=self.nodes[solid], coordinate=k))
         return self._markers[key]
+
+    def coordinate_shift(self, solid: int, k: int) -> float:
+        """Coordinate value minus what its ``coordinate_marker`` reads (the pose if grounded)."""
+        if solid in self.grounded:
+            s = self.mech.solids[solid]
+            return float((s.x, s.y, s.fi)[k])
+        return 0.0
 
     def ground_coordinate(self):
         """A coordinate marker on a ground node (value 0)."""
@@ -146,9 +171,9 @@ class ExudynSystem:
             bodyNumbers=[self.bodies[reference], self.bodies[solid]], nodeNumber=data,
             axis0=[0.0, 0.0, 1.0]))
 
-    def drive(self, obj, parameter: str, law) -> None:
-        """Make an object's parameter follow law f(t) during position solves."""
-        self.drivers.append((obj, parameter, law))
+    def drive(self, obj, parameter: str, law, shift: float = 0.0) -> None:
+        """Make an object's parameter follow f(t) + shift during position solves."""
+        self.drivers.append((obj, parameter, law, shift))
 
     def ae_rows(self, element) -> list[int]:
         """Exudyn's AE (multiplier) indices of an element, in the order of its native rows.
@@ -162,8 +187,15 @@ class ExudynSystem:
 
     # ---- solving ---------------------------------------------------------------------------
     def coordinates(self) -> np.ndarray:
-        """Current ODE2 coordinates (x, y, fi per solid)."""
-        return np.asarray(self.mbs.systemData.GetODE2Coordinates())
+        """Current x, y, fi of every solid (grounded ones at their pose)."""
+        q = self.mech.initial_q()
+        ode2 = np.asarray(self.mbs.systemData.GetODE2Coordinates())
+        k = 0
+        for i, node in enumerate(self.nodes):
+            if node is not None:
+                q[3 * i:3 * i + 3] = ode2[k:k + 3]
+                k += 3
+        return q
 
     def roundoff(self, tables) -> float:
         """The residual below which Newton cannot go: 16 ulps of the largest equation term.
@@ -215,16 +247,21 @@ class ExudynSystem:
         settings = settings or SolveSettings()
         times = np.asarray(times, dtype=float)
         n = len(times)
+        self.error, self.multipliers = None, None
+        if not self.sensors:                     # every solid is fixed: nothing to solve
+            return np.tile(self.mech.initial_q(), (n, 1)), n
         dt = float(times[1] - times[0]) if n > 1 else 1.0
-        tables = [(obj, par, law, law(times)[0]) for obj, par, law in self.drivers]
+        tables = [(obj, par, law, shift, law(times)[0] + shift)
+                  for obj, par, law, shift in self.drivers]
         mbs = self.mbs
 
         def pre_step(mbs, t):
             tau = t - dt
             k = int(round(tau / dt))
             on_grid = 0 <= k < n and abs(tau - k * dt) <= 1e-6 * dt
-            for obj, par, law, values in tables:
-                mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid else law.value(tau))
+            for obj, par, law, shift, values in tables:
+                mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid
+                                       else law.value(tau) + shift)
             return True
 
         if tables:
@@ -252,14 +289,17 @@ class ExudynSystem:
             error = exc
         finally:
             exu.config.printToConsole = False
-        data = [np.asarray(mbs.GetSensorStoredData(s)) for s in self.sensors]
-        q = np.full((n, 3 * len(self.nodes)), np.nan)
-        if data and len(data[0]) > 1:
-            t_rows = data[0][1:, 0] - dt          # row 0 is the unsolved initial state
+        data = {i: np.asarray(mbs.GetSensorStoredData(s)) for i, s in self.sensors.items()}
+        q = np.full((n, self.mech.nq), np.nan)
+        first = next(iter(data.values()), None)
+        if first is not None and len(first) > 1:
+            t_rows = first[1:, 0] - dt          # row 0 is the unsolved initial state
             k_rows = np.rint(t_rows / dt).astype(int)
             on_grid = (np.abs(t_rows - k_rows * dt) <= 1e-6 * dt) & (k_rows >= 0) & (k_rows < n)
-            for i, d in enumerate(data):
+            for i, d in data.items():
                 q[k_rows[on_grid], 3 * i:3 * i + 3] = d[1:, 1:4][on_grid]
+            for i in self.grounded:
+                q[k_rows[on_grid], 3 * i:3 * i + 3] = self.mech.initial_q()[3 * i:3 * i + 3]
         solved = int(np.argmin(np.isfinite(q).all(axis=1))) if not np.isfinite(q).all() else n
         if error is None and solved < n:
             error = RuntimeError("the static solver stopped early")

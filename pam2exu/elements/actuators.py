@@ -38,11 +38,13 @@ class AngularActuator(Actuator):
         return st.angle(self.ref2.solid) - st.angle(self.ref1.solid), self.time_law()
 
     def build(self, ex):
+        # marker values are fi − shift (a grounded solid's marker reads 0, not its fi)
+        shift = ex.coordinate_shift(self.ref1.solid, 2) - ex.coordinate_shift(self.ref2.solid, 2)
         obj = ex.add(self, ex.items.ObjectConnectorCoordinate(
             markerNumbers=[ex.coordinate_marker(self.ref1.solid, 2),
                            ex.coordinate_marker(self.ref2.solid, 2)],
-            offset=self.time_law().value(0.0)))
-        ex.drive(obj, "offset", self.time_law())
+            offset=self.time_law().value(0.0) + shift))
+        ex.drive(obj, "offset", self.time_law(), shift)
 
 
 @dataclass(eq=False)

@@ -134,6 +134,9 @@ class Element:
     #: moment) components of the wrench it applies to its receiving solid, in its reporting
     #: frame (``report_frame``); None marks a component that is zero by construction
     wrench: ClassVar[tuple[str | None, str | None, str | None]] = ()
+    #: the element holds its (first) solid at its pose: a constraints-only Exudyn system
+    #: may model that solid as ground instead
+    grounds: ClassVar[bool] = False
 
     #: 1-based position in the file's [[element]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)

@@ -25,6 +25,7 @@ class Fixed(Element):
     )
     equations = 3
     wrench = ("Fx", "Fy", "Mz")
+    grounds = True
 
     @property
     def receiver(self):
