@@ -9,6 +9,7 @@ from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
 from .errors import (MobilityError, ModelError, Pam2ExuError, SolverError, TranslationError)
 from .model import Law, Model, Solid, load, loads
+from .results.compare import compare
 
 __version__ = "0.1.0"
 
@@ -22,7 +23,7 @@ def run(model, analysis=None, **settings):
     return _run(model, analysis=analysis, **settings)
 
 
-__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "ELEMENTS", "Fixed", "Revolute",
-           "Prismatic", "PinSlot", "Transmission", "Torsor", "Spring", "TorsionalSpring",
-           "AngularActuator", "LinearActuator", "Pam2ExuError", "ModelError", "MobilityError",
-           "SolverError", "TranslationError"]
+__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "compare", "ELEMENTS", "Fixed",
+           "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor", "Spring",
+           "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError", "ModelError",
+           "MobilityError", "SolverError", "TranslationError"]

@@ -1,6 +1,7 @@
-"""The ``pam2exu`` command: run and check PAM models.
+"""The ``pam2exu`` command: run and check PAM models, compare result files.
 
 Exit codes: 0 success, 1 solver failure, 2 model error (or bad command line).
+``compare``: 0 every variable within the tolerance, 1 some outside, 2 bad input.
 Errors are printed to stderr as one paragraph; ``--debug`` shows the traceback.
 """
 from __future__ import annotations
@@ -39,6 +40,30 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("model", help="model file (TOML)")
     check.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help=argparse.SUPPRESS)
+
+    from .results.compare import ATOL, RTOL
+    comp = sub.add_parser(
+        "compare", help="compare a result CSV with a reference CSV, variable by variable",
+        description="For each variable in both files: max absolute and relative error, the "
+                    "time where it occurs, and pass when max |result - reference| <= "
+                    "atol + rtol * max |reference|. Exit 0 when every variable passes, 1 "
+                    "otherwise, 2 for bad input. See docs/compare.md.")
+    comp.add_argument("result", help="result CSV (pam2exu run MODEL -o FILE.csv)")
+    comp.add_argument("reference", help="reference CSV (another run, or exported from PAM)")
+    comp.add_argument("--rtol", type=float, default=RTOL, metavar="R",
+                      help=f"relative tolerance, times max |reference| (default {RTOL:g})")
+    comp.add_argument("--atol", type=float, default=ATOL, metavar="A",
+                      help=f"absolute tolerance, SI units (default {ATOL:g})")
+    comp.add_argument("--columns", nargs="+", metavar="PAT",
+                      help="variables to compare: names, 'solid.*', '*.Fx' or bare 'Fx'")
+    comp.add_argument("--names", metavar="MAP",
+                      help="names map: two-column CSV 'pam_name,pam2exu_name'")
+    comp.add_argument("--format", choices=["md", "csv"], default="md",
+                      help="md: Markdown table (default); csv: CSV on stdout, notes on stderr")
+    comp.add_argument("--interp", choices=["cubic", "linear"], default="cubic",
+                      help="interpolation of the result when the times differ (default cubic)")
+    comp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                      help=argparse.SUPPRESS)
     return p
 
 
@@ -88,10 +113,30 @@ def _check(args) -> int:
     return 0
 
 
+def _compare(args) -> int:
+    from .results.compare import CompareInputError, compare
+    try:
+        table = compare(args.result, args.reference, rtol=args.rtol, atol=args.atol,
+                        columns=args.columns, names=args.names, method=args.interp)
+    except CompareInputError as exc:
+        if args.debug:
+            raise
+        print(f"pam2exu: compare: {exc}", file=sys.stderr)
+        return 2
+    if args.format == "csv":
+        for line in table.header():
+            print(line, file=sys.stderr)
+        sys.stdout.write(table.to_csv())
+        print(table.verdict(), file=sys.stderr)
+    else:
+        print(table.to_markdown())
+    return 0 if table.passed else 1
+
+
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"run": _run, "check": _check}[args.command](args)
+        return {"run": _run, "check": _check, "compare": _compare}[args.command](args)
     except BrokenPipeError:              # output piped into head & co.
         sys.stderr.close()
         return 0

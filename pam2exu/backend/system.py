@@ -16,6 +16,7 @@ import exudyn as exu
 from exudyn import itemInterface as items
 
 from ..kinematics import State
+from .symbolic import offset_function
 
 
 @dataclass
@@ -254,17 +255,33 @@ class ExudynSystem:
         tables = [(obj, par, law, shift, law(times)[0] + shift)
                   for obj, par, law, shift in self.drivers]
         mbs = self.mbs
+        # connector offsets follow their law as compiled symbolic functions; the rest
+        # (a distance, or an Exudyn without symbolic functions) by a Python pre-step function
+        self._symbolic, stepped = [], []
+        for table in tables:
+            obj, par, law, shift, _ = table
+            try:
+                if par != "offset":
+                    raise NotImplementedError(par)
+                function = offset_function(mbs, obj, law, shift, dt)
+            except Exception:
+                stepped.append(table)
+                continue
+            mbs.SetObjectParameter(obj, "offsetUserFunction", function)
+            self._symbolic.append(function)
+        if self._symbolic:
+            mbs.Assemble()
 
         def pre_step(mbs, t):
             tau = t - dt
             k = int(round(tau / dt))
             on_grid = 0 <= k < n and abs(tau - k * dt) <= 1e-6 * dt
-            for obj, par, law, shift, values in tables:
+            for obj, par, law, shift, values in stepped:
                 mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid
                                        else law.value(tau) + shift)
             return True
 
-        if tables:
+        if stepped:
             mbs.SetPreStepUserFunction(pre_step)
         self.multipliers = None
         if multipliers:

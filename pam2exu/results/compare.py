@@ -107,7 +107,7 @@ class Comparison:
             times = (f"times: the same {self.reference_rows} times in both, "
                      f"compared row by row (t = {lo:g} … {hi:g} s)")
         else:
-            kind = "cubic spline (not-a-knot)" if self.method == "cubic" else "linear"
+            kind = "not-a-knot cubic spline" if self.method == "cubic" else "linear"
             times = (f"times differ: the result is interpolated onto the reference times "
                      f"({kind}) within t = {lo:g} … {hi:g} s; {self.rows_compared} of "
                      f"{self.reference_rows} reference rows compared, {self.rows_outside} "
@@ -116,8 +116,8 @@ class Comparison:
         return [f"result: {self.result} ({self.result_rows} rows)",
                 f"reference: {self.reference} ({self.reference_rows} rows)",
                 times,
-                f"rule: a variable passes when max |result − reference| ≤ atol + rtol·scale, "
-                f"scale = max |reference| (rtol = {self.rtol:g}, atol = {self.atol:g})",
+                (f"rule: a variable passes when max |result − reference| ≤ atol + rtol·scale, "
+                 f"scale = max |reference| (rtol = {self.rtol:g}, atol = {self.atol:g})"),
                 *self.notes]
 
     def verdict(self) -> str:
@@ -224,8 +224,8 @@ def scale_of(reference: np.ndarray) -> float:
 
 
 def canonical_name(column: str, names: dict[str, str] | None = None) -> str:
-    """pam2exu's name of a column: the names map (whole column, then the part before the
-    dot), then ``SPELLINGS`` on the part after the dot (Forca → Força, f → f(t), Df → Df(t))."""
+    """pam2exu's name of a column: the names map (whole column, else the part before the dot),
+    then ``SPELLINGS`` on the part after the dot (Forca → Força, f → f(t), Df → Df(t))."""
     return _canonical(column, names or {})[0]
 
 
@@ -401,7 +401,7 @@ def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str]]:
 def _load(source, role: str, names: dict[str, str]) -> _Table:
     """A path or a Results table, with its columns renamed to pam2exu's spelling."""
     if isinstance(source, Results):
-        label = f"Results of '{source.model}' ({source.analysis})" if source.model \
+        label = f"'{source.model}' {source.analysis} results" if source.model \
             else repr(source)
         raw = ["t", *source.columns]
         data, units, notes = source.to_numpy().T, dict(source.units), []
