@@ -146,11 +146,12 @@ def warn(job: Job, text: str, category) -> None:
 
 
 def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
-              forces: bool = False):
+              forces: bool = False, check: bool = True):
     """Positions at every time from Exudyn's static solver; raises SolverError on failure.
 
     With ``forces`` the Exudyn system also has the masses, gravity and force elements
     (without dampers), and its multipliers are kept: returns (q, system) then, else q.
+    ``check=False`` leaves the residual check to ``velocities`` (which has the residual).
     """
     from ..backend import ExudynSystem, SolveSettings
     mech = job.mech
@@ -179,17 +180,22 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
             "cannot close at this time or reaches a singular (dead-point) position. "
             f"Exudyn said: {system.error}",
             time=t, step=solved, elements=tuple(n for n, _ in worst))
-    check_residual(mech, job.times, q, job)
+    if check:
+        check_residual(mech, job.times, q, job)
     if redundant:
         warn_redundant(job, q[0])
     return (q, system) if forces else q
 
 
-def check_residual(mech, t, q, job: Job | None = None) -> None:
-    """Self-check: pam2exu's own constraint equations hold at Exudyn's configuration."""
+def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = None) -> None:
+    """Self-check: pam2exu's own constraint equations hold at Exudyn's configuration.
+
+    res: the residual C(q, t) when already computed.
+    """
     if mech.n_equations == 0:
         return
-    res = native.residuals(mech, t, q)
+    if res is None:
+        res = native.residuals(mech, t, q)
     worst = float(np.max(np.abs(res)))
     if job is not None:
         job.info["max_residual"] = worst
@@ -204,18 +210,21 @@ def check_residual(mech, t, q, job: Job | None = None) -> None:
 
 
 def velocities(job: Job, q: np.ndarray, redundant: bool):
-    """(qd, qdd) from the native pass; SolverError at a singular position."""
+    """(qd, qdd) from the native pass, after the residual check of Exudyn's positions;
+    SolverError at a singular position."""
     mech, t = job.mech, job.times
     accelerations = ACCELERATION in job.levels
-    try:
-        with np.errstate(all="ignore"):
-            qd, qdd = native.rates(mech, t, q, accelerations, redundant)
-        bad = ~np.isfinite(qd).all(axis=1)
-        if qdd is not None:
-            bad |= ~np.isfinite(qdd).all(axis=1)
-        if bad.any():
-            raise np.linalg.LinAlgError
-    except np.linalg.LinAlgError:
+    with np.errstate(all="ignore"):
+        try:
+            qd, qdd, residual = native.rates(mech, t, q, accelerations, redundant)
+        except np.linalg.LinAlgError:
+            qd = qdd = None
+            residual = native.residuals(mech, t, q)
+    check_residual(mech, t, q, job, residual)
+    bad = None if qd is None else ~np.isfinite(qd).all(axis=1)
+    if qdd is not None:
+        bad |= ~np.isfinite(qdd).all(axis=1)
+    if bad is None or bad.any():
         k = native.first_singular(mech, t, q)
         drivers = [f"'{e.name}'" for e in mech.constraints if hasattr(e, "time_law")]
         raise SolverError(
@@ -223,7 +232,7 @@ def velocities(job: Job, q: np.ndarray, redundant: bool):
             f"position: the constraint Jacobian loses rank, so the actuator(s) "
             f"{', '.join(drivers) or '(none)'} cannot drive it through this position and "
             "velocities are not defined. Drive the mechanism by another member, or stop the "
-            "interval before this time.", time=float(t[k]), step=k) from None
+            "interval before this time.", time=float(t[k]), step=k)
     return qd, qdd
 
 

@@ -13,7 +13,7 @@ def kinematic(job: Job):
     """
     mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
     redundant = mob.redundant > 0
-    q = positions(job, redundant)
+    q = positions(job, redundant, check=VELOCITY not in job.levels)
     qd = qdd = None
     if VELOCITY in job.levels:
         qd, qdd = velocities(job, q, redundant)

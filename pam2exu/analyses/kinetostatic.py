@@ -20,7 +20,7 @@ def kinetostatic(job: Job):
     """
     mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
     redundant = mob.redundant > 0
-    q = positions(job, redundant)
+    q = positions(job, redundant, check=False)
     qd, qdd = velocities(job, q, redundant)
     extra = inverse_dynamics(job, q, qd, qdd, redundant) if FORCE in job.levels else {}
     return collect(job, q, qd, qdd, extra)

@@ -94,17 +94,20 @@ def _solve(J, b, redundant, rtol=1e-12):
 
 
 def rates(mech, t, q, accelerations: bool, redundant: bool):
-    """(qd, qdd) at every step; qdd is None when not asked for."""
+    """(qd, qdd, C) at every step; qdd is None when not asked for; C = C(q, t) (n, m)
+    comes from the same evaluation of the equations, for the residual check."""
     n = len(t)
     qd = np.empty_like(q)
     qdd = np.empty_like(q) if accelerations else None
+    residual = np.empty((n, mech.n_equations))
     for s in chunks(mech, n):
         eq = equations(mech, State(t[s], q[s]))
+        residual[s] = eq.residual
         qd[s] = _solve(eq.jacobian, -eq.c_t, redundant)
         if accelerations:
             gamma = equations(mech, State(t[s], q[s], qd[s]), jacobian=False).gamma
             qdd[s] = _solve(eq.jacobian, gamma, redundant)
-    return qd, qdd
+    return qd, qdd, residual
 
 
 @dataclass

@@ -27,7 +27,7 @@ def quasi_static(job: Job):
     redundant = mob.redundant > 0
     if FORCE not in job.levels:
         return collect(job, positions(job, redundant))
-    q, system = positions(job, redundant, forces=True)
+    q, system = positions(job, redundant, forces=True, check=False)
     velocities(job, q, redundant)      # raises at a singular position: reactions undefined
     mech, t = job.mech, job.times
     order = [i for el in mech.constraints for i in system.ae_rows(el)]
