@@ -162,29 +162,52 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
                                        redundant=redundant, multipliers=forces)
     job.info["exudyn_seconds"] = _time.perf_counter() - start
     if solved < len(job.times):
-        t = float(job.times[solved])
-        start = q[solved - 1] if solved > 0 else system.coordinates()
-        left = native.closest_violation(mech, t, start)
-        worst = [w for w in native.worst_elements(mech, left, len(mech.constraints))
-                 if w[1] > RESIDUAL_TOLERANCE * mech.scale()]
-        where = (("the constraints cannot all hold; still violated at the closest "
-                  "configuration: " + ", ".join(f"{name} by {r:.3g}" for name, r in worst))
-                 if worst else "the constraints can all hold, so the Newton iteration "
-                               "diverged (a singular position or too large a step)")
-        step = f"step {solved} of {len(job.times) - 1}" if job.analysis != "assembly" else "assembly"
-        raise SolverError(
-            f"Exudyn's static solver did not converge at t = {t:.6g} s ({step}). "
-            f"At that time {where}. "
-            "Try: an initial guess (x, y, fi of the solids) closer to an assembled position; "
-            "more steps, so the actuators move less per step; or check whether the mechanism "
-            "cannot close at this time or reaches a singular (dead-point) position. "
-            f"Exudyn said: {system.error}",
-            time=t, step=solved, elements=tuple(n for n, _ in worst))
+        raise _position_failure(job, system, q, solved)
     if check:
         check_residual(mech, job.times, q, job)
     if redundant:
         warn_redundant(job, q[0])
     return (q, system) if forces else q
+
+
+def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverError:
+    """The error for Exudyn's static solver stopping at step ``solved``, with a diagnosis.
+
+    A least-squares solve at the failing time (native, for the message only) tells whether
+    the constraints can hold there. If they cannot, after the previous step did: the
+    motion went through a limit position, where the Jacobian is singular (dead point).
+    """
+    mech, times = job.mech, job.times
+    t = float(times[solved])
+    start = q[solved - 1] if solved > 0 else system.coordinates()
+    left, _ = native.closest_violation(mech, t, start)
+    worst = [w for w in native.worst_elements(mech, left, len(mech.constraints))
+             if w[1] > RESIDUAL_TOLERANCE * mech.scale()]
+    violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)
+    drivers = ", ".join(f"'{e.name}'" for e in mech.constraints if hasattr(e, "time_law"))
+    elements = tuple(n for n, _ in worst)
+    if worst and solved > 0:
+        t0 = float(times[solved - 1])
+        return SolverError(
+            f"between t = {t0:.6g} s and t = {t:.6g} s (step {solved} of {len(times) - 1}) "
+            f"the mechanism reached a singular (dead-point) position: the actuator(s) "
+            f"{drivers or '(none)'} drive it to a limit position it cannot pass. After it "
+            f"the constraints cannot all hold (still violated at the closest "
+            f"configuration: {violated}). Drive the mechanism by another member, change the "
+            f"law so it stays within the limit, or end the interval before t = {t0:.6g} s. "
+            f"Exudyn said: {system.error}", time=t0, step=solved, elements=elements)
+    where = (f"the constraints cannot all hold; still violated at the closest "
+             f"configuration: {violated}" if worst else
+             "the constraints can all hold, so the Newton iteration diverged (a singular "
+             "position or too large a step)")
+    step = f"step {solved} of {len(times) - 1}" if job.analysis != "assembly" else "assembly"
+    return SolverError(
+        f"Exudyn's static solver did not converge at t = {t:.6g} s ({step}). "
+        f"At that time {where}. "
+        "Try: an initial guess (x, y, fi of the solids) closer to an assembled position; "
+        "more steps, so the actuators move less per step; or check whether the mechanism "
+        "cannot close at this time or reaches a singular (dead-point) position. "
+        f"Exudyn said: {system.error}", time=t, step=solved, elements=elements)
 
 
 def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = None) -> None:

@@ -180,19 +180,20 @@ def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
     return n - 1
 
 
-def closest_violation(mech, t: float, q_start: np.ndarray) -> np.ndarray:
-    """Residual C(q*, t) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only).
+def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(C(q*, t), q*) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only).
 
-    The elements still violated at q* are those that cannot close at time t.
+    The elements still violated at q* are those that cannot close at time t. Where
+    C(q*) ≠ 0, Cqᵀ C = 0 there: the constraint Jacobian is singular at q*.
     """
     from scipy.optimize import least_squares
 
     def fun(q):
-        return equations(mech, State([t], q[None])).residual[0]
+        return equations(mech, State([t], q[None]), jacobian=False).residual[0]
 
     def jac(q):
         return equations(mech, State([t], q[None])).jacobian[0]
 
     sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
                         else "trf", max_nfev=200 * mech.nq, xtol=1e-14, ftol=1e-14)
-    return sol.fun
+    return sol.fun, sol.x
