@@ -57,7 +57,8 @@ def _parser() -> argparse.ArgumentParser:
     comp.add_argument("--columns", nargs="+", metavar="PAT",
                       help="variables to compare: names, 'solid.*', '*.Fx' or bare 'Fx'")
     comp.add_argument("--names", metavar="MAP",
-                      help="names map: two-column CSV 'pam_name,pam2exu_name'")
+                      help="names map for the reference's columns: two-column CSV "
+                           "'pam_name,pam2exu_name'")
     comp.add_argument("--format", choices=["md", "csv"], default="md",
                       help="md: Markdown table (default); csv: CSV on stdout, notes on stderr")
     comp.add_argument("--interp", choices=["cubic", "linear"], default="cubic",

@@ -9,7 +9,8 @@ For every variable in both tables, over the reference rows compared:
 Rows are matched by ``t``. When the two tables have different times, the result is
 interpolated onto the reference times (cubic spline by default) inside the result's time
 interval; reference rows outside it are counted and left out. Column names are brought to
-pam2exu's spelling first: a names map (PAM name -> pam2exu name), then ``SPELLINGS``.
+pam2exu's spelling first: the reference's by a names map (PAM name -> pam2exu name), then
+both tables' by ``SPELLINGS``.
 The user guide is docs/compare.md.
 """
 from __future__ import annotations
@@ -370,15 +371,23 @@ def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str]]:
     if delimiter != ",":
         notes.append(f"{role} read with {'tab' if delimiter == chr(9) else repr(delimiter)} "
                      f"as separator and ',' as decimal mark")
-    rows = list(csv.reader([line for _, line in lines], delimiter=delimiter))
-    header = [_clean(h) for h in rows[0]]
+    header = [_clean(h) for h in next(csv.reader([header_line], delimiter=delimiter))]
     while header and header[-1] == "":
         header.pop()                       # a trailing separator
     if "" in header:
         raise CompareInputError(f"{path}: column {header.index('') + 1} has no name in the "
                                 f"header line; name it or delete the column")
-    values = np.empty((len(rows) - 1, len(header)))
-    for k, (row, (number, _)) in enumerate(zip(rows[1:], lines[1:])):
+    body = "\n".join(line for _, line in lines[1:])
+    try:                                   # fast path: a clean table
+        values = np.loadtxt(io.StringIO(body if delimiter == "," else body.replace(",", ".")),
+                            delimiter=delimiter, ndmin=2, dtype=float, comments=None)
+        if values.shape[1] == len(header):
+            return header, values.T, notes
+    except ValueError:
+        pass
+    rows = list(csv.reader([line for _, line in lines[1:]], delimiter=delimiter))
+    cells = []
+    for row, (number, _) in zip(rows, lines[1:]):
         if all(f.strip() == "" for f in row[len(header):]):
             row = row[:len(header)]        # trailing separators
         if len(row) != len(header):
@@ -387,14 +396,21 @@ def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str]]:
             raise CompareInputError(f"{path}, line {number}: {len(row)} values, the header has "
                                     f"{len(header)} names{hint}; every line needs one value "
                                     f"per column")
-        for j, cell in enumerate(row):
-            cell = cell.strip().replace(",", ".") if delimiter != "," else cell.strip()
-            try:
-                values[k, j] = float(cell) if cell else np.nan
-            except ValueError:
-                raise CompareInputError(f"{path}, line {number}, column '{header[j]}': "
-                                        f"'{row[j].strip()}' is not a number; fix the value "
-                                        f"(an empty cell is read as missing)") from None
+        cells.append([f.strip().replace(",", ".") if delimiter != "," else f.strip()
+                      for f in row])
+    try:
+        values = np.array(cells, dtype=float).reshape(len(cells), len(header))
+    except ValueError:                     # empty cells, or a bad one to point at
+        values = np.empty((len(cells), len(header)))
+        for k, (row, (number, _)) in enumerate(zip(cells, lines[1:])):
+            for j, cell in enumerate(row):
+                try:
+                    values[k, j] = float(cell) if cell else np.nan
+                except ValueError:
+                    raise CompareInputError(
+                        f"{path}, line {number}, column '{header[j]}': '{rows[k][j].strip()}'"
+                        f" is not a number; fix the value (an empty cell is read as missing)"
+                    ) from None
     return header, values.T, notes
 
 
@@ -402,7 +418,7 @@ def _load(source, role: str, names: dict[str, str]) -> _Table:
     """A path or a Results table, with its columns renamed to pam2exu's spelling."""
     if isinstance(source, Results):
         label = f"'{source.model}' {source.analysis} results" if source.model \
-            else repr(source)
+            else "Results table"
         raw = ["t", *source.columns]
         data, units, notes = source.to_numpy().T, dict(source.units), []
     elif isinstance(source, (str, Path)):
@@ -517,7 +533,8 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
         Patterns of the variables to compare: full names, ``crank.*``, ``*.Fx``, bare ``Fx``.
     names : dict, str or Path, optional
         Names map PAM name → pam2exu name, or a two-column CSV file of it (``read_names``);
-        applied to both tables, before the built-in ``SPELLINGS``.
+        applied to the reference's columns, before the built-in ``SPELLINGS`` (which apply
+        to both tables).
     method : str
         ``cubic`` (not-a-knot spline) or ``linear``: how the result is interpolated onto the
         reference times when the times differ.
@@ -540,13 +557,13 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
         raise CompareInputError(f"`method` must be one of {', '.join(METHODS)}, not "
                                 f"{method!r}{closest(method, METHODS)}")
     names_map = _names_map(names)
-    res = _load(result, "result", names_map)
+    res = _load(result, "result", {})              # the map is for the reference's names
     ref = _load(reference, "reference", names_map)
     common, only_res, only_ref = _choose(res, ref, columns)
     ir = [res.names.index(c) for c in common]
     jr = [ref.names.index(c) for c in common]
     notes = res.notes + ref.notes
-    unused = sorted(set(names_map) - res.used_keys - ref.used_keys)
+    unused = sorted(set(names_map) - ref.used_keys)
     if unused:
         notes.append(f"names map: no column matched {_listing(unused)}")
 
