@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..errors import ModelError, Problem
 from .assembly import assembly
-from .common import ConsistencyWarning, RedundancyWarning, prepare
+from .common import ConditionWarning, ConsistencyWarning, RedundancyWarning, prepare
 from .kinematic import kinematic
 from .kinetostatic import kinetostatic
 from .quasi_static import quasi_static
@@ -40,4 +40,4 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None)
     return ANALYSES[job.analysis](job)
 
 
-__all__ = ["ANALYSES", "run", "RedundancyWarning", "ConsistencyWarning"]
+__all__ = ["ANALYSES", "run", "RedundancyWarning", "ConsistencyWarning", "ConditionWarning"]

@@ -49,6 +49,10 @@ class ConsistencyWarning(UserWarning):
     """A physics check after an analysis (the power balance) did not hold."""
 
 
+class ConditionWarning(UserWarning):
+    """The mechanism passes at or near a singular position: results there are less exact."""
+
+
 @dataclass
 class Job:
     """One analysis of one mechanism, with everything decided before the numerics."""
@@ -146,12 +150,14 @@ def warn(job: Job, text: str, category) -> None:
 
 
 def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
-              forces: bool = False, check: bool = True):
+              forces: bool = False, check: bool = True, partial: bool = False):
     """Positions at every time from Exudyn's static solver; raises SolverError on failure.
 
     With ``forces`` the Exudyn system also has the masses, gravity and force elements
     (without dampers), and its multipliers are kept: returns (q, system) then, else q.
     ``check=False`` leaves the residual check to ``velocities`` (which has the residual).
+    ``partial``: a failure after the first step is not raised; returns (q, solved, system)
+    with the rows from ``solved`` on NaN (``branch.motion`` may still repair it).
     """
     from ..backend import ExudynSystem, SolveSettings
     mech = job.mech
@@ -161,12 +167,14 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     q, solved = system.solve_positions(job.times, job.solver or SolveSettings(),
                                        redundant=redundant, multipliers=forces)
     job.info["exudyn_seconds"] = _time.perf_counter() - start
-    if solved < len(job.times):
+    if solved < len(job.times) and not (partial and solved > 0):
         raise _position_failure(job, system, q, solved)
     if check:
         check_residual(mech, job.times, q, job)
     if redundant:
         warn_redundant(job, q[0])
+    if partial:
+        return q, solved, system
     return (q, system) if forces else q
 
 
@@ -232,30 +240,32 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
             "translation of this element is wrong. Please report it with the model file.")
 
 
+def singular_error(job: Job, k: int) -> SolverError:
+    """The error for a singular (dead-point) position at step k, where rates are undefined."""
+    t = job.times
+    drivers = [f"'{e.name}'" for e in job.mech.constraints if hasattr(e, "time_law")]
+    return SolverError(
+        f"at t = {t[k]:.6g} s (step {k}) the mechanism is at a singular (dead-point) "
+        f"position: the constraint Jacobian loses rank, so the actuator(s) "
+        f"{', '.join(drivers) or '(none)'} cannot drive it through this position and "
+        f"velocities{'' if job.analysis == 'kinematic' else ' and reactions'} are not "
+        "defined. Drive the mechanism by another member, or stop the interval before this "
+        "time.", time=float(t[k]), step=k)
+
+
 def velocities(job: Job, q: np.ndarray, redundant: bool):
     """(qd, qdd) from the native pass, after the residual check of Exudyn's positions;
-    SolverError at a singular position."""
+    SolverError at a singular position (``branch.motion`` follows the branch instead)."""
     mech, t = job.mech, job.times
     accelerations = ACCELERATION in job.levels
     with np.errstate(all="ignore"):
-        try:
-            qd, qdd, residual = native.rates(mech, t, q, accelerations, redundant)
-        except np.linalg.LinAlgError:
-            qd = qdd = None
-            residual = native.residuals(mech, t, q)
+        qd, qdd, residual = native.rates(mech, t, q, accelerations, redundant)
     check_residual(mech, t, q, job, residual)
-    bad = None if qd is None else ~np.isfinite(qd).all(axis=1)
+    bad = ~np.isfinite(qd).all(axis=1)
     if qdd is not None:
         bad |= ~np.isfinite(qdd).all(axis=1)
-    if bad is None or bad.any():
-        k = native.first_singular(mech, t, q)
-        drivers = [f"'{e.name}'" for e in mech.constraints if hasattr(e, "time_law")]
-        raise SolverError(
-            f"at t = {t[k]:.6g} s (step {k}) the mechanism is at a singular (dead-point) "
-            f"position: the constraint Jacobian loses rank, so the actuator(s) "
-            f"{', '.join(drivers) or '(none)'} cannot drive it through this position and "
-            "velocities are not defined. Drive the mechanism by another member, or stop the "
-            "interval before this time.", time=float(t[k]), step=k)
+    if bad.any():
+        raise singular_error(job, min(int(np.argmax(bad)), native.first_singular(mech, t, q)))
     return qd, qdd
 
 

@@ -6,8 +6,8 @@ import numpy as np
 from ..elements import FORCE
 from ..kinematics import State
 from . import forces, native
-from .common import (ConsistencyWarning, Job, check_mobility, collect, positions, velocities,
-                     warn)
+from .branch import motion
+from .common import ConsistencyWarning, Job, check_mobility, collect, warn
 
 
 def kinetostatic(job: Job):
@@ -20,8 +20,7 @@ def kinetostatic(job: Job):
     """
     mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
     redundant = mob.redundant > 0
-    q = positions(job, redundant, check=False)
-    qd, qdd = velocities(job, q, redundant)
+    q, qd, qdd = motion(job, redundant, singular_ok=False)
     extra = inverse_dynamics(job, q, qd, qdd, redundant) if FORCE in job.levels else {}
     return collect(job, q, qd, qdd, extra)
 

@@ -81,16 +81,58 @@ def worst_elements(mech, residual_row: np.ndarray, count: int = 3) -> list[tuple
 
 
 def _solve(J, b, redundant, rtol=1e-12):
-    """x with J x = b per step: LU when square; x = V Σ⁻¹ Uᵀ b (exact when consistent) if redundant.
-
-    Raises LinAlgError where J has lost rank (a singular position).
+    """x with J x = b per step: LU when square; x = V Σ⁻¹ Uᵀ b (exact when consistent) if
+    redundant or where LU fails. Rows where J has lost rank (a singular position) are NaN.
     """
     if not redundant:
-        return np.linalg.solve(J, b[..., None])[..., 0]
+        try:
+            return np.linalg.solve(J, b[..., None])[..., 0]
+        except np.linalg.LinAlgError:       # an exactly singular step: solve this chunk by SVD
+            pass
     U, s, Vt = np.linalg.svd(J, full_matrices=False)
-    if np.any(s[:, -1] <= rtol * s[:, 0]):
-        raise np.linalg.LinAlgError("rank lost")
-    return np.einsum("nkq,nk->nq", Vt, np.einsum("nmk,nm->nk", U, b) / s)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.einsum("nkq,nk->nq", Vt, np.einsum("nmk,nm->nk", U, b) / s)
+    x[s[:, -1] <= rtol * s[:, 0]] = np.nan
+    return x
+
+
+def turns_jumped(t, q, qd, solids: int) -> np.ndarray:
+    """n (steps, solids): whole turns by which each angle jumped at each step.
+
+    fi_k − fi_j − (t_k − t_j)(ω_k + ω_j)/2 ≈ 2π n, j the previous step with finite rates
+    (a step without rates is predicted from ω_j alone). Newton's iteration at a singular
+    position can land on the same configuration with an angle off by whole turns.
+    """
+    fi, w = q[:, 2::3][:, :solids], qd[:, 2::3][:, :solids]
+    valid = np.isfinite(w).all(axis=1)
+    valid[0] = True
+    last = np.maximum.accumulate(np.where(valid, np.arange(len(t)), 0))
+    j, k = last[:-1], np.arange(1, len(t))
+    wk = np.where(valid[k, None], w[k], w[j])
+    n = np.zeros(fi.shape)
+    with np.errstate(invalid="ignore"):
+        n[1:] = np.rint((fi[k] - fi[j] - (t[k] - t[j])[:, None] * (wk + w[j]) / 2)
+                        / (2 * np.pi))
+    n[~np.isfinite(n)] = 0.0
+    return n
+
+
+def continuity_defect(t, qd, qdd, scale, breakpoints=()) -> np.ndarray:
+    """d_k = max |qd_k − qd_{k−1} − dt (qdd_k + qdd_{k−1})/2| / scale (k ≥ 1; d_0 = 0).
+
+    On a smooth motion d_k = O(dt³); a jump of the velocities, as when Newton's iteration
+    switches to another branch of the mechanism, makes it O(1). Steps whose interval holds
+    a law breakpoint (where velocities may jump) get 0.
+    """
+    dt = np.diff(t)[:, None]
+    d = np.zeros(len(t))
+    jump = qd[1:] - qd[:-1] - dt * (qdd[1:] + qdd[:-1]) / 2
+    with np.errstate(invalid="ignore"):
+        d[1:] = np.max(np.abs(jump) / scale, axis=1)
+    d[np.isnan(d)] = np.inf
+    for b in breakpoints:
+        d[1:][(t[:-1] < b) & (b <= t[1:])] = 0.0
+    return d
 
 
 def rates(mech, t, q, accelerations: bool, redundant: bool):

@@ -39,13 +39,27 @@ def test_run_reports_the_redundancy(res):
     assert any("'O3'" in w and "not" in w for w in res.warnings)
 
 
-def test_singular_position_of_a_redundant_mechanism_is_an_error(request):
-    """Driven through θ = π, all bars are collinear: Cq loses rank (a change point)."""
+def test_redundant_mechanism_passes_its_change_points_on_its_branch(request):
+    """Driven through θ = π and 2π (steps 100 and 300 of 400), all bars are collinear and Cq
+    loses rank: a change point. The mechanism goes on as a parallelogram (every crank at θ,
+    the coupler translating), and the rates at those two steps, not fixed by the
+    constraints, are the limits interpolated from the neighbours, with a warning.
+
+    Reference: θ = π/2 + 2π t, θ' = 2π, θ'' = 0 for all three cranks; coupler fi = 0.
+    """
+    from pam2exu.analyses import ConditionWarning
     model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
     model["motor"].law, model["motor"].C = "polynomial", [np.pi / 2, 2 * np.pi]
     with pytest.warns(RedundancyWarning):
-        with pytest.raises(pam2exu.SolverError, match=r"t = 0\.25 s .*singular"):
-            pam2exu.run(model, steps=400)
+        with pytest.warns(ConditionWarning, match=r"t = 0\.25, 0\.75 s .*exactly at a singular"):
+            res = pam2exu.run(model, steps=400)
+    th, w = np.pi / 2 + 2 * np.pi * res.t, 2 * np.pi
+    for crank in ("crank1", "crank2", "crank3"):
+        np.testing.assert_allclose(res[f"{crank}.fi"], th, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(res[f"{crank}.Dfi"], w, rtol=0, atol=1e-9 * w)
+        np.testing.assert_allclose(res[f"{crank}.DDfi"], 0.0, rtol=0, atol=1e-9 * w * w)
+    for var, scale in (("fi", 1.0), ("Dfi", w), ("DDfi", w * w)):
+        np.testing.assert_allclose(res[f"coupler.{var}"], 0.0, rtol=0, atol=1e-9 * scale)
 
 
 def test_quasi_static_through_a_singular_position_is_an_error(request):

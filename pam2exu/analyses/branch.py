@@ -1,0 +1,280 @@
+"""Following one branch of the motion through singular and nearly singular positions.
+
+Exudyn's static solver starts each step's Newton iteration from the previous step's
+configuration. Near a change point (a parallelogram whose links become collinear, a
+four-bar passing close to one) that start can be nearer to another assembly branch, and
+Newton converges there: the positions still close, but the mechanism has switched branch.
+The velocities tell: on a smooth motion they change by O(dt³) more than the accelerations
+predict between two steps (``native.continuity_defect``); a branch switch makes them jump.
+
+Where they jump, the step is solved again by Exudyn, its Newton iteration now started from
+the Taylor predictor q + h q̇ + h²/2 q̈ of the last good step, which lies on the branch
+followed. If Exudyn lands on the same configuration as before, there was no switch (a
+coarse grid); otherwise the rest of the run is replaced by the re-solved one.
+
+At a step that lies exactly on a singular position, Cq q̇ = −C_t does not fix the rates.
+Kinematic runs give there the limits interpolated from the neighbouring steps, and warn;
+force analyses stop (the reactions are not defined there).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SolverError
+from ..kinematics import State
+from . import native
+from .common import (ConditionWarning, Job, _position_failure, check_residual, singular_error,
+                     warn)
+
+#: a velocity jump between two steps above this fraction of the velocities' scale is
+#: taken as a possible branch switch (smooth motion: O((ω dt)³) of it)
+JUMP = 0.05
+#: ... or above SPIKE times the defects around it (and above SPIKE_FLOOR)
+SPIKE, SPIKE_FLOOR = 10.0, 1e-4
+#: sub-steps per step when the predictor alone does not find the branch
+SUBSTEPS = 16
+#: the most re-solves of a run before giving up
+MAX_RESOLVES = 64
+#: the condition number of the constraint Jacobian (rows and columns equilibrated) above
+#: which a run warns; ordinary mechanisms: 3 to 10, a four-bar 0.2° from a change point: 190
+CONDITION_WARNING = 100.0
+#: condition numbers are computed at most at this many steps (equally spaced) per run
+CONDITION_SAMPLES = 400
+#: a step next to a velocity jump whose condition number is above this is taken as lying
+#: on the singular position itself: Newton converges there only to ~√(tolerance), so the
+#: condition number of Exudyn's configuration is ~1e6, not 1e16
+SINGULAR = 1e4
+
+
+def _scales(mech, qd) -> np.ndarray:
+    """Per-coordinate scale of the velocities: the largest speed, angles × the length scale."""
+    finite = np.where(np.isfinite(qd), qd, 0.0)
+    L = mech.scale()
+    weights = np.tile([1.0, 1.0, L], len(mech.solids))
+    speed = max(float(np.max(np.abs(finite * weights), initial=0.0)), 1e-12 * L)
+    return speed / weights
+
+
+def _breakpoints(mech) -> list[float]:
+    return [b for el in mech.constraints if hasattr(el, "time_law")
+            for b in el.time_law().breakpoints()]
+
+
+def _resolve(job: Job, k: int, start: np.ndarray, redundant: bool):
+    """(positions, steps solved, system): Exudyn at steps k… from ``start`` at step k."""
+    from ..backend import ExudynSystem, SolveSettings
+    system = ExudynSystem(job.mech, start=start)
+    part, solved = system.solve_positions(job.times[k:], job.solver or SolveSettings(),
+                                          redundant=redundant)
+    return part, solved, system
+
+
+def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: bool = True):
+    """(q, qd, qdd) on the branch the mechanism starts on (see the module's doc).
+
+    Positions come from Exudyn; steps where the velocities jump are solved again.
+    singular_ok: steps exactly at a singular position get interpolated rates (with a
+    warning); False: they raise a SolverError (force analyses).
+    """
+    from .common import positions
+    mech, t = job.mech, job.times
+    q, solved, system = positions(job, redundant, check=False, partial=True)
+    breakpoints = _breakpoints(mech)
+    verified: set[int] = set()
+    resolves = 0
+    while True:
+        tk, qk = t[:solved], q[:solved]
+        with np.errstate(all="ignore"):
+            qd, qdd, residual = native.rates(mech, tk, qk, True, redundant)
+        check_residual(mech, tk, qk, job, residual)
+        singular = ~(np.isfinite(qd).all(axis=1) & np.isfinite(qdd).all(axis=1))
+        q = _unwrap(mech, tk, q, qd, solved)
+        if singular[0] or (singular.any() and not singular_ok):
+            raise singular_error(job, int(np.argmax(singular)))
+        scale = _scales(mech, qd)
+        defect = native.continuity_defect(tk, qd, qdd, scale, breakpoints)
+        k = _first_jump(defect, singular, verified)
+        while k is not None:         # numerically singular steps: their rates are round-off
+            near = [i for i in (k - 1, k) if i > 0 and not singular[i]]
+            at = [i for i, c in zip(near, condition_numbers(mech, tk[near], qk[near]))
+                  if c > SINGULAR]
+            if not at:
+                break
+            singular[at] = True
+            qd[at] = qdd[at] = np.nan
+            k = _first_jump(defect, singular, verified)
+        if k is None:
+            if solved < len(t):
+                raise _position_failure(job, system, q, solved)
+            break
+        j = k - 1
+        while singular[j]:
+            j -= 1
+        if resolves == MAX_RESOLVES:
+            raise SolverError(
+                f"at t = {t[k]:.6g} s (step {k}) the mechanism keeps switching branch near "
+                f"singular positions ({MAX_RESOLVES} steps solved again already). Use more "
+                "steps, so the actuators move less per step.", time=float(t[k]), step=k)
+        h = t[k] - t[j]
+        start = q[j] + h * qd[j] + 0.5 * h * h * qdd[j]
+        part, part_solved, part_system = _resolve(job, k, start, redundant)
+        if part_solved:
+            part = _unturn(mech, t[k:k + part_solved], part, part_solved, start)
+        resolves += 1
+        verified.add(k)
+        verdict = _compare(job, q, qd, qdd, j, k, part[0], scale, redundant) if part_solved \
+            else "worse"
+        j0, k1 = max(0, j - 2), min(k + 2, solved - 1)
+        if verdict != "better" and not singular[j0:k1 + 1].any():
+            # the predictor found no other branch: track the branch closely instead (not
+            # through a singular step, where small steps cannot choose the branch)
+            tracked = _track(job, j0, k1, q[j0], redundant)
+            if tracked is not None:
+                differs = np.nonzero(np.max(np.abs(tracked - q[j0:j0 + len(tracked)]),
+                                            axis=1) > 1e-8 * mech.scale())[0]
+                if differs.size:     # the switch happened at step f: go on from there
+                    k = j0 + int(differs[0])
+                    part, part_solved, part_system = _resolve(
+                        job, k, tracked[differs[0]], redundant)
+                    verdict = "better" if part_solved else "worse"
+        if verdict == "worse" or (verdict == "same" and k + part_solved <= solved):
+            continue                 # no switch (a coarse grid), or no better branch found
+        q = q.copy()
+        q[k:] = part
+        solved, system = k + part_solved, part_system
+    job.info["branch_resolves"] = resolves
+    if singular.any():
+        qd, qdd = _interpolate_singular(t, qd, qdd, singular)
+        times = ", ".join(f"{t[i]:.6g}" for i in np.nonzero(singular)[0][:5])
+        warn(job, f"at t = {times} s the mechanism is exactly at a singular position (a "
+                  "change point, where the constraints do not fix the velocities): it goes "
+                  "on along the branch it was on, and the velocities and accelerations "
+                  "there are interpolated from the neighbouring steps (error of order "
+                  "(ω dt)⁴).", ConditionWarning)
+    _warn_ill_conditioned(job, q, singular)
+    return q, qd, (qdd if accelerations else None)
+
+
+def _unwrap(mech, t, q, qd, solved):
+    """q with angles that jumped by whole turns at a step (Newton at a singular position)
+    brought back, when the constraints still hold after it (they are 2π-periodic in the
+    angles of joints, not in those of actuators or transmissions)."""
+    turns = native.turns_jumped(t, q[:solved], qd, len(mech.solids))
+    if not turns.any():
+        return q
+    out = q.copy()
+    out[:solved, 2::3] -= 2 * np.pi * np.cumsum(turns, axis=0)
+    before = np.max(np.abs(native.residuals(mech, t, q[:solved])))
+    after = np.max(np.abs(native.residuals(mech, t, out[:solved])))
+    return out if after <= max(before, 1e-12 * mech.scale()) * 10 else q
+
+
+def _track(job: Job, j0: int, k1: int, start, redundant: bool, count: int = SUBSTEPS):
+    """Configurations at steps j0…k1 reached from step j0 in ``count`` Exudyn steps per
+    step (Newton then follows the branch closely), or None if Exudyn fails."""
+    from ..backend import ExudynSystem, SolveSettings
+    times = np.linspace(job.times[j0], job.times[k1], (k1 - j0) * count + 1)
+    fine, solved = ExudynSystem(job.mech, start=start).solve_positions(
+        times, job.solver or SolveSettings(), redundant=redundant)
+    return fine[::count] if solved == len(times) else None
+
+
+def _unturn(mech, t, part, solved, start):
+    """``part`` with whole turns removed from its angles so that it starts nearest
+    ``start`` (when the constraints still hold after it)."""
+    turns = np.rint((part[0, 2::3] - start[2::3]) / (2 * np.pi))
+    if not turns.any():
+        return part
+    out = part.copy()
+    out[:, 2::3] -= 2 * np.pi * turns
+    before = np.max(np.abs(native.residuals(mech, t[:1], part[:1])))
+    after = np.max(np.abs(native.residuals(mech, t[:1], out[:1])))
+    return out if after <= max(before, 1e-12 * mech.scale()) * 10 else part
+
+
+def _compare(job, q, qd, qdd, j, k, candidate, scale, redundant) -> str:
+    """'same' (q[k] again), 'better' or 'worse': how ``candidate`` at step k continues the
+    motion of step j, against q[k]."""
+    mech, t = job.mech, job.times
+    if np.max(np.abs(candidate - q[k])) <= 1e-8 * mech.scale():
+        return "same"
+    with np.errstate(all="ignore"):
+        new_qd, new_qdd, _ = native.rates(mech, t[[k]], candidate[None], True, redundant)
+    old = _jump(t, qd, qdd, j, k, scale) if k < len(qd) else np.inf
+    new = _jump(t, np.r_[qd[:k], new_qd], np.r_[qdd[:k], new_qdd], j, k, scale)
+    return "better" if new <= min(JUMP, 0.1 * old) else "worse"
+
+
+def _spikes(defect) -> np.ndarray:
+    """Steps whose defect stands out: above JUMP, or SPIKE times the median of the 17
+    steps around it (a smooth motion changes its defect gradually, a switch does not)."""
+    out = defect > JUMP
+    candidates = np.nonzero((defect > SPIKE_FLOOR) & ~out)[0]
+    if candidates.size:
+        finite = np.where(np.isfinite(defect), defect, 0.0)
+        windows = np.lib.stride_tricks.sliding_window_view(np.pad(finite, 8, mode="edge"), 17)
+        background = np.median(windows[candidates], axis=1)
+        out[candidates] = defect[candidates] > SPIKE * background
+    return out
+
+
+def _first_jump(defect, singular, verified) -> int | None:
+    """The first step whose velocities jump (or that follows a singular step)."""
+    for k in np.nonzero(_spikes(defect) | np.r_[False, singular[:-1]])[0]:
+        k = int(k)
+        if k not in verified and not singular[k]:
+            return k
+    return None
+
+
+def _jump(t, qd, qdd, j, k, scale) -> float:
+    """Velocity jump from step j to k beyond the trapezoid rule on the accelerations (scaled)."""
+    h = t[k] - t[j]
+    jump = qd[k] - qd[j] - h * (qdd[k] + qdd[j]) / 2
+    value = float(np.max(np.abs(jump) / scale))
+    return value if np.isfinite(value) else np.inf
+
+
+def _interpolate_singular(t, qd, qdd, singular):
+    """Rates at singular steps from the regular steps around them (cubic through 4 steps)."""
+    qd, qdd = qd.copy(), qdd.copy()
+    good = np.nonzero(~singular)[0]
+    for k in np.nonzero(singular)[0]:
+        near = good[np.argsort(np.abs(good - k))[:4]]
+        near.sort()
+        for values in (qd, qdd):
+            coefficients = np.polyfit(t[near] - t[k], values[near], len(near) - 1)
+            values[k] = coefficients[-1]
+    return qd, qdd
+
+
+def condition_numbers(mech, t, q) -> np.ndarray:
+    """Condition number of Cq at each step, rows and columns equilibrated (units drop out)."""
+    J = native.equations(mech, State(t, q)).jacobian
+    for _ in range(3):
+        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+        J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
+    s = np.linalg.svd(J, compute_uv=False)
+    with np.errstate(divide="ignore"):
+        return s[:, 0] / s[:, mech.nq - 1]
+
+
+def _warn_ill_conditioned(job: Job, q, singular) -> None:
+    """Warn when the constraint Jacobian is ill-conditioned somewhere (sampled steps)."""
+    from ..backend import SolveSettings
+    mech, t = job.mech, job.times
+    tolerance = (job.solver or SolveSettings()).tolerance
+    if mech.n_equations == 0:
+        return
+    steps = np.unique(np.linspace(0, len(t) - 1, min(len(t), CONDITION_SAMPLES)).astype(int))
+    steps = steps[~singular[steps]]
+    condition = condition_numbers(mech, t[steps], q[steps])
+    i = int(np.argmax(condition))
+    worst = float(condition[i])
+    job.info["max_condition_number"] = worst
+    if worst > CONDITION_WARNING:
+        warn(job, f"the constraint Jacobian is ill-conditioned near t = {t[steps[i]]:.6g} s "
+                  f"(condition number {worst:.2g}): the mechanism passes close to a singular "
+                  f"position, and velocities, accelerations and forces there may carry "
+                  f"relative errors of order {worst * worst * tolerance:.0e} (condition "
+                  f"number² × the position tolerance {tolerance:g}).", ConditionWarning)
