@@ -151,7 +151,8 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
                   "on along the branch it was on, and the velocities and accelerations "
                   "there are interpolated from the neighbouring steps (error of order "
                   "(ω dt)⁴).", ConditionWarning)
-    _warn_ill_conditioned(job, q, singular)
+    near = np.nonzero(_spikes(defect) | np.convolve(singular, [1, 1, 1], "same").astype(bool))[0]
+    _warn_ill_conditioned(job, q, singular, near)
     return q, qd, (qdd if accelerations else None)
 
 
@@ -259,14 +260,16 @@ def condition_numbers(mech, t, q) -> np.ndarray:
         return s[:, 0] / s[:, mech.nq - 1]
 
 
-def _warn_ill_conditioned(job: Job, q, singular) -> None:
-    """Warn when the constraint Jacobian is ill-conditioned somewhere (sampled steps)."""
+def _warn_ill_conditioned(job: Job, q, singular, near=()) -> None:
+    """Warn when the constraint Jacobian is ill-conditioned somewhere: at sampled steps,
+    and at the steps ``near`` singular positions or velocity jumps."""
     from ..backend import SolveSettings
     mech, t = job.mech, job.times
     tolerance = (job.solver or SolveSettings()).tolerance
     if mech.n_equations == 0:
         return
-    steps = np.unique(np.linspace(0, len(t) - 1, min(len(t), CONDITION_SAMPLES)).astype(int))
+    steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), CONDITION_SAMPLES))
+                            .astype(int), np.asarray(near, dtype=int)])
     steps = steps[~singular[steps]]
     condition = condition_numbers(mech, t[steps], q[steps])
     i = int(np.argmax(condition))

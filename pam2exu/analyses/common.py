@@ -188,9 +188,18 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
     mech, times = job.mech, job.times
     t = float(times[solved])
     start = q[solved - 1] if solved > 0 else system.coordinates()
+    from ..backend import SolveSettings
     left, _ = native.closest_violation(mech, t, start)
+    # Newton aims at tolerance × L: what the closest configuration leaves above 1000 times
+    # that cannot be closed
+    can_hold = 1e3 * (job.solver or SolveSettings()).tolerance * mech.scale()
     worst = [w for w in native.worst_elements(mech, left, len(mech.constraints))
-             if w[1] > RESIDUAL_TOLERANCE * mech.scale()]
+             if w[1] > can_hold]
+    # actuators and fixed links can always hold on their own: name the joints, if any
+    setters = {f"'{e.name}' ({e.type})" for e in mech.constraints
+               if hasattr(e, "time_law") or e.grounds}
+    if any(name not in setters for name, _ in worst):
+        worst = [w for w in worst if w[0] not in setters]
     violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)
     drivers = ", ".join(f"'{e.name}'" for e in mech.constraints if hasattr(e, "time_law"))
     elements = tuple(n for n, _ in worst)

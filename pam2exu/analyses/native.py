@@ -230,12 +230,20 @@ def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, 
     """
     from scipy.optimize import least_squares
 
+    # actuators and fixed links can always hold (they only set a coordinate): weight them
+    # so that what is left shows in the joints that cannot close
+    weight = np.ones(mech.n_equations)
+    for el, rows in zip(mech.constraints, mech.rows):
+        if hasattr(el, "time_law") or el.grounds:
+            weight[rows] = 1e3
+
     def fun(q):
-        return equations(mech, State([t], q[None]), jacobian=False).residual[0]
+        return weight * equations(mech, State([t], q[None]), jacobian=False).residual[0]
 
     def jac(q):
-        return equations(mech, State([t], q[None])).jacobian[0]
+        return weight[:, None] * equations(mech, State([t], q[None])).jacobian[0]
 
     sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
-                        else "trf", max_nfev=200 * mech.nq, xtol=1e-14, ftol=1e-14)
-    return sol.fun, sol.x
+                        else "trf", max_nfev=200 * mech.nq, xtol=1e-15, ftol=1e-15,
+                        gtol=1e-15)
+    return sol.fun / weight, sol.x
