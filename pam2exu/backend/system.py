@@ -56,12 +56,15 @@ class ExudynSystem:
         If > 0, tie every coordinate to its initial guess by a spring of this stiffness
         (per m², and per rad² times the length scale²): the assembled configuration is then
         the one nearest to the guess when degrees of freedom are left free.
+    start : array, optional
+        x, y, fi of every solid to start Newton's iteration from (default: the solids'
+        x, y, fi in the model); used to restart a run part-way.
     """
 
     items = items
 
     def __init__(self, mech, forces: bool = False, velocity_forces: bool = True,
-                 anchor_stiffness: float = 0.0):
+                 anchor_stiffness: float = 0.0, start=None):
         exu.config.printToConsole = False
         self.mech = mech
         self.forces, self.velocity_forces = forces, velocity_forces
@@ -73,8 +76,9 @@ class ExudynSystem:
         self.grounded = set() if forces else {el.ref1.solid for el in mech.elements
                                               if el.grounds}
         self.nodes, self.bodies = [], []
+        self.start = mech.initial_q() if start is None else np.asarray(start, dtype=float)
         for i, s in enumerate(mech.solids):
-            x, y, fi = float(s.x), float(s.y), float(s.fi)
+            x, y, fi = (float(v) for v in self.start[3 * i:3 * i + 3])
             if i in self.grounded:
                 c, sn = np.cos(fi), np.sin(fi)
                 self.nodes.append(None)
@@ -165,9 +169,9 @@ class ExudynSystem:
 
     def relative_rotation_marker(self, reference: int, solid: int):
         """fi_solid − fi_reference, continued past ±π by a NodeGenericData."""
-        s0, s1 = self.mech.solids[reference], self.mech.solids[solid]
+        fi0, fi1 = self.start[3 * reference + 2], self.start[3 * solid + 2]
         data = self.mbs.AddNode(items.NodeGenericData(
-            numberOfDataCoordinates=1, initialCoordinates=[float(s1.fi) - float(s0.fi)]))
+            numberOfDataCoordinates=1, initialCoordinates=[float(fi1 - fi0)]))
         return self.mbs.AddMarker(items.MarkerBodiesRelativeRotationCoordinate(
             bodyNumbers=[self.bodies[reference], self.bodies[solid]], nodeNumber=data,
             axis0=[0.0, 0.0, 1.0]))
@@ -235,7 +239,8 @@ class ExudynSystem:
     def solve_positions(self, times: np.ndarray, settings: SolveSettings | None = None,
                         redundant: bool = False,
                         multipliers: bool = False) -> tuple[np.ndarray, int]:
-        """Positions at times t_k = k·dt (k = 0…n−1), one static load step each.
+        """Positions at times t_k = k·dt (k = k0…k0+n−1, equally spaced), one static load
+        step each, from the start configuration.
 
         Returns (q, n_solved): q has a row per time; when Exudyn stops early, the rows
         after n_solved are NaN. With ``multipliers``, Exudyn's Lagrange multipliers of
@@ -252,6 +257,7 @@ class ExudynSystem:
         if not self.sensors:                     # every solid is fixed: nothing to solve
             return np.tile(self.mech.initial_q(), (n, 1)), n
         dt = float(times[1] - times[0]) if n > 1 else 1.0
+        k0 = int(round(times[0] / dt))          # global index of the first step
         tables = [(obj, par, law, shift, law(times)[0] + shift)
                   for obj, par, law, shift in self.drivers]
         mbs = self.mbs
@@ -274,8 +280,8 @@ class ExudynSystem:
 
         def pre_step(mbs, t):
             tau = t - dt
-            k = int(round(tau / dt))
-            on_grid = 0 <= k < n and abs(tau - k * dt) <= 1e-6 * dt
+            k = int(round(tau / dt)) - k0
+            on_grid = 0 <= k < n and abs(tau - (k + k0) * dt) <= 1e-6 * dt
             for obj, par, law, shift, values in stepped:
                 mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid
                                        else law.value(tau) + shift)
@@ -289,7 +295,7 @@ class ExudynSystem:
             get = mbs.systemData.GetAECoordinates
 
             def post_step(mbs, t):
-                k = int(round(t / dt)) - 1
+                k = int(round(t / dt)) - 1 - k0
                 if 0 <= k < n:
                     lam[k] = get()
                 return True
@@ -297,6 +303,7 @@ class ExudynSystem:
             mbs.SetPostStepUserFunction(post_step)
         ss = self.simulation_settings(settings, redundant, self.roundoff(tables))
         ss.staticSolver.numberOfLoadSteps = n
+        ss.staticSolver.loadStepStart = k0 * dt
         ss.staticSolver.loadStepDuration = n * dt
         error = None
         exu.config.printToConsole = settings.verbose > 0
@@ -312,7 +319,9 @@ class ExudynSystem:
         if first is not None and len(first) > 1:
             t_rows = first[1:, 0] - dt          # row 0 is the unsolved initial state
             k_rows = np.rint(t_rows / dt).astype(int)
-            on_grid = (np.abs(t_rows - k_rows * dt) <= 1e-6 * dt) & (k_rows >= 0) & (k_rows < n)
+            on_grid = np.abs(t_rows - k_rows * dt) <= 1e-6 * dt
+            k_rows -= k0
+            on_grid &= (k_rows >= 0) & (k_rows < n)
             for i, d in data.items():
                 q[k_rows[on_grid], 3 * i:3 * i + 3] = d[1:, 1:4][on_grid]
             for i in self.grounded:
