@@ -139,17 +139,29 @@ def rates(mech, t, q, accelerations: bool, redundant: bool):
     """(qd, qdd, C) at every step; qdd is None when not asked for; C = C(q, t) (n, m)
     comes from the same evaluation of the equations, for the residual check."""
     n = len(t)
-    qd = np.empty_like(q)
-    qdd = np.empty_like(q) if accelerations else None
+    qd = np.zeros_like(q)
+    qdd = np.zeros_like(q) if accelerations else None
     residual = np.empty((n, mech.n_equations))
+    rows, cols = _moving(mech)
     for s in chunks(mech, n):
         eq = equations(mech, State(t[s], q[s]))
         residual[s] = eq.residual
-        qd[s] = _solve(eq.jacobian, -eq.c_t, redundant)
+        J = eq.jacobian[:, rows[:, None], cols]
+        qd[s, cols] = _solve(J, -eq.c_t[:, rows], redundant)
         if accelerations:
             gamma = equations(mech, State(t[s], q[s], qd[s]), jacobian=False).gamma
-            qdd[s] = _solve(eq.jacobian, gamma, redundant)
+            qdd[s, cols] = _solve(J, gamma[:, rows], redundant)
     return qd, qdd, residual
+
+
+def _moving(mech):
+    """(rows, columns) of Cq left once fixed links and the solids they hold are removed:
+    those solids do not move (q̇ = q̈ = 0), so the rate solves are smaller."""
+    held = {el.ref1.solid for el in mech.constraints if el.grounds}
+    rows = [r for el, rr in zip(mech.constraints, mech.rows) if not el.grounds
+            for r in range(rr.start, rr.stop)]
+    cols = [3 * i + k for i in range(len(mech.solids)) if i not in held for k in range(3)]
+    return np.array(rows, dtype=int), np.array(cols, dtype=int)
 
 
 @dataclass
