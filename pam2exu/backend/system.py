@@ -19,6 +19,11 @@ from ..kinematics import State
 from .symbolic import offset_function
 
 
+#: Exudyn's dense linear solver up to this many coordinates, the sparse one above (measured:
+#: sparse is faster from 27–51 coordinates on, 14× faster at 300; docs/performance.md)
+DENSE_UP_TO = 40
+
+
 @dataclass
 class SolveSettings:
     """Settings of Exudyn's static (position) solver.
@@ -31,7 +36,7 @@ class SolveSettings:
     max_iterations : int
         Newton iterations per step before Exudyn subdivides the step.
     dense : bool | None
-        Dense linear solver (None: dense up to 300 coordinates, sparse above).
+        Dense linear solver (None: dense up to DENSE_UP_TO coordinates, sparse above).
     verbose : int
         Exudyn's solver output (0: quiet).
     """
@@ -228,7 +233,7 @@ class ExudynSystem:
         newton.absoluteTolerance = max(settings.tolerance * self.mech.scale(), roundoff)
         newton.relativeTolerance = settings.tolerance
         newton.maxIterations = settings.max_iterations
-        dense = settings.dense if settings.dense is not None else self.mech.nq <= 300
+        dense = settings.dense if settings.dense is not None else self.mech.nq <= DENSE_UP_TO
         if redundant:
             dense = True
             ss.linearSolver.ignoreSingularJacobian = True
