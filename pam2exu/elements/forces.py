@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
-from ..kinematics import generalized_force, rotate, torque
+from ..kinematics import Quantity, generalized_force, rotate, torque
 from .base import FORCE, POSITION, VELOCITY, Element, Load, Param, Var, constants
 
 
@@ -62,8 +62,41 @@ class Torsor(Element):
                                                    bodyFixed=solid_axes), kind="load")
 
 
+class _SpringDamper(Element):
+    """A spring-damper on a scalar measure x (a distance, a relative angle):
+    F = C1 + C2 (x − C3) + C4 ẋ, acting to decrease x."""
+
+    #: names of the measure x and of the force output
+    variable: ClassVar[str] = ""
+    force: ClassVar[str] = ""
+
+    def measure(self, st) -> Quantity:
+        """x as a Quantity."""
+        raise NotImplementedError
+
+    def compute(self, st, names):
+        x = self.measure(st)
+        out = {self.variable: x.value[:, 0]}
+        if x.rate is not None:
+            out[f"D{self.variable}"] = x.rate[:, 0]
+        return out
+
+    def loads(self, st, damping):
+        """Q = −F ∂x/∂q; V = C1 x + C2 (x − C3)²/2; the damper dissipates C4 ẋ²."""
+        c1, c2, c3, c4 = constants(self.C)
+        x = self.measure(st)
+        value = x.value[:, 0]
+        force = c1 + c2 * (value - c3)
+        dissipation = None
+        if damping:
+            force = force + c4 * x.rate[:, 0]
+            dissipation = c4 * x.rate[:, 0] ** 2
+        return Load(_from_potential(x, force), {self.force: force},
+                    c1 * value + 0.5 * c2 * (value - c3) ** 2, dissipation)
+
+
 @dataclass(eq=False)
-class Spring(Element):
+class Spring(_SpringDamper):
     """F = C1 + C2 (ro − C3) + C4 Dro between two points, positive = attraction."""
 
     C: Any = (0.0, 0.0, 0.0, 0.0)
@@ -79,33 +112,12 @@ class Spring(Element):
         Var("Dro", "m/s", VELOCITY, "its rate"),
     )
 
-    def distance(self, st):
-        """ro = |Q − P|, as a Quantity."""
+    variable, force = "ro", "Força"
+
+    def measure(self, st):
+        """ro = |Q − P| (F > 0 attracts P and Q)."""
         P, Q = (st.point(r.solid, r.local) for r in self.refs)
         return (Q - P).norm()
-
-    def compute(self, st, names):
-        ro = self.distance(st)
-        out = {"ro": ro.value[:, 0]}
-        if ro.rate is not None:
-            out["Dro"] = ro.rate[:, 0]
-        return out
-
-    def loads(self, st, damping):
-        """F = C1 + C2 (ro − C3) + C4 Dro attracts P and Q: Q = −F ∂ro/∂q.
-
-        V = C1 ro + C2 (ro − C3)²/2; the damper dissipates C4 Dro².
-        """
-        c1, c2, c3, c4 = constants(self.C)
-        ro = self.distance(st)
-        r = ro.value[:, 0]
-        force = c1 + c2 * (r - c3)
-        dissipation = None
-        if damping:
-            force = force + c4 * ro.rate[:, 0]
-            dissipation = c4 * ro.rate[:, 0] ** 2
-        return Load(_from_potential(ro, force), {"Força": force},
-                    c1 * r + 0.5 * c2 * (r - c3) ** 2, dissipation)
 
     def build(self, ex):
         c1, c2, c3, c4 = constants(self.C)
@@ -116,7 +128,7 @@ class Spring(Element):
 
 
 @dataclass(eq=False)
-class TorsionalSpring(Element):
+class TorsionalSpring(_SpringDamper):
     """Parell = C1 + C2 (fi_rel − C3) + C4 Dfi_rel, fi_rel = fi2 − fi1."""
 
     C: Any = (0.0, 0.0, 0.0, 0.0)
@@ -133,32 +145,11 @@ class TorsionalSpring(Element):
         Var("Dfi_rel", "rad/s", VELOCITY, "its rate"),
     )
 
-    def relative_angle(self, st):
-        """fi_rel = fi2 − fi1, as a Quantity."""
+    variable, force = "fi_rel", "Parell"
+
+    def measure(self, st):
+        """fi_rel = fi2 − fi1 (Parell > 0 turns solid 1 counter-clockwise, solid 2 clockwise)."""
         return st.angle(self.ref2.solid) - st.angle(self.ref1.solid)
-
-    def compute(self, st, names):
-        rel = self.relative_angle(st)
-        out = {"fi_rel": rel.value[:, 0]}
-        if rel.rate is not None:
-            out["Dfi_rel"] = rel.rate[:, 0]
-        return out
-
-    def loads(self, st, damping):
-        """Parell on solid 1, −Parell on solid 2: Q = −Parell ∂fi_rel/∂q.
-
-        V = C1 fi_rel + C2 (fi_rel − C3)²/2; the damper dissipates C4 Dfi_rel².
-        """
-        c1, c2, c3, c4 = constants(self.C)
-        rel = self.relative_angle(st)
-        r = rel.value[:, 0]
-        parell = c1 + c2 * (r - c3)
-        dissipation = None
-        if damping:
-            parell = parell + c4 * rel.rate[:, 0]
-            dissipation = c4 * rel.rate[:, 0] ** 2
-        return Load(_from_potential(rel, parell), {"Parell": parell},
-                    c1 * r + 0.5 * c2 * (r - c3) ** 2, dissipation)
 
     def build(self, ex):
         c1, c2, c3, c4 = constants(self.C)

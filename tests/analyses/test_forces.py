@@ -209,7 +209,7 @@ def test_power_balance_check_detects_a_wrong_damper_force(monkeypatch):
         load = loads(self, st, damping)
         if damping:                 # remove the damper from the forces, keep its dissipation
             c4 = self.C[3]
-            ro = self.distance(st)
+            ro = self.measure(st)
             for s, block in ro.jac.items():
                 load.force[s] = load.force[s] + c4 * ro.rate[:, 0][:, None] * block[:, 0, :]
         return load
