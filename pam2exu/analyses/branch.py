@@ -269,7 +269,7 @@ def _warn_ill_conditioned(job: Job, q, singular, near=()) -> None:
     if mech.n_equations == 0:
         return
     # an SVD costs ~nq³: fewer samples for large mechanisms
-    samples = int(np.clip(2e5 / mech.nq ** 2, 10, CONDITION_SAMPLES))
+    samples = int(np.clip(2e7 / mech.nq ** 3, 1, CONDITION_SAMPLES))
     steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), samples)).astype(int),
                             np.asarray(near, dtype=int)[:samples]])
     steps = steps[~singular[steps]]

@@ -176,6 +176,10 @@ def multipliers(mech, st: State, rhs: np.ndarray, redundant: bool,
     Redundant constraints: of all solutions, the one whose reported reaction components
     R = B λ have the least sum of squares: R = (Cqᵀ B⁻¹)⁺ rhs, λ = B⁻¹ R.
     """
+    if not redundant and jacobian is None and mech.n_equations >= native.SPARSE_FROM:
+        lam = _sparse_multipliers(mech, st, rhs)
+        if lam is not None:
+            return lam
     if jacobian is None:
         jacobian = native.equations(mech, st).jacobian
     A = np.swapaxes(jacobian, 1, 2)                      # Cqᵀ, (n, nq, m)
@@ -185,6 +189,16 @@ def multipliers(mech, st: State, rhs: np.ndarray, redundant: bool,
     AB = np.swapaxes(np.linalg.solve(np.swapaxes(B, 1, 2), np.swapaxes(A, 1, 2)), 1, 2)
     R = np.einsum("nmq,nq->nm", np.linalg.pinv(AB, rcond=rcond), rhs)
     return np.linalg.solve(B, R[..., None])[..., 0]
+
+
+def _sparse_multipliers(mech, st: State, rhs: np.ndarray):
+    """λ with Cqᵀ λ = rhs for all states by one sparse LU (large mechanisms); None if singular."""
+    from scipy.sparse.linalg import splu
+    try:
+        lu = splu(native.sparse_jacobian(mech, st).T.tocsc())
+    except RuntimeError:
+        return None
+    return lu.solve(np.ascontiguousarray(rhs).ravel()).reshape(st.n, mech.n_equations)
 
 
 def equilibrium_residual(mech, st: State, lam: np.ndarray, rhs: np.ndarray,

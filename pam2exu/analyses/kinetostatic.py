@@ -31,7 +31,7 @@ def inverse_dynamics(job: Job, q, qd, qdd, redundant: bool) -> dict[str, np.ndar
     n = len(t)
     out: dict[str, np.ndarray] = {}
     energy, dissipation, external = np.zeros(n), np.zeros(n), np.zeros(n)
-    for s in native.chunks(mech, n):
+    for s in native.chunks(mech, n, sparse=mech.n_equations >= native.SPARSE_FROM):
         st = State(t[s], q[s], qd[s])
         applied = forces.applied_forces(mech, st, damping=True)
         inertia, kinetic = forces.inertia_forces(mech, st, qdd[s])

@@ -18,6 +18,12 @@ from ..laws import Law
 
 #: bytes of Jacobian kept in memory at once (steps are processed in chunks)
 CHUNK_BYTES = 64 * 2**20
+#: from this many constraint equations on, a chunk of steps is solved as one sparse,
+#: block-diagonal system (one LU for velocities and accelerations, cost linear in the
+#: mechanism's size) instead of dense batched solves (cost cubic in it)
+SPARSE_FROM = 40
+#: unknowns per sparse chunk
+SPARSE_CHUNK = 200_000
 
 
 @dataclass
@@ -57,10 +63,44 @@ def equations(mech, st: State, jacobian: bool = True) -> Equations:
     return Equations(residual, jac, c_t, gamma)
 
 
-def chunks(mech, n: int):
-    """Slices of the n steps, each small enough that its Jacobian fits in CHUNK_BYTES."""
-    size = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
+def chunks(mech, n: int, sparse: bool = False):
+    """Slices of the n steps, each small enough that its Jacobian fits in CHUNK_BYTES
+    (sparse: SPARSE_CHUNK unknowns)."""
+    if sparse:
+        size = max(1, SPARSE_CHUNK // max(1, mech.nq))
+    else:
+        size = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
     return (slice(a, min(n, a + size)) for a in range(0, n, size))
+
+
+def sparse_jacobian(mech, st: State):
+    """Cq of every state as one block-diagonal sparse matrix, (n·m, n·nq), CSR."""
+    from scipy.sparse import coo_matrix
+    n, m, nq = st.n, mech.n_equations, mech.nq
+    step = np.arange(n)[:, None, None]
+    rows, cols, data = [], [], []
+    for el, rr in zip(mech.constraints, mech.rows):
+        v, _ = el.constraint(st)
+        for solid, block in v.jac.items():                      # (n, d, 3)
+            r = step * m + rr.start + np.arange(block.shape[1])[None, :, None]
+            c = step * nq + 3 * solid + np.arange(3)[None, None, :]
+            rows.append(np.broadcast_to(r, block.shape).ravel())
+            cols.append(np.broadcast_to(c, block.shape).ravel())
+            data.append(block.ravel())
+    return coo_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(n * m, n * nq)).tocsr()
+
+
+def sparse_lu(J, rows, cols, n: int, m: int, nq: int):
+    """LU of the block-diagonal system restricted to ``rows`` and ``cols`` of every step;
+    None where it is singular."""
+    from scipy.sparse.linalg import splu
+    R = (np.arange(n)[:, None] * m + rows[None]).ravel()
+    C = (np.arange(n)[:, None] * nq + cols[None]).ravel()
+    try:
+        return splu(J[R][:, C].tocsc())
+    except RuntimeError:                           # exactly singular somewhere
+        return None
 
 
 def residuals(mech, t, q) -> np.ndarray:
@@ -143,15 +183,45 @@ def rates(mech, t, q, accelerations: bool, redundant: bool):
     qdd = np.zeros_like(q) if accelerations else None
     residual = np.empty((n, mech.n_equations))
     rows, cols = _moving(mech)
+    if not redundant and mech.n_equations >= SPARSE_FROM:
+        for s in chunks(mech, n, sparse=True):
+            if _sparse_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
+                             residual[s], rows, cols):
+                continue
+            _dense_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
+                         residual[s], rows, cols, redundant)
+        return qd, qdd, residual
     for s in chunks(mech, n):
-        eq = equations(mech, State(t[s], q[s]))
-        residual[s] = eq.residual
-        J = eq.jacobian[:, rows[:, None], cols]
-        qd[s, cols] = _solve(J, -eq.c_t[:, rows], redundant)
-        if accelerations:
-            gamma = equations(mech, State(t[s], q[s], qd[s]), jacobian=False).gamma
-            qdd[s, cols] = _solve(J, gamma[:, rows], redundant)
+        _dense_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
+                     residual[s], rows, cols, redundant)
     return qd, qdd, residual
+
+
+def _sparse_rates(mech, t, q, qd, qdd, residual, rows, cols) -> bool:
+    """Fill qd, qdd (views) of a chunk by one sparse LU; False if it is singular."""
+    st = State(t, q)
+    eq = equations(mech, st, jacobian=False)
+    residual[:] = eq.residual
+    n = st.n
+    lu = sparse_lu(sparse_jacobian(mech, st), rows, cols, n, mech.n_equations, mech.nq)
+    if lu is None:
+        return False
+    qd[:, cols] = lu.solve(np.ascontiguousarray(-eq.c_t[:, rows]).ravel()).reshape(n, -1)
+    if qdd is not None:
+        gamma = equations(mech, State(t, q, qd), jacobian=False).gamma
+        qdd[:, cols] = lu.solve(np.ascontiguousarray(gamma[:, rows]).ravel()).reshape(n, -1)
+    return True
+
+
+def _dense_rates(mech, t, q, qd, qdd, residual, rows, cols, redundant) -> None:
+    """Fill qd, qdd (views) of a chunk by batched dense solves."""
+    eq = equations(mech, State(t, q))
+    residual[:] = eq.residual
+    J = eq.jacobian[:, rows[:, None], cols]
+    qd[:, cols] = _solve(J, -eq.c_t[:, rows], redundant)
+    if qdd is not None:
+        gamma = equations(mech, State(t, q, qd), jacobian=False).gamma
+        qdd[:, cols] = _solve(J, gamma[:, rows], redundant)
 
 
 def _moving(mech):
