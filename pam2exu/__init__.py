@@ -8,6 +8,7 @@
 from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot, Prismatic,
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
 from .errors import (MobilityError, ModelError, Pam2ExuError, SolverError, TranslationError)
+from .export import export
 from .model import Law, Model, Solid, load, loads
 from .results.compare import compare
 
@@ -23,7 +24,7 @@ def run(model, analysis=None, **settings):
     return _run(model, analysis=analysis, **settings)
 
 
-__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "compare", "ELEMENTS", "Fixed",
-           "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor", "Spring",
+__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "compare", "export", "ELEMENTS",
+           "Fixed", "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor", "Spring",
            "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError", "ModelError",
            "MobilityError", "SolverError", "TranslationError"]

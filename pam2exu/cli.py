@@ -2,6 +2,8 @@
 
 Exit codes: 0 success, 1 solver failure, 2 model error (or bad command line).
 ``compare``: 0 every variable within the tolerance, 1 some outside, 2 bad input.
+``plot``, ``draw``, ``animate``: 2 also for a picture that cannot be made as asked (an
+unknown image format, no ffmpeg for .mp4, a variable that matches nothing).
 Errors are printed to stderr as one paragraph; ``--debug`` shows the traceback.
 """
 from __future__ import annotations
@@ -33,6 +35,10 @@ def _parser() -> argparse.ArgumentParser:
                      help="columns to keep: names, 'solid.*', '*.Fx' or bare 'Fx'")
     run.add_argument("-o", "--output", metavar="OUT.csv", help="write all rows as CSV")
     run.add_argument("--verbose", action="store_true", help="show Exudyn's solver output")
+    run.add_argument("--plot", nargs="+", metavar="VAR",
+                     help="plot these variables against t (names or patterns, as --outputs)")
+    run.add_argument("--plot-file", metavar="FIG.png",
+                     help="image file of --plot (default: <model>_plot.png)")
     run.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                      help=argparse.SUPPRESS)
 
@@ -65,7 +71,70 @@ def _parser() -> argparse.ArgumentParser:
                       help="interpolation of the result when the times differ (default cubic)")
     comp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                       help=argparse.SUPPRESS)
+
+    exp = sub.add_parser(
+        "export", help="write a standalone Exudyn script of the model (positions to CSV)",
+        description="Write a Python script that imports only exudyn and numpy, builds the "
+                    "model's Exudyn system (one commented block per solid and element), "
+                    "solves the positions over the [analysis] interval with Exudyn's static "
+                    "solver and writes x, y, fi of every solid as CSV. See docs/export.md.")
+    exp.add_argument("model", help="model file (TOML)")
+    exp.add_argument("-o", "--output", required=True, metavar="FILE.py",
+                     help="the script to write")
+    exp.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
+    exp.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
+    exp.add_argument("--forces", action="store_true",
+                     help="include masses, gravity, springs and loads (same positions)")
+    exp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                     help=argparse.SUPPRESS)
+
+    _picture_parsers(sub)
     return p
+
+
+def _picture_parsers(sub) -> None:
+    """plot, draw and animate (see docs/pictures.md)."""
+    plot = sub.add_parser(
+        "plot", help="plot variables of a result CSV against t (PNG, SVG, PDF)",
+        description="Plot variables of a result file against t, labelled with their PAM "
+                    "names and units; variables of one unit share a panel. Exit 2 for bad "
+                    "input. See docs/pictures.md.")
+    plot.add_argument("results", help="result CSV (pam2exu run MODEL -o FILE.csv)")
+    plot.add_argument("variables", nargs="+", metavar="VAR",
+                      help="names or patterns: crank.fi, 'crank.*', '*.Fx' or a bare Fx")
+    plot.add_argument("-o", "--output", metavar="FIG.png",
+                      help="image file, format from the suffix (default: <results>.png)")
+    plot.add_argument("--model", metavar="MODEL",
+                      help="the model, for the units of f(t) and Df(t) (rad or m)")
+    draw = sub.add_parser(
+        "draw", help="draw the mechanism at a configuration (PNG, SVG, PDF)",
+        description="Draw the solids and elements of a model: assembled at t = 0, or at "
+                    "time T of a kinematic run. See docs/pictures.md.")
+    draw.add_argument("model", help="model file (TOML)")
+    draw.add_argument("--t", type=float, default=0.0, metavar="T",
+                      help="time [s] (default 0: the assembly)")
+    draw.add_argument("-o", "--output", metavar="FIG.png",
+                      help="image file, format from the suffix (default: <model>.png)")
+    anim = sub.add_parser(
+        "animate", help="animate the model's kinematic run (GIF; MP4 with ffmpeg)",
+        description="An animation of the kinematic run over the model's interval, with the "
+                    "paths of traced points. A progress bar shows on a terminal. See "
+                    "docs/pictures.md.")
+    anim.add_argument("model", help="model file (TOML)")
+    anim.add_argument("-o", "--output", metavar="ANIM.gif",
+                      help="animation file: .gif, or .mp4 when ffmpeg is installed "
+                           "(default: <model>.gif)")
+    anim.add_argument("--steps", type=int, metavar="N",
+                      help="number of intervals: N + 1 frames (default: the model's steps, "
+                           "at most 100)")
+    anim.add_argument("--t-end", type=float, metavar="T", help="end of the motion [s]")
+    anim.add_argument("--trace", nargs="+", metavar="SOLID.POINT", default=(),
+                      help="points whose paths are drawn (coupler curves)")
+    anim.add_argument("--fps", type=float, help="frames per second (default: real time, "
+                                                 "2 to 30)")
+    for p in (plot, draw, anim):
+        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                       help=argparse.SUPPRESS)
 
 
 def _run(args) -> int:
@@ -74,16 +143,35 @@ def _run(args) -> int:
     solver = SolveSettings(verbose=1 if args.verbose else 0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # warnings are carried in res.warnings
+        outputs = args.outputs
+        if outputs and args.plot:
+            outputs = [*outputs, *args.plot]      # the plotted variables are computed too
         res = run(args.model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
-                  outputs=args.outputs, solver=solver)
+                  outputs=outputs, solver=solver)
+    table = res.select(args.outputs) if args.outputs and args.plot else res
     if args.output:
-        path = res.to_csv(args.output)
-        print(f"wrote {len(res)} rows × {len(res.columns) + 1} columns to {path}")
+        path = table.to_csv(args.output)
+        print(f"wrote {len(table)} rows × {len(table.columns) + 1} columns to {path}")
         for w in res.warnings:
             print(f"warning: {w}", file=sys.stderr)
     else:
-        print(res.summary())
+        print(table.summary())
+    if args.plot:
+        return _run_plot(args, res)
     return 0
+
+
+def _run_plot(args, res) -> int:
+    """``run --plot``: the plot of the run's variables, units from the run."""
+    from pathlib import Path
+
+    from .results.plot import plot
+    out = args.plot_file or f"{Path(args.model).stem}_plot.png"
+
+    def make():
+        plot(res, args.plot, out)
+        return out
+    return _picture("plot", make, args.debug)
 
 
 def _check(args) -> int:
@@ -134,10 +222,69 @@ def _compare(args) -> int:
     return 0 if table.passed else 1
 
 
+def _picture(kind: str, make, debug: bool = False) -> int:
+    """Run ``make()``; bad input for a picture (PictureError, unreadable CSV) exits 2."""
+    from .results.compare import CompareInputError
+    from .results.plot import PictureError
+    try:
+        path = make()
+    except (PictureError, CompareInputError) as exc:
+        if debug:
+            raise
+        print(f"pam2exu: {kind}: {exc}", file=sys.stderr)
+        return 2
+    print(f"wrote {path}")
+    return 0
+
+
+def _plot(args) -> int:
+    from pathlib import Path
+
+    from .results.plot import plot
+    out = args.output or Path(args.results).with_suffix(".png").name
+
+    def make():
+        plot(args.results, args.variables, out, model=args.model)
+        return out
+    return _picture("plot", make, args.debug)
+
+
+def _draw(args) -> int:
+    from pathlib import Path
+
+    from .pictures import draw
+    out = args.output or Path(args.model).with_suffix(".png").name
+
+    def make():
+        draw(args.model, t=args.t, path=out)
+        return out
+    return _picture("draw", make, args.debug)
+
+
+def _animate(args) -> int:
+    from pathlib import Path
+
+    from .pictures import animate
+    out = args.output or Path(args.model).with_suffix(".gif").name
+    return _picture("animate", lambda: animate(args.model, out, steps=args.steps,
+                                               t_end=args.t_end, trace=args.trace,
+                                               fps=args.fps), args.debug)
+
+
+def _export(args) -> int:
+    from .export import export
+    path = export(args.model, args.output, t_end=args.t_end, steps=args.steps,
+                  forces=args.forces)
+    print(f"wrote {path}; run it with: python {path} [OUT.csv]")
+    return 0
+
+
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"run": _run, "check": _check, "compare": _compare}[args.command](args)
+        return {"run": _run, "check": _check, "compare": _compare,
+                "export": _export, "plot": _plot, "draw": _draw,
+                "animate": _animate}[args.command](args)
     except BrokenPipeError:              # output piped into head & co.
         sys.stderr.close()
         return 0

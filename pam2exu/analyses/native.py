@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import MobilityError, Problem
 from ..kinematics import State
 from ..laws import Law
+from ..progress import Progress
 
 #: bytes of Jacobian kept in memory at once (steps are processed in chunks)
 CHUNK_BYTES = 64 * 2**20
@@ -183,17 +184,17 @@ def rates(mech, t, q, accelerations: bool, redundant: bool):
     qdd = np.zeros_like(q) if accelerations else None
     residual = np.empty((n, mech.n_equations))
     rows, cols = _moving(mech)
-    if not redundant and mech.n_equations >= SPARSE_FROM:
-        for s in chunks(mech, n, sparse=True):
-            if _sparse_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
-                             residual[s], rows, cols):
-                continue
-            _dense_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
-                         residual[s], rows, cols, redundant)
-        return qd, qdd, residual
-    for s in chunks(mech, n):
-        _dense_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
-                     residual[s], rows, cols, redundant)
+    sparse = not redundant and mech.n_equations >= SPARSE_FROM
+    parts = list(chunks(mech, n, sparse=sparse))
+    # a bar on a terminal when the pass takes several chunks (one chunk: over in a blink)
+    with Progress(len(parts), "velocities and accelerations") as bar:
+        for done, s in enumerate(parts, start=1):
+            if not (sparse and _sparse_rates(mech, t[s], q[s], qd[s],
+                                             qdd[s] if accelerations else None,
+                                             residual[s], rows, cols)):
+                _dense_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
+                             residual[s], rows, cols, redundant)
+            bar.update(done)
     return qd, qdd, residual
 
 

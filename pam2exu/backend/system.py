@@ -5,6 +5,10 @@ x, y, fi, so node coordinates read PAM's values) with an ``ObjectRigidBody2D``. 
 element adds its own items through ``Element.build(system)``, using the helpers below.
 Positions over time come from Exudyn's static solver, one load step per time step;
 actuators follow their laws through a pre-step function.
+
+The same construction also writes a standalone script (``backend.script.ScriptSystem``):
+items are created only through ``self.mbs`` and ``self.items``, and ``begin`` marks where
+the items of each solid and element start.
 """
 from __future__ import annotations
 
@@ -47,6 +51,32 @@ class SolveSettings:
     verbose: int = 0
 
 
+def solver_options(mech, settings: SolveSettings, redundant: bool,
+                   roundoff: float = 0.0) -> dict:
+    """The SimulationSettings that differ from Exudyn's defaults, {dotted path: value}.
+
+    roundoff: the residual floor of ``ExudynSystem.roundoff`` (a lower bound of the
+    absolute tolerance).
+    """
+    dense = settings.dense if settings.dense is not None else mech.nq <= DENSE_UP_TO
+    options = {
+        "solution.file.write": False,
+        "solution.sensors.writePeriod": 0.0,
+        "staticSolver.useLoadFactor": False,       # loads in full at every step, no ramp
+        "staticSolver.verboseMode": settings.verbose,
+        "staticSolver.newton.absoluteTolerance": max(settings.tolerance * mech.scale(),
+                                                     roundoff),
+        "staticSolver.newton.relativeTolerance": settings.tolerance,
+        "staticSolver.newton.maxIterations": settings.max_iterations,
+    }
+    if redundant:
+        dense = True
+        options["linearSolver.ignoreSingularJacobian"] = True
+    options["linearSolver.solverType"] = (exu.LinearSolverType.EigenDense if dense
+                                          else exu.LinearSolverType.EigenSparse)
+    return options
+
+
 class ExudynSystem:
     """The Exudyn system of one mechanism for one analysis.
 
@@ -73,8 +103,8 @@ class ExudynSystem:
         exu.config.printToConsole = False
         self.mech = mech
         self.forces, self.velocity_forces = forces, velocity_forces
-        self.SC = exu.SystemContainer()
-        self.mbs = mbs = self.SC.AddSystem()
+        self.mbs = mbs = self.new_system()
+        items = self.items
         # constraints-only systems model a solid held by a fixed link as Exudyn ground at
         # its pose: fewer coordinates and equations (the fixed link's reaction is not
         # needed from Exudyn then)
@@ -83,6 +113,7 @@ class ExudynSystem:
         self.nodes, self.bodies = [], []
         self.start = mech.initial_q() if start is None else np.asarray(start, dtype=float)
         for i, s in enumerate(mech.solids):
+            self.begin(s)
             x, y, fi = (float(v) for v in self.start[3 * i:3 * i + 3])
             if i in self.grounded:
                 c, sn = np.cos(fi), np.sin(fi)
@@ -105,9 +136,11 @@ class ExudynSystem:
         self.drivers: list = []          # (object, parameter, law)
         self.objects: dict[str, list] = {el.name: [] for el in mech.elements}
         for el in mech.elements:
-            if (el.equations or forces) and not (el.grounds and el.ref1.solid in self.grounded):
+            self.begin(el)
+            if self.builds(el):
                 el.build(self)
         if forces and mech.gravity:
+            self.begin("gravity")
             for s, body in zip(mech.solids, self.bodies):
                 if float(s.mass) > 0:
                     marker = mbs.AddMarker(items.MarkerBodyMass(bodyNumber=body))
@@ -122,11 +155,27 @@ class ExudynSystem:
                         markerNumbers=[self.ground_coordinate(), self.coordinate_marker(i, k)],
                         stiffness=anchor_stiffness * (L2 if k == 2 else 1.0),
                         offset=float(q0[3 * i + k])))
+        self.begin("sensors")
         self.sensors = {i: mbs.AddSensor(items.SensorNode(
             nodeNumber=n, storeInternal=True, writeToFile=False,
             outputVariableType=exu.OutputVariableType.Coordinates))
             for i, n in enumerate(self.nodes) if n is not None}
         mbs.Assemble()
+
+    def new_system(self):
+        """The Exudyn MainSystem the items go into."""
+        self.SC = exu.SystemContainer()
+        return self.SC.AddSystem()
+
+    def begin(self, owner) -> None:
+        """Called before the items of each solid and element (and of "gravity" and the
+        "sensors") are added; the script exporter writes a comment there."""
+
+    def builds(self, element) -> bool:
+        """Whether the element adds Exudyn items to this system: force elements only to
+        force systems, and a fixed link not when its solid is modelled as ground."""
+        return bool(element.equations or self.forces) and not (
+            element.grounds and element.ref1.solid in self.grounded)
 
     # ---- helpers for Element.build ---------------------------------------------------------
     def add(self, element, item, kind: str = "object"):
@@ -140,7 +189,7 @@ class ExudynSystem:
         local = getattr(ref, "local", getattr(ref, "point", (0.0, 0.0)))
         key = ("point", ref.solid, tuple(local))
         if key not in self._markers:
-            self._markers[key] = self.mbs.AddMarker(items.MarkerBodyRigid(
+            self._markers[key] = self.mbs.AddMarker(self.items.MarkerBodyRigid(
                 bodyNumber=self.bodies[ref.solid], localPosition=[local[0], local[1], 0.0]))
         return self._markers[key]
 
@@ -153,7 +202,7 @@ class ExudynSystem:
             return self.ground_coordinate()
         key = ("coordinate", solid, k)
         if key not in self._markers:
-            self._markers[key] = self.mbs.AddMarker(items.MarkerNodeCoordinate(
+            self._markers[key] = self.mbs.AddMarker(self.items.MarkerNodeCoordinate(
                 nodeNumber=self.nodes[solid], coordinate=k))
         return self._markers[key]
 
@@ -167,17 +216,17 @@ class ExudynSystem:
     def ground_coordinate(self):
         """A coordinate marker on a ground node (value 0)."""
         if self._ground is None:
-            node = self.mbs.AddNode(items.NodePointGround())
-            self._ground = self.mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=node,
-                                                                         coordinate=0))
+            node = self.mbs.AddNode(self.items.NodePointGround())
+            self._ground = self.mbs.AddMarker(self.items.MarkerNodeCoordinate(
+                nodeNumber=node, coordinate=0))
         return self._ground
 
     def relative_rotation_marker(self, reference: int, solid: int):
         """fi_solid − fi_reference, continued past ±π by a NodeGenericData."""
         fi0, fi1 = self.start[3 * reference + 2], self.start[3 * solid + 2]
-        data = self.mbs.AddNode(items.NodeGenericData(
+        data = self.mbs.AddNode(self.items.NodeGenericData(
             numberOfDataCoordinates=1, initialCoordinates=[float(fi1 - fi0)]))
-        return self.mbs.AddMarker(items.MarkerBodiesRelativeRotationCoordinate(
+        return self.mbs.AddMarker(self.items.MarkerBodiesRelativeRotationCoordinate(
             bodyNumbers=[self.bodies[reference], self.bodies[solid]], nodeNumber=data,
             axis0=[0.0, 0.0, 1.0]))
 
@@ -207,7 +256,7 @@ class ExudynSystem:
                 k += 3
         return q
 
-    def roundoff(self, tables) -> float:
+    def roundoff(self, times) -> float:
         """The residual below which Newton cannot go: 16 ulps of the largest equation term.
 
         Angles are never wrapped, so the angle equations (actuators, transmissions) add up
@@ -219,26 +268,20 @@ class ExudynSystem:
         gain = max([1.0, *(float(np.max(np.abs(block[..., 2])))
                            for el in self.mech.constraints
                            for block in el.constraint(st)[0].jac.values())])
-        size = max([1.0, *np.abs(q0), *(float(np.max(np.abs(v))) for *_, v in tables)])
+        size = max([1.0, *np.abs(q0), *(float(np.max(np.abs(law(times)[0] + shift)))
+                                        for *_, law, shift in self.drivers)])
         return 16.0 * np.finfo(float).eps * size * gain
 
     def simulation_settings(self, settings: SolveSettings, redundant: bool,
                             roundoff: float = 0.0):
+        """Exudyn's SimulationSettings with ``solver_options`` applied."""
         ss = exu.SimulationSettings()
-        ss.solution.file.write = False
-        ss.solution.sensors.writePeriod = 0.0
-        ss.staticSolver.useLoadFactor = False      # loads in full at every step, no ramp
-        ss.staticSolver.verboseMode = settings.verbose
-        newton = ss.staticSolver.newton
-        newton.absoluteTolerance = max(settings.tolerance * self.mech.scale(), roundoff)
-        newton.relativeTolerance = settings.tolerance
-        newton.maxIterations = settings.max_iterations
-        dense = settings.dense if settings.dense is not None else self.mech.nq <= DENSE_UP_TO
-        if redundant:
-            dense = True
-            ss.linearSolver.ignoreSingularJacobian = True
-        ss.linearSolver.solverType = (exu.LinearSolverType.EigenDense if dense
-                                      else exu.LinearSolverType.EigenSparse)
+        for path, value in solver_options(self.mech, settings, redundant, roundoff).items():
+            *parents, leaf = path.split(".")
+            target = ss
+            for name in parents:
+                target = getattr(target, name)
+            setattr(target, leaf, value)
         return ss
 
     def solve_positions(self, times: np.ndarray, settings: SolveSettings | None = None,
@@ -306,7 +349,7 @@ class ExudynSystem:
                 return True
 
             mbs.SetPostStepUserFunction(post_step)
-        ss = self.simulation_settings(settings, redundant, self.roundoff(tables))
+        ss = self.simulation_settings(settings, redundant, self.roundoff(times))
         ss.staticSolver.numberOfLoadSteps = n
         ss.staticSolver.loadStepStart = k0 * dt
         ss.staticSolver.loadStepDuration = n * dt

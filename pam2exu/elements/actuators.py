@@ -46,6 +46,10 @@ class AngularActuator(Actuator):
             offset=self.time_law().value(0.0) + shift))
         ex.drive(obj, "offset", self.time_law(), shift)
 
+    def draw(self, pen, st):
+        """An arc arrow about solid 2's origin."""
+        pen.rotation(st.point(self.ref2.solid, (0.0, 0.0)).value[0])
+
 
 @dataclass(eq=False)
 class LinearActuator(Actuator):
@@ -84,3 +88,7 @@ class LinearActuator(Actuator):
             markerNumbers=[ex.point_marker(self.ref1), ex.point_marker(self.ref2)],
             distance=law.value(0.0)))
         ex.drive(obj, "distance", law)
+
+    def draw(self, pen, st):
+        """A thick bar from P to Q."""
+        pen.cylinder(*(st.point(r.solid, r.local).value[0] for r in self.refs))

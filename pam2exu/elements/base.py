@@ -3,8 +3,10 @@
 An element class is the one place where everything about a PAM element lives:
 the keys it takes (checked by the model's validation), the constraint equations it
 adds (used by the native velocity and acceleration pass), the Exudyn items it becomes
-(``build``) and the output variables it reports under PAM's names (``outputs``).
-Nothing here imports Exudyn: ``build`` receives the backend's system builder.
+(``build``), the output variables it reports under PAM's names (``outputs``) and its
+symbol in a drawing (``draw``).
+Nothing here imports Exudyn or matplotlib: ``build`` receives the backend's system
+builder, ``draw`` a pen (``pictures.pen.Pen``).
 """
 from __future__ import annotations
 
@@ -234,8 +236,19 @@ class Element:
 
     # ---- Exudyn ------------------------------------------------------------------------
     def build(self, ex) -> None:
-        """Add this element's Exudyn items to ``ex`` (a backend.system.ExudynSystem)."""
+        """Add this element's Exudyn items to ``ex`` (a backend.system.ExudynSystem).
+
+        Talk to Exudyn only through ``ex`` (``ex.items``, ``ex.add``, the marker helpers,
+        ``ex.drive``), with keyword arguments: the same method then writes the element's
+        block of an exported script (``backend.script.ScriptSystem``, ``pam2exu export``).
+        """
         raise NotImplementedError
+
+    # ---- pictures ----------------------------------------------------------------------
+    def draw(self, pen, st: State) -> None:
+        """Draw the element's symbol with ``pen`` (a ``pictures.pen.Pen``) at the one
+        configuration of ``st``: the element says what and where, the pen how it looks
+        (as ``build`` says which Exudyn items, and the backend how to add them)."""
 
 
 class Actuator(Element):

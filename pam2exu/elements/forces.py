@@ -61,6 +61,19 @@ class Torsor(Element):
             ex.add(self, ex.items.LoadTorqueVector(markerNumber=marker, loadVector=[0.0, 0.0, m],
                                                    bodyFixed=solid_axes), kind="load")
 
+    def draw(self, pen, st):
+        """An arrow along the force at its point, an arc arrow for the moment."""
+        fx, fy, m = constants(self.C, 3)
+        solid, local = self.ref1.solid, self.ref1.local
+        p = st.point(solid, local).value[0]
+        force = np.array([fx, fy])
+        if self.axes == "solid":
+            force = rotate(st.q[:, 3 * solid + 2], force)[0]
+        if fx or fy:
+            pen.force(p, force)
+        if m:
+            pen.moment(p, m)
+
 
 class _SpringDamper(Element):
     """A spring-damper on a scalar measure x (a distance, a relative angle):
@@ -126,6 +139,10 @@ class Spring(_SpringDamper):
             referenceLength=c3, stiffness=c2, damping=c4 if ex.velocity_forces else 0.0,
             force=c1))
 
+    def draw(self, pen, st):
+        """A zigzag between the two points."""
+        pen.zigzag(*(st.point(r.solid, r.local).value[0] for r in self.refs))
+
 
 @dataclass(eq=False)
 class TorsionalSpring(_SpringDamper):
@@ -162,3 +179,7 @@ class TorsionalSpring(_SpringDamper):
                 ex.add(self, ex.items.LoadTorqueVector(
                     markerNumber=ex.point_marker(ref), loadVector=[0.0, 0.0, sign * c1]),
                     kind="load")
+
+    def draw(self, pen, st):
+        """A spiral about solid 2's origin."""
+        pen.spiral(st.point(self.ref2.solid, (0.0, 0.0)).value[0])

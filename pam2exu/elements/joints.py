@@ -47,6 +47,10 @@ class Fixed(Element):
                 markerNumbers=[ground, ex.coordinate_marker(self.ref1.solid, k)],
                 offset=float(self.pose[k])))
 
+    def draw(self, pen, st):
+        """A ground line under the held solid's origin."""
+        pen.ground(st.point(self.ref1.solid, (0.0, 0.0)).value[0])
+
 
 @dataclass(eq=False)
 class Revolute(Element):
@@ -75,6 +79,10 @@ class Revolute(Element):
     def build(self, ex):
         ex.add(self, ex.items.ObjectJointRevolute2D(
             markerNumbers=[ex.point_marker(self.ref1), ex.point_marker(self.ref2)]))
+
+    def draw(self, pen, st):
+        """A pin joint at solid 2's point (on a support when it holds a solid to ground)."""
+        pen.joint(st.point(self.ref2.solid, self.ref2.local).value[0], self.solids)
 
 
 def _on_line(st, guide, pin_solid, pin_local):
@@ -121,6 +129,14 @@ class Prismatic(Element):
             axisMarker0=[*line2.direction, 0.0], normalMarker1=[*line1.normal, 0.0],
             constrainRotation=True))
 
+    def draw(self, pen, st):
+        """Line 1 as a guide, a slider block on solid 2's defining point along line 2."""
+        line1, line2 = self.refs
+        p2 = st.point(line2.solid, line2.point).value[0]
+        pen.guide(st.point(line1.solid, line1.point).value[0],
+                  st.direction(line1.solid, line1.direction).value[0], p2, line1.solid)
+        pen.block(p2, st.direction(line2.solid, line2.direction).value[0], line2.solid)
+
 
 @dataclass(eq=False)
 class PinSlot(Element):
@@ -152,6 +168,14 @@ class PinSlot(Element):
             markerNumbers=[ex.point_marker(pin), ex.point_marker(guide)],
             axisMarker0=[*guide.direction, 0.0], normalMarker1=[*guide.normal, 0.0],
             constrainRotation=False))
+
+    def draw(self, pen, st):
+        """The guide line, the pin on it."""
+        guide, pin = self.refs
+        p = st.point(pin.solid, pin.local).value[0]
+        pen.guide(st.point(guide.solid, guide.point).value[0],
+                  st.direction(guide.solid, guide.direction).value[0], p, guide.solid)
+        pen.pin(p)
 
 
 @dataclass(eq=False)
@@ -224,3 +248,8 @@ class Transmission(Element):
         rel1 = ex.relative_rotation_marker(self.arm_solid, self.ref1.solid)
         ex.add(self, ex.items.ObjectConnectorCoordinate(
             markerNumbers=[rel2, rel1], factor1=self.ratio, offset=-self.offset))
+
+    def draw(self, pen, st):
+        """Pitch circles about the two solids' origins, radii in the ratio |T|."""
+        o1, o2 = (st.point(r.solid, (0.0, 0.0)).value[0] for r in self.refs)
+        pen.gears(o1, o2, self.ratio, (self.ref1.solid, self.ref2.solid))

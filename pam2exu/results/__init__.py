@@ -1,6 +1,7 @@
-"""Results: the table of named columns, CSV, selection of outputs, comparison."""
+"""Results: the table of named columns, CSV, selection of outputs, comparison, plots."""
 from .compare import CompareInputError, Comparison, VariableComparison, compare, read_names
-from .table import Results, select_columns
+from .plot import plot
+from .table import Results, read_csv, select_columns
 
-__all__ = ["Results", "select_columns", "compare", "Comparison", "VariableComparison",
-           "CompareInputError", "read_names"]
+__all__ = ["Results", "select_columns", "read_csv", "plot", "compare", "Comparison",
+           "VariableComparison", "CompareInputError", "read_names"]

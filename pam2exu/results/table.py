@@ -147,3 +147,23 @@ def select_columns(columns: list[str], patterns) -> list[str]:
     if problems:
         raise ModelError(problems)
     return [c for c in columns if c in chosen]
+
+
+def read_csv(path: str | Path, model=None) -> Results:
+    """A result CSV file as a Results table, with units from the output declarations.
+
+    Reads what ``pam2exu compare`` reads: ``Results.to_csv`` files and PAM-style exports
+    (',' or ';' separated, decimal comma with ';', PAM spellings such as ``Forca``).
+    ``model`` (a Model or a model file) gives the units of ``f(t)`` and ``Df(t)``, which
+    depend on the actuator type (see ``units.unit_of``). Raises CompareInputError for a
+    missing or unreadable file.
+    """
+    from ..model import Model, load
+    from .compare import _load
+    from .units import unit_of
+    if model is not None and not isinstance(model, Model):
+        model = load(model)
+    table = _load(path, "results", {})
+    units = {name: unit_of(name, model) for name in table.names}
+    return Results(table.t, dict(zip(table.names, table.values)), units,
+                   model=Path(path).stem if model is None else model.name)

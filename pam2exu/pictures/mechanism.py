@@ -1,0 +1,311 @@
+"""Pictures of a mechanism: one configuration (``draw``) or its motion (``animate``).
+
+The configurations come from the analyses: the assembly at t = 0, or the positions of a
+kinematic run (Exudyn's static solver, on the branch the mechanism starts on). Each solid is
+drawn by ``Pen.solid``, each element by its own ``draw`` method (``pam2exu/elements/``), the
+symbols themselves by ``Pen`` (``pen.py``). Figures use the Agg canvas, never a window.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError, Problem
+from ..kinematics import State
+from ..progress import Progress
+from ..results.plot import DPI, PictureError, figure, save
+from .pen import PALETTE, Pen
+
+#: figure sizes [in]: a drawing, an animation (smaller: every frame is stored)
+DRAW_SIZE = (8.0, 6.0)
+ANIMATION_SIZE = (6.4, 4.8)
+#: margin around the box the mechanism moves in, fraction of its larger side
+MARGIN = 0.12
+#: room the axis labels and the title take from the figure [in] (width, height)
+LABEL_ROOM = np.array([0.9, 0.9])
+#: frames per second of an animation are steps / t_end (real time), within these bounds
+FPS = (2.0, 30.0)
+#: most frames of an animation by default (the model's steps, up to this)
+FRAMES = 100
+#: coordinates asked of a kinematic run (a velocity makes it follow the branch)
+_POSE = ("*.x", "*.y", "*.fi", "*.Dfi")
+
+
+def _model(model):
+    from ..model import Model, load
+    return model if isinstance(model, Model) else load(model)
+
+
+def configurations(model, t_end: float | None = None, steps: int | None = None,
+                   analysis: str = "kinematic") -> tuple[object, np.ndarray, np.ndarray]:
+    """(mechanism, t (n,), q (n, 3·solids)) of a run: the assembly (one row at t = 0), or
+    the positions of a kinematic run over [0, t_end] in ``steps`` intervals."""
+    from ..analyses import run
+    model = _model(model)
+    mech = model.mechanism()
+    if analysis == "assembly":
+        res = run(model, analysis="assembly")
+    else:
+        res = run(model, analysis="kinematic", t_end=t_end, steps=steps, outputs=list(_POSE))
+    q = np.column_stack([res[f"{s.name}.{k}"] for s in mech.solids for k in ("x", "y", "fi")])
+    return mech, np.array(res.t), q
+
+
+def pose(model, t: float = 0.0):
+    """(mechanism, q) at time t: the assembly at t = 0, else a kinematic run from 0 to t
+    with the model's step length."""
+    model = _model(model)
+    if not t:
+        mech, _, q = configurations(model, analysis="assembly")
+        return mech, q[0]
+    a = model.analysis
+    if not (isinstance(t, (int, float)) and math.isfinite(t) and t > 0):
+        raise PictureError(f"the time of a drawing must be a number ≥ 0 [s], not {t!r}")
+    steps = max(1, math.ceil(a.steps * t / a.t_end - 1e-9))
+    mech, _, q = configurations(model, t_end=float(t), steps=steps)
+    return mech, q[-1]
+
+
+class Scene:
+    """A mechanism on an Axes: fixed limits (the box it moves in), the global frame, and
+    ``show(t, q)`` to draw one configuration (removing the previous one).
+
+    ``extra`` points (n, 2) widen the box (traced paths).
+    """
+
+    def __init__(self, ax, mech, q_all: np.ndarray, extra=()):
+        self.ax, self.mech = ax, mech
+        self.locals = [np.array([[float(v) for v in p] for p in s.points.values()]
+                                if s.points else np.zeros((0, 2))) for s in mech.solids]
+        lo, hi = self._box(q_all, extra)
+        self.size = float(max(hi - lo)) or 1.0
+        grounded = {el.ref1.solid for el in mech.elements if el.grounds}
+        moving = [i for i in range(len(mech.solids)) if i not in grounded]
+        colors = {i: PALETTE[k % len(PALETTE)] for k, i in enumerate(moving)}
+        self.pen = Pen(ax, self.size, grounded, colors)
+        # the box with a margin, widened to the shape of the axes (the figure less room
+        # for the labels and the title), then equal scales by shrinking the axes a little
+        lo, hi = lo - MARGIN * self.size, hi + MARGIN * self.size
+        width, height = ax.figure.get_size_inches() - LABEL_ROOM
+        centre, half = (lo + hi) / 2, (hi - lo) / 2
+        half = np.maximum(half, half[::-1] * np.array([width / height, height / width]))
+        ax.set_xlim(centre[0] - half[0], centre[0] + half[0])
+        ax.set_ylim(centre[1] - half[1], centre[1] + half[1])
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_autoscale_on(False)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.grid(True, alpha=0.2)
+        with self.pen.owner("frame"):
+            self.pen.frame()
+        self.pen.artists = []                  # the frame stays from frame to frame
+
+    def _box(self, q_all, extra):
+        """Lower-left and upper-right corners of everything drawn, over every row of q."""
+        st = State(np.zeros(len(q_all)), q_all)
+        pts = [np.zeros((1, 2))]
+        for i, local in enumerate(self.locals):
+            pts.append(st.point(i, (0.0, 0.0)).value)
+            for p in local:
+                pts.append(st.point(i, p).value)
+        for el in self.mech.elements:          # line points, anchors given as bare solids
+            for ref in getattr(el, "refs", ()):
+                local = getattr(ref, "local", getattr(ref, "point", (0.0, 0.0)))
+                pts.append(st.point(ref.solid, local).value)
+        if len(extra):
+            pts.append(np.asarray(extra, dtype=float).reshape(-1, 2))
+        pts = np.vstack(pts)
+        pts = pts[np.isfinite(pts).all(axis=1)]
+        return pts.min(axis=0), pts.max(axis=0)
+
+    def show(self, t: float, q: np.ndarray) -> None:
+        """Draw the configuration q (3·solids,) at time t."""
+        self.pen.clear()
+        st = State([t], np.asarray(q, dtype=float)[None, :])
+        pen = self.pen
+        for i, s in enumerate(self.mech.solids):
+            origin = st.point(i, (0.0, 0.0)).value[0]
+            points = np.array([st.point(i, p).value[0] for p in self.locals[i]]) \
+                if len(self.locals[i]) else np.zeros((0, 2))
+            with pen.owner(f"solid:{s.name}"):
+                pen.solid(i, s.name, points, origin)
+        for el in self.mech.elements:
+            with pen.owner(f"{el.type}:{el.name}"):
+                el.draw(pen, st)
+
+
+def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI,
+         size: tuple[float, float] = DRAW_SIZE):
+    """Draw the mechanism at time t; returns the matplotlib Figure.
+
+    Parameters
+    ----------
+    model : Model or path
+    t : float
+        0 (default): the assembled configuration at t = 0; else the positions of a
+        kinematic run from 0 to t [s] (with the model's step length).
+    path : str or Path, optional
+        Image file to write (.png, .svg, .pdf, …).
+    dpi, size : resolution and size [in] of the figure (``size`` × ``dpi`` pixels).
+    """
+    model = _model(model)
+    mech, q = pose(model, t)
+    fig = figure(*size, dpi)
+    ax = fig.add_subplot()
+    scene = Scene(ax, mech, q[None, :])
+    scene.show(t, q)
+    when = f"t = {t:g} s (kinematic run)" if t else "assembled at t = 0"
+    ax.set_title(f"'{mech.name}' — {when}")
+    if path is not None:
+        save(fig, path)
+    return fig
+
+
+def _traces(mech, names) -> list[tuple[str, int, tuple[float, float]]]:
+    """(name, solid, local point) of each ``solid.point`` to trace; ModelError naming every
+    one that does not exist."""
+    from ..model.solid import Scope
+    scope, out, problems = Scope(mech.solids), [], []
+    for name in names or ():
+        try:
+            ref = scope.point(name)
+        except LookupError as exc:
+            problems.append(Problem(f"trace '{name}'", f"{exc}; give a point as solid.point "
+                                                       "(or a solid's name for its origin)"))
+            continue
+        out.append((name, ref.solid, ref.local))
+    if problems:
+        raise ModelError(problems, mech.model.source)
+    return out
+
+
+def _writer(path: Path, fps: float):
+    """None for .gif (written by ``_write_gif``, Pillow); matplotlib's ffmpeg writer for
+    .mp4 when ffmpeg is installed."""
+    from matplotlib import animation
+    suffix = path.suffix.lower()
+    if suffix == ".gif":
+        return None
+    if suffix == ".mp4":
+        if not animation.writers.is_available("ffmpeg"):
+            raise PictureError(f"cannot write '{path}': MP4 needs ffmpeg, which is not "
+                               "installed (or not on PATH); write a .gif instead")
+        return animation.FFMpegWriter(fps=fps)
+    raise PictureError(f"cannot write '{path}': an animation is a .gif file (or .mp4 "
+                       "when ffmpeg is installed)")
+
+
+def animate(model, path: str | Path, steps: int | None = None, t_end: float | None = None,
+            trace=(), fps: float | None = None, dpi: float = DPI,
+            size: tuple[float, float] = ANIMATION_SIZE) -> Path:
+    """Write an animation of the model's kinematic run; returns the path.
+
+    Parameters
+    ----------
+    model : Model or path
+    path : str or Path
+        ``.gif`` (Pillow), or ``.mp4`` when ffmpeg is installed.
+    steps : int, optional
+        Number of intervals: steps + 1 frames (default: the model's steps, at most
+        ``FRAMES``).
+    t_end : float, optional
+        End of the motion [s] (default: the model's t_end).
+    trace : list of str
+        Points whose paths are drawn (``coupler.P``): the whole path faintly, the part
+        travelled so far in full.
+    fps : float, optional
+        Frames per second; default steps / t_end (real time) within ``FPS``.
+    dpi, size : resolution and size [in] of each frame.
+
+    A progress bar shows on stderr while the frames are written, when it is a terminal.
+    """
+    path = Path(path)
+    model = _model(model)
+    a = model.analysis
+    steps = int(steps or min(a.steps, FRAMES))
+    t_end = float(t_end or a.t_end)
+    fps = float(fps or min(max(steps / t_end, FPS[0]), FPS[1]))
+    writer = _writer(path, fps)                 # fail before the run, not after it
+    mech = model.mechanism()
+    traced = _traces(mech, trace)
+    mech, t, q = configurations(model, t_end=t_end, steps=steps)
+    st = State(t, q)
+    paths = [st.point(solid, local).value for _, solid, local in traced]
+
+    fig = figure(*size, dpi)
+    ax = fig.add_subplot()
+    scene = Scene(ax, mech, q, np.vstack(paths) if paths else ())
+    ax.set_title(f"'{mech.name}' — kinematic run, t = 0 … {t_end:g} s")
+    clock = ax.text(0.015, 0.975, "", transform=ax.transAxes, ha="left", va="top",
+                    fontsize=10, family="monospace", zorder=10,
+                    bbox=dict(facecolor="white", edgecolor="none", alpha=0.8))
+    moving = []
+    for k, ((name, _, _), xy) in enumerate(zip(traced, paths)):
+        color = ("#444444", "#d62728", "#1f77b4", "#2ca02c")[k % 4]
+        ax.plot(*xy.T, color=color, lw=1.0, alpha=0.5, linestyle=":", zorder=0.5,
+                gid=f"trace:{name}")
+        line, = ax.plot([], [], color=color, lw=1.6, zorder=0.6, label=f"path of {name}",
+                        gid=f"trace:{name}")
+        moving.append(line)
+    if traced:
+        ax.legend(loc="upper right", fontsize="small")
+
+    def frame(k: int):
+        scene.show(float(t[k]), q[k])
+        for line, xy in zip(moving, paths):
+            line.set_data(xy[:k + 1, 0], xy[:k + 1, 1])
+        clock.set_text(f"t = {t[k]:.3f} s")
+        return []
+
+    # the layout is computed once, on the first frame, then kept (it would be redone at
+    # every frame)
+    frame(0)
+    fig.canvas.draw()
+    fig.set_layout_engine("none")
+    with Progress(len(t), f"writing {path.name}") as bar:
+        if writer is None:
+            _write_gif(fig, path, fps, len(t), frame,
+                       lambda: [*scene.pen.artists, *moving, clock], bar)
+        else:
+            with writer.saving(fig, path, dpi):
+                for k in range(len(t)):
+                    frame(k)
+                    writer.grab_frame()
+                    bar.update(k + 1)
+    return path
+
+
+def _write_gif(fig, path: Path, fps: float, frames: int, show, dynamic, bar) -> None:
+    """Write a GIF with Pillow: the static part of the figure (axes, ticks, grid, global
+    frame, whole traced paths) is drawn once and restored at each frame, over which only the
+    artists of ``dynamic()`` are drawn; one palette for all frames (no flicker)."""
+    from PIL import Image
+    canvas = fig.canvas
+    ax = fig.axes[0]
+    for a in dynamic():
+        a.set_visible(False)
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
+    size = canvas.get_width_height()
+    images = []
+    for k in range(frames):
+        show(k)
+        canvas.restore_region(background)
+        for a in sorted(dynamic(), key=lambda a: a.get_zorder()):
+            a.set_visible(True)
+            ax.draw_artist(a)
+        images.append(Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
+                      .convert("RGB"))
+        bar.update(k + 1)
+    # the palette from the first, middle and last frames together
+    sample = Image.new("RGB", (size[0], 3 * size[1]))
+    for j, k in enumerate((0, frames // 2, frames - 1)):
+        sample.paste(images[k], (0, j * size[1]))
+    palette = sample.quantize(colors=255, method=Image.Quantize.FASTOCTREE)
+    frames_p = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    tmp = path.with_name(path.name + ".part")
+    frames_p[0].save(tmp, format="GIF", save_all=True, append_images=frames_p[1:],
+                     duration=round(1000.0 / fps), loop=0, optimize=False)
+    tmp.replace(path)

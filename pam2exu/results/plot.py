@@ -1,0 +1,150 @@
+"""Plots of result variables against time (``pam2exu plot``, ``pam2exu run --plot``).
+
+Figures are made with matplotlib's object-oriented API on the Agg canvas (``figure``): no
+pyplot, no window, no global backend state, so plotting works the same on a server, in CI
+and in a script. Variables that share a unit share a panel; every line is labelled with its
+PAM name and unit (``motor.Mz [N·m]``), every panel's y axis with its variables and unit.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import Pam2ExuError
+
+#: default resolution [dots per inch]; with ``WIDTH`` inches a plot is 880 px wide
+DPI = 100
+WIDTH = 8.8
+#: height of one panel and of the space around the panels [in]
+PANEL, MARGIN = 2.4, 0.9
+#: legends with more entries than this go to the right of their panel
+LEGEND_INSIDE = 4
+
+
+class PictureError(Pam2ExuError):
+    """A picture cannot be made as asked: an image format that is not supported, ffmpeg
+    missing for an MP4 file, nothing to plot. CLI exit code 2."""
+
+
+def figure(width: float, height: float, dpi: float = DPI):
+    """A matplotlib Figure on the Agg canvas (never a window), constrained layout."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(width, height), dpi=dpi, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save(fig, path: str | Path) -> Path:
+    """Write the figure at its own size and resolution; the format from the suffix."""
+    path = Path(path)
+    fmt = path.suffix[1:].lower()
+    formats = fig.canvas.get_supported_filetypes()
+    if fmt not in formats:
+        raise PictureError(f"cannot write '{path}': the image format is chosen by the file "
+                           f"suffix, one of {', '.join('.' + f for f in sorted(formats))}")
+    fig.savefig(path, dpi=fig.dpi, format=fmt)
+    return path
+
+
+def label(name: str, unit: str) -> str:
+    """``crank.fi [rad]`` (no brackets for a variable without a known unit)."""
+    return f"{name} [{unit}]" if unit else name
+
+
+def plot(source, names=None, path: str | Path | None = None, model=None,
+         title: str | None = None, dpi: float = DPI):
+    """Plot variables of a result table against t; returns the matplotlib Figure.
+
+    Parameters
+    ----------
+    source : Results, str or Path
+        A Results table (its ``units`` are used) or a result CSV file (units from the
+        output declarations, see ``units.unit_of``).
+    names : str or list of str, optional
+        Variables: full names (``crank.fi``), ``crank.*``, ``*.Fx`` or a bare ``Fx``, as for
+        ``--outputs``. Default: every column.
+    path : str or Path, optional
+        Image file to write (.png, .svg, .pdf, …).
+    model : Model or path, optional
+        For a CSV file: the model, which gives the units of ``f(t)`` and ``Df(t)``.
+    title : str, optional
+        Default: the model's name and the analysis.
+    dpi : float
+        Resolution; the image is ``WIDTH`` × (``MARGIN`` + ``PANEL`` × panels) inches.
+
+    Raises
+    ------
+    PictureError
+        A name matches no column (the message suggests the nearest), or the image format
+        of ``path`` is not supported.
+    CompareInputError
+        The CSV file is missing or unreadable.
+    """
+    from ..model import Model, load
+    from .table import Results, read_csv, select_columns
+    from .units import unit_of
+    if model is not None and not isinstance(model, Model):
+        model = load(model)
+    if isinstance(source, Results):
+        res = source
+    else:
+        res = read_csv(source, model)
+        if title is None:
+            title = f"{Path(source).name}" + (f" ('{model.name}')" if model else "")
+    where = f"'{source}'" if not isinstance(source, Results) else "the results"
+    columns = _in_order(res.columns, names, select_columns, where)
+    if not columns:
+        raise PictureError("nothing to plot: choose variables besides t")
+    panels: dict[str, list[str]] = {}
+    for c in columns:
+        unit = res.units.get(c) or unit_of(c, model)
+        panels.setdefault(unit, []).append(c)
+    fig = figure(WIDTH, MARGIN + PANEL * len(panels), dpi)
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    marker = "o" if len(res) == 1 else None
+    for ax, (unit, cols) in zip(axes, panels.items()):
+        for c in cols:
+            ax.plot(res.t, res[c], marker=marker, label=label(c, unit))
+        if len(cols) == 1:
+            ax.set_ylabel(label(cols[0], unit))
+        else:
+            variables = list(dict.fromkeys(c.rpartition(".")[2] for c in cols))
+            ax.set_ylabel(label(", ".join(variables[:3]) + (", …" if len(variables) > 3
+                                                            else ""), unit))
+            if len(cols) <= LEGEND_INSIDE:
+                ax.legend(fontsize="small")
+            else:
+                ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel(label("t", "s"))
+    if title is None:
+        title = " — ".join(x for x in (f"'{res.model}'" if res.model else "",
+                                       f"{res.analysis} analysis" if res.analysis else "") if x)
+    if title:
+        fig.suptitle(title)
+    if path is not None:
+        save(fig, path)
+    return fig
+
+
+def _in_order(columns: list[str], names, select_columns, where: str) -> list[str]:
+    """The columns matching ``names``, in the order of the patterns (then of the table);
+    PictureError naming every pattern that matches nothing."""
+    from ..errors import ModelError
+    if names is None:
+        return [c for c in columns if c != "t"]
+    from .compare import SPELLINGS, canonical_name
+    names = [names] if isinstance(names, str) else list(names)
+    # PAM spellings as in the files: motor.Forca, f, Df
+    names = [canonical_name(n) if "." in n else SPELLINGS.get(n, n) for n in names]
+    try:
+        select_columns(columns, names)
+    except ModelError as exc:
+        raise PictureError("; ".join(p.message.replace("of this analysis", f"of {where}")
+                                     for p in exc.problems)
+                           + "; use full names (crank.fi), 'crank.*', '*.Fx' or a bare "
+                             "variable (Fx)") from None
+    out: dict[str, None] = {}
+    for p in names:
+        out.update(dict.fromkeys(c for c in select_columns(columns, [p]) if c != "t"))
+    return list(out)
