@@ -39,13 +39,9 @@ def _parser() -> argparse.ArgumentParser:
                      help="plot these variables against t (names or patterns, as --outputs)")
     run.add_argument("--plot-file", metavar="FIG.png",
                      help="image file of --plot (default: <model>_plot.png)")
-    run.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                     help=argparse.SUPPRESS)
 
     check = sub.add_parser("check", help="validate a model, print its mobility and elements")
     check.add_argument("model", help="model file (TOML)")
-    check.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help=argparse.SUPPRESS)
 
     from .results.compare import ATOL, RTOL
     comp = sub.add_parser(
@@ -69,8 +65,6 @@ def _parser() -> argparse.ArgumentParser:
                       help="md: Markdown table (default); csv: CSV on stdout, notes on stderr")
     comp.add_argument("--interp", choices=["cubic", "linear"], default="cubic",
                       help="interpolation of the result when the times differ (default cubic)")
-    comp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                      help=argparse.SUPPRESS)
 
     exp = sub.add_parser(
         "export", help="write a standalone Exudyn script of the model (positions to CSV)",
@@ -85,8 +79,6 @@ def _parser() -> argparse.ArgumentParser:
     exp.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
     exp.add_argument("--forces", action="store_true",
                      help="include masses, gravity, springs and loads (same positions)")
-    exp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                     help=argparse.SUPPRESS)
 
     _picture_parsers(sub)
     return p
@@ -132,9 +124,9 @@ def _picture_parsers(sub) -> None:
                       help="points whose paths are drawn (coupler curves)")
     anim.add_argument("--fps", type=float, help="frames per second (default: real time, "
                                                  "2 to 30)")
-    for p in (plot, draw, anim):
-        p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                       help=argparse.SUPPRESS)
+    for sub_parser in sub.choices.values():     # --debug after the subcommand, too
+        sub_parser.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                                help=argparse.SUPPRESS)
 
 
 def _run(args) -> int:

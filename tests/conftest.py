@@ -1,7 +1,10 @@
-"""Shared fixtures: paths of the shipped models."""
+"""Shared fixtures: paths of the shipped models, and a rigidly moved copy of a model."""
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+import pam2exu
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -14,3 +17,22 @@ def examples() -> Path:
 @pytest.fixture
 def data() -> Path:
     return ROOT / "tests" / "data"
+
+
+def moved_model(path, x0=0.3, y0=-0.2, fi0=0.7):
+    """The model with every solid's pose moved by the same rigid motion (x0, y0, fi0): the
+    ground is then rotated and shifted (its ObjectGround has a rotation, the actuators on
+    it an angle shift)."""
+    model = pam2exu.load(path)
+    c, s = np.cos(fi0), np.sin(fi0)
+    for solid in model.solids:
+        x, y = float(solid.x), float(solid.y)
+        solid.x, solid.y = x0 + c * x - s * y, y0 + s * x + c * y
+        solid.fi = float(solid.fi) + fi0
+    return model
+
+
+@pytest.fixture
+def moved():
+    """``moved_model``, for tests."""
+    return moved_model

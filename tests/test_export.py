@@ -41,17 +41,6 @@ def max_difference(header, data, res) -> float:
     return max(float(np.max(np.abs(data[:, k + 1] - res[c]))) for k, c in enumerate(res.columns))
 
 
-def _moved(path, x0=0.3, y0=-0.2, fi0=0.7):
-    """The model with every solid moved by one rigid motion: the ground is then rotated and
-    shifted, so its ObjectGround has a rotation and the actuators on it an angle shift."""
-    model = pam2exu.load(path)
-    c, s = np.cos(fi0), np.sin(fi0)
-    for solid in model.solids:
-        x, y = float(solid.x), float(solid.y)
-        solid.x, solid.y = x0 + c * x - s * y, y0 + s * x + c * y
-        solid.fi = float(solid.fi) + fi0
-    return model
-
 
 def test_example_has_every_element_type_and_law(examples):
     model = pam2exu.load(examples / "all_elements.toml")
@@ -69,10 +58,10 @@ def test_script_gives_pam2exus_positions(examples, tmp_path, forces):
     assert max_difference(header, data, res) <= 1e-10
 
 
-def test_script_of_a_moved_ground(examples, tmp_path):
+def test_script_of_a_moved_ground(examples, tmp_path, moved):
     """A fixed solid at a rotated pose: ObjectGround with a rotation, actuator offsets shifted
     by the ground's angle."""
-    model = _moved(examples / "all_elements.toml")
+    model = moved(examples / "all_elements.toml")
     path = pam2exu.export(model, tmp_path / "moved.py", steps=50)
     text = path.read_text()
     assert "ObjectGround(" in text and " + 0.7)" in text       # the shift of fi_ground

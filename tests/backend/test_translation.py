@@ -108,22 +108,13 @@ def test_degrees_of_freedom_agree_with_exudyn(examples, drop, dof):
     assert ours.redundant == theirs["redundantConstraints"] == 0
 
 
-def _moved(path, x0=0.3, y0=-0.2, fi0=0.7):
-    """The model with every solid's pose moved by the same rigid motion (x0, y0, fi0)."""
-    model = pam2exu.load(path)
-    c, s = np.cos(fi0), np.sin(fi0)
-    for solid in model.solids:
-        x, y = float(solid.x), float(solid.y)
-        solid.x, solid.y = x0 + c * x - s * y, y0 + s * x + c * y
-        solid.fi = float(solid.fi) + fi0
-    return model
 
-
-def test_fixed_solids_modelled_as_ground_give_the_same_positions(examples):
+def test_fixed_solids_modelled_as_ground_give_the_same_positions(examples,
+                                                                  moved):
     """The constraints-only system models fixed solids as Exudyn ground (at a rotated,
     shifted pose here); the force system keeps them as bodies held by three coordinate
     constraints. Both must give the same configurations."""
-    mech = _moved(examples / "all_elements.toml").mechanism()
+    mech = moved(examples / "all_elements.toml").mechanism()
     t = np.linspace(0.0, 1.0, 41)
     grounded = ExudynSystem(mech)
     assert grounded.grounded == {mech.index["ground"]}
@@ -133,17 +124,17 @@ def test_fixed_solids_modelled_as_ground_give_the_same_positions(examples):
     np.testing.assert_allclose(q1, q2, rtol=0, atol=1e-12)
 
 
-def test_a_rigidly_moved_mechanism_moves_the_same(examples):
+def test_a_rigidly_moved_mechanism_moves_the_same(examples, moved):
     """Moving every solid by one rigid motion (x0, y0, fi0) moves the results by it:
     fi + fi0 for every solid, (x, y) rotated by fi0 and shifted, reactions rotated."""
     x0, y0, fi0 = 0.3, -0.2, 0.7
     path = examples / "all_elements.toml"
     model = pam2exu.load(path)
     model.gravity = 0.0
-    moved = _moved(path, x0, y0, fi0)
-    moved.gravity = 0.0
+    shifted = moved(path, x0, y0, fi0)
+    shifted.gravity = 0.0
     a = pam2exu.run(model, analysis="kinetostatic", steps=30)
-    b = pam2exu.run(moved, analysis="kinetostatic", steps=30)
+    b = pam2exu.run(shifted, analysis="kinetostatic", steps=30)
     c, s = np.cos(fi0), np.sin(fi0)
     for solid in model.solids:
         n = solid.name
