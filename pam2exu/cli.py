@@ -43,6 +43,14 @@ def _parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="validate a model, print its mobility and elements")
     check.add_argument("model", help="model file (TOML)")
 
+    elements = sub.add_parser(
+        "elements", help="the element types: keys, anchors, outputs and sign conventions",
+        description="Without TYPE: every element type (Catalan PAM names in brackets) and the "
+                    "time laws. With TYPE (English or Catalan): its keys, defaults, constraint "
+                    "equations, outputs with units, and where its reaction is reported. The "
+                    "same text as docs/model-format.md.")
+    elements.add_argument("types", nargs="*", metavar="TYPE", help="e.g. revolute, piu_guia")
+
     from .results.compare import ATOL, RTOL
     comp = sub.add_parser(
         "compare", help="compare a result CSV with a reference CSV, variable by variable",
@@ -194,6 +202,26 @@ def _check(args) -> int:
     return 0
 
 
+def _elements(args) -> int:
+    from . import reference
+    if not args.types:
+        from .elements import ELEMENTS
+        width = max(len(t) + len(c.alias) for t, c in ELEMENTS.items()) + 3
+        for kind, cls in ELEMENTS.items():
+            anchors = ", ".join(reference.anchor_meaning(cls, k) for k in range(len(cls.anchors)))
+            print(f"{f'{kind} [{cls.alias}]':<{width}}  {anchors}: {cls.summary}")
+        print("\ntime laws (law = ..., constants C = [C1, C2, C3, C4]):\n")
+        print(reference.laws_markdown())
+        print("pam2exu elements TYPE: keys, outputs and sign conventions of one type")
+        return 0
+    try:
+        classes = [reference.element_class(name) for name in args.types]
+    except KeyError as exc:
+        raise ModelError(exc.args[0]) from None
+    print("\n".join(reference.element_markdown(cls) for cls in classes), end="")
+    return 0
+
+
 def _compare(args) -> int:
     from .results.compare import CompareInputError, compare
     try:
@@ -274,7 +302,7 @@ def _export(args) -> int:
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"run": _run, "check": _check, "compare": _compare,
+        return {"run": _run, "check": _check, "elements": _elements, "compare": _compare,
                 "export": _export, "plot": _plot, "draw": _draw,
                 "animate": _animate}[args.command](args)
     except BrokenPipeError:              # output piped into head & co.

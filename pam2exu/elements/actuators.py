@@ -61,6 +61,7 @@ class LinearActuator(Actuator):
     type = "linear_actuator"
     alias = "actuador_lineal"
     anchors = ("point", "point")
+    roles = ("P", "Q")
     summary = "distance PQ = f(t)"
     params = {"law": _LAW, "C": _C}
     outputs = (

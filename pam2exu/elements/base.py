@@ -124,6 +124,8 @@ class Element:
     alias: ClassVar[str] = ""
     #: what anc1 and anc2 must name: "solid", "point" or "line" (one entry per anchor)
     anchors: ClassVar[tuple[str, ...]] = ()
+    #: what each anchor is, in PAM's words (default "solid 1", "solid 2")
+    roles: ClassVar[tuple[str, ...]] = ()
     #: one line: what the element does
     summary: ClassVar[str] = ""
     #: keys besides name/anc1/anc2
@@ -220,9 +222,10 @@ class Element:
         return self.ref2.solid
 
     def report_frame(self, st: State) -> tuple[np.ndarray, np.ndarray]:
-        """(point (n, 2), unit x axis (n, 2)) where and in which basis the wrench is reported.
+        """At the receiving solid's frame origin, global basis.
 
-        Default: the receiving solid's origin, global basis.
+        Returns (point (n, 2), unit x axis (n, 2)): where, and in which basis, the wrench
+        is reported (the first docstring line says it in words, for the reference pages).
         """
         s = self.receiver
         return st.q[:, 3 * s:3 * s + 2], np.broadcast_to([1.0, 0.0], (st.n, 2))

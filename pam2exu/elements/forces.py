@@ -33,7 +33,9 @@ class Torsor(Element):
     type = "torsor"
     alias = "torsor"
     anchors = ("point",)
-    summary = "applied force and moment, constant in the global frame or in the solid's frame"
+    roles = ("where the force acts",)
+    summary = ("applied force and moment; components constant in the global frame or in the "
+               "solid's frame")
     params = {
         "C": Param("constants", "[Fx, Fy, M] in N, N, N·m", size=3),
         "axes": Param("choice", "basis of the components", choices=("global", "solid")),
@@ -117,7 +119,8 @@ class Spring(_SpringDamper):
     type = "spring"
     alias = "molla_amortidor_lineal"
     anchors = ("point", "point")
-    summary = "F = C1 + C2 (ro - C3) + C4 Dro, positive = attraction"
+    summary = ("F = C1 + C2 (ro - C3) + C4 Dro, positive = attraction; ro = distance between "
+               "the points")
     params = {"C": Param("constants", "C1 [N], C2 [N/m], C3 [m], C4 [N·s/m]")}
     outputs = (
         Var("Força", "N", FORCE, "force of the spring-damper, positive = attraction"),
@@ -153,8 +156,8 @@ class TorsionalSpring(_SpringDamper):
     type = "torsional_spring"
     alias = "molla_amortidor_torsional"
     anchors = ("solid", "solid")
-    summary = ("Parell = C1 + C2 (fi_rel - C3) + C4 Dfi_rel, positive counter-clockwise on "
-               "solid 1, clockwise on solid 2")
+    summary = ("Parell = C1 + C2 (fi_rel - C3) + C4 Dfi_rel, fi_rel = fi2 - fi1; positive "
+               "counter-clockwise on solid 1, clockwise on solid 2")
     params = {"C": Param("constants", "C1 [N·m], C2 [N·m/rad], C3 [rad], C4 [N·m·s/rad]")}
     outputs = (
         Var("Parell", "N·m", FORCE, "torque, counter-clockwise on solid 1, clockwise on solid 2"),

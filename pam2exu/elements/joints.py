@@ -17,6 +17,7 @@ class Fixed(Element):
     type = "fixed"
     alias = "enllac_fix"
     anchors = ("solid",)
+    roles = ("the solid held",)
     summary = "the solid keeps its initial x, y, fi"
     outputs = (
         Var("Fx", "N", FORCE, "force the solid receives, at its local origin, global x"),
@@ -100,7 +101,8 @@ class Prismatic(Element):
     alias = "prismatic"
     anchors = ("line", "line")
     summary = ("the two lines coincide: solid 2's defining point lies on line 1, and the "
-               "directions stay parallel")
+               "line directions stay parallel, in the same or the opposite sense, whichever "
+               "the initial guess is nearer to")
     outputs = (
         Var("Fnormal", "N", FORCE, "force solid 1 exerts on solid 2, normal to solid 2's line"),
         Var("Mz", "N·m", FORCE, "moment solid 1 exerts on solid 2, about the defining point "
@@ -145,6 +147,7 @@ class PinSlot(Element):
     type = "pin_slot"
     alias = "piu_guia"
     anchors = ("line", "point")
+    roles = ("guide", "pin")
     summary = "the pin stays on the guide"
     outputs = (Var("Fnormal", "N", FORCE,
                    "force the guide (solid 1) exerts on the pin (solid 2), normal to the guide"),)
@@ -189,13 +192,17 @@ class Transmission(Element):
     type = "transmission"
     alias = "transmissio"
     anchors = ("solid", "solid")
-    summary = "(fi2 - fi_arm) - T (fi1 - fi_arm) - C = 0, the arm hinged to both solids"
+    summary = ("(fi2 - fi_arm) - T (fi1 - fi_arm) - C = 0; the arm is the solid that both are "
+               "hinged to by revolute joints (ground included); name it with `arm` when that "
+               "is ambiguous")
     params = {
         "T": Param("number", "transmission ratio", required=True),
         "C": Param("number", "initial angle [rad]"),
         "arm": Param("solid", "the solid both gears are hinged to (found when unambiguous)"),
     }
-    outputs = (Var("Parell", "N·m", FORCE, "torque solid 2 receives from the transmission"),)
+    outputs = (Var("Parell", "N·m", FORCE, "torque solid 2 receives from the transmission "
+                   "(pure torques: Parell on solid 2, −T·Parell on solid 1, (T−1)·Parell on "
+                   "the arm; no tooth force enters the bearings)"),)
     equations = 1
     wrench = (None, None, "Parell")
 

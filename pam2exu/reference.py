@@ -1,0 +1,220 @@
+"""The element reference, written from the element declarations so it cannot drift.
+
+Every table here is read from the classes in ``pam2exu.elements`` (their keys, anchors,
+parameters, outputs and reporting frames), from the solid outputs and analysis levels of
+``pam2exu.analyses``, and from the time laws of ``pam2exu.laws``. It feeds three places:
+
+- ``pam2exu elements [TYPE ...]`` on the command line;
+- the generated regions of ``docs/model-format.md`` and ``docs/glossary.md``, between
+  ``<!-- BEGIN generated: NAME -->`` and ``<!-- END generated: NAME -->``;
+- ``python -m pam2exu.reference [--check] PAGE ...`` rewrites (or checks) those regions.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import inspect
+import re
+import sys
+from pathlib import Path
+
+from .elements import ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY, ACCELERATION, Element
+from .laws import LAW_ALIASES, LAWS
+
+#: which analyses give a variable of each level (PAM's analyses; assembly gives x, y, fi)
+ANALYSES_OF_LEVEL = {
+    POSITION: ("quasi_static", "kinematic", "kinetostatic"),
+    VELOCITY: ("kinematic", "kinetostatic"),
+    ACCELERATION: ("kinematic", "kinetostatic"),
+    FORCE: ("quasi_static", "kinetostatic"),
+}
+
+_ANCHOR_FORMS = {
+    "solid": "a solid name",
+    "point": '`"solid.point"`, or a solid name for its origin',
+    "line": '`"solid.line"`, or a solid name for its local x axis',
+}
+
+
+def element_class(name: str) -> type[Element]:
+    """The element class of a type name or a Catalan alias (KeyError with the known names)."""
+    kind = ALIASES.get(name, name)
+    if kind not in ELEMENTS:
+        known = ", ".join(ELEMENTS)
+        raise KeyError(f"unknown element type '{name}'; known types: {known} "
+                       f"(Catalan names: {', '.join(ALIASES)})")
+    return ELEMENTS[kind]
+
+
+def anchor_meaning(cls: type[Element], k: int) -> str:
+    """What anchor k (0-based) names, e.g. 'line of solid 1 (the guide)'."""
+    kind = cls.anchors[k]
+    owner = "the solid" if len(cls.anchors) == 1 else f"solid {k + 1}"
+    text = owner if kind == "solid" else f"{kind} of {owner}"
+    role = cls.roles[k] if k < len(cls.roles) else ""
+    return f"{text} ({role})" if role else text
+
+
+def _default(cls: type[Element], key: str) -> str:
+    param = cls.params[key]
+    if param.required:
+        return "required"
+    field = next((f for f in dataclasses.fields(cls) if f.name == key), None)
+    value = None if field is None else field.default
+    if value is None:
+        return "–"
+    if isinstance(value, tuple):
+        if all(v == 0 for v in value):
+            return "zeros"
+        value = list(value)
+    return f"`{value!r}`".replace("'", '"')
+
+
+def _analyses(level: str) -> str:
+    return ", ".join(ANALYSES_OF_LEVEL[level])
+
+
+def _first_line(function) -> str:
+    return (inspect.getdoc(function) or "").splitlines()[0]
+
+
+def reported_at(cls: type[Element]) -> str:
+    """Where and in which basis a constraint element's reaction is reported, in words."""
+    return _first_line(cls.report_frame).rstrip(".")
+
+
+def _table(header: tuple[str, ...], rows) -> list[str]:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return lines
+
+
+def element_markdown(cls: type[Element], level: int = 3) -> str:
+    """One element's section: what it does, its keys, its equations and its outputs."""
+    alias = f" [`{cls.alias}`]" if cls.alias != cls.type else ""
+    lines = [f'<a id="{cls.type}"></a>', "", f"{'#' * level} `{cls.type}`{alias}", "",
+             cls.summary[0].upper() + cls.summary[1:] + ".", ""]
+    keys = [("type", f'`"{cls.type}"` (or `"{cls.alias}"`)', "required"),
+            ("name", "unique name", f"`{cls.type}<n>`")]
+    for k in range(len(cls.anchors)):
+        keys.append((f"anc{k + 1}", f"{anchor_meaning(cls, k)}: {_ANCHOR_FORMS[cls.anchors[k]]}",
+                     "required"))
+    for key, param in cls.params.items():
+        keys.append((key, param.meaning, _default(cls, key)))
+    lines += _table(("key", "what to write", "default"),
+                    ((f"`{k}`", m, d) for k, m, d in keys))
+    lines.append("")
+    if cls.equations:
+        equation = _first_line(cls.constraint).rstrip(".")
+        plural = "s" if cls.equations > 1 else ""
+        lines += [f"Constraint: {cls.equations} equation{plural}, {equation}.", ""]
+    else:
+        lines += ["A force element: it adds no constraint equation.", ""]
+    if cls.outputs:
+        lines += _table(("output", "unit", "given by", "meaning"),
+                        ((f"`<name>.{v.name}`", v.unit, _analyses(v.level), v.meaning)
+                         for v in cls.outputs))
+        lines.append("")
+    if cls.wrench:
+        lines += [f"Reaction reported: {reported_at(cls)[0].lower()}{reported_at(cls)[1:]}.", ""]
+    return "\n".join(lines)
+
+
+def elements_markdown() -> str:
+    """Every element type, in the contract's order, with a summary table first."""
+    rows = []
+    for cls in ELEMENTS.values():
+        anchors = [anchor_meaning(cls, k) for k in range(2)] if len(cls.anchors) == 2 else \
+            [anchor_meaning(cls, 0) if cls.anchors else "–", "–"]
+        rows.append((f"[`{cls.type}`](#{cls.type}) [`{cls.alias}`]", *anchors,
+                     ", ".join(f"`{k}`" for k in cls.params) or "–", cls.summary))
+    lines = _table(("type [alias]", "anc1", "anc2", "other keys", "constraint or action"), rows)
+    lines.append("")
+    return "\n".join(lines) + "\n" + "\n".join(element_markdown(cls) for cls in ELEMENTS.values())
+
+
+def laws_markdown() -> str:
+    """The time laws: name, Catalan alias, f(t) as the law function's docstring states it."""
+    aliases = {law: alias for alias, law in LAW_ALIASES.items()}
+    rows = []
+    for name, (function, span) in LAWS.items():
+        alias = f" [`{aliases[name]}`]" if name in aliases else ""
+        formula = _first_line(function).rstrip(".")
+        rows.append((f"`{name}`{alias}", formula, "C1 < C2" if span else "–"))
+    return "\n".join(_table(("law", "f(t)", "needs"), rows)) + "\n"
+
+
+def outputs_markdown() -> str:
+    """Every output variable: owner, PAM name, unit, which analyses give it, meaning."""
+    from .analyses.common import SOLID_OUTPUTS
+    rows = [("solid", f"`{v.name}`", v.unit, _analyses(v.level), v.meaning)
+            for v in SOLID_OUTPUTS]
+    for cls in ELEMENTS.values():
+        rows += [(f"[`{cls.type}`](#{cls.type})", f"`{v.name}`", v.unit,
+                  _analyses(v.level), v.meaning) for v in cls.outputs]
+    return "\n".join(_table(("owner", "variable", "unit", "given by", "meaning"), rows)) + "\n"
+
+
+def reactions_markdown() -> str:
+    """One entry per element type with force outputs: its sketch, point, basis and signs."""
+    lines = []
+    for cls in ELEMENTS.values():
+        forces = [v for v in cls.outputs if v.level == FORCE]
+        if not forces:
+            continue
+        lines += [f'<a id="{cls.type}"></a>', "", f"### `{cls.type}`", "",
+                  f"![free-body sketch of {cls.type}](img/fbd_{cls.type}.png)", ""]
+        if cls.wrench:
+            lines += [f"Reported {reported_at(cls)[0].lower()}{reported_at(cls)[1:]}.", ""]
+        lines += [f"- `{v.name}` [{v.unit}]: {v.meaning}" for v in forces]
+        lines.append("")
+    return "\n".join(lines)
+
+
+#: generated region name -> its text
+REGIONS = {"elements": elements_markdown, "laws": laws_markdown,
+           "outputs": outputs_markdown, "reactions": reactions_markdown}
+
+_REGION = re.compile(r"(<!-- BEGIN generated: (\w+) -->\n)(.*?)(<!-- END generated: \2 -->)",
+                     re.S)
+
+
+def refresh(text: str) -> str:
+    """``text`` with every generated region written anew."""
+    def body(match):
+        name = match.group(2)
+        if name not in REGIONS:
+            raise KeyError(f"unknown generated region '{name}'; known: {', '.join(REGIONS)}")
+        return match.group(1) + "\n" + REGIONS[name]().rstrip("\n") + "\n\n" + match.group(4)
+    return _REGION.sub(body, text)
+
+
+def regions(text: str) -> list[str]:
+    """The names of the generated regions in ``text``."""
+    return [m.group(2) for m in _REGION.finditer(text)]
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m pam2exu.reference",
+                                description="Rewrite the generated regions of reference pages.")
+    p.add_argument("pages", nargs="+", type=Path)
+    p.add_argument("--check", action="store_true",
+                   help="exit 1 when a page is stale instead of rewriting it")
+    args = p.parse_args(argv)
+    stale = []
+    for page in args.pages:
+        old = page.read_text(encoding="utf-8")
+        new = refresh(old)
+        if new != old:
+            stale.append(page)
+            if not args.check:
+                page.write_text(new, encoding="utf-8")
+    if args.check and stale:
+        print("stale: " + ", ".join(map(str, stale)) + "; run python -m pam2exu.reference "
+              + " ".join(map(str, args.pages)), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,174 @@
+"""The element reference agrees with the contract and cannot drift from the declarations.
+
+Reference: the model-format contract, kept verbatim in tests/data/model-format-contract.md
+(a copy of shared/spec/model-format.md). Its tables are parsed here and compared with the
+element declarations (pam2exu/elements/) the reference pages are generated from.
+"""
+import dataclasses
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from pam2exu import reference
+from pam2exu.analyses.common import LEVELS, SOLID_OUTPUTS
+from pam2exu.elements import ALIASES, ELEMENTS, FORCE
+from pam2exu.laws import LAW_ALIASES, LAWS
+from pam2exu.model.model import Analysis
+from pam2exu.model.solid import Solid
+
+ROOT = Path(__file__).resolve().parents[1]
+CONTRACT = (ROOT / "tests" / "data" / "model-format-contract.md").read_text(encoding="utf-8")
+PAGES = [ROOT / "docs" / "model-format.md", ROOT / "docs" / "glossary.md"]
+
+
+def _section(title: str) -> str:
+    return re.search(rf"^## {re.escape(title)}.*?\n(.*?)(?=^## |\Z)", CONTRACT, re.S | re.M)[1]
+
+
+def _rows(title: str) -> list[list[str]]:
+    """The cells of the first Markdown table of a contract section (header excluded)."""
+    lines = [ln for ln in _section(title).splitlines() if ln.startswith("|")]
+    return [[c.strip() for c in ln.strip("|").split("|")] for ln in lines[2:]]
+
+
+def _names(cell: str) -> list[str]:
+    return re.findall(r"`([^`]+)`", cell)
+
+
+def test_contract_copy_is_the_shared_contract():
+    shared = ROOT.parent / "shared" / "spec" / "model-format.md"
+    if not shared.exists():
+        pytest.skip("shared/spec is not next to this clone")
+    assert shared.read_text(encoding="utf-8") == CONTRACT
+
+
+def test_element_table_matches_the_contract():
+    """Type, alias, anchor kinds, keys and the action text, row by row and in order."""
+    rows = _rows("Elements")
+    assert [_names(r[0])[0] for r in rows] == list(ELEMENTS)
+    for (kinds, anc1, anc2, keys, action) in rows:
+        kind, alias = _names(kinds)
+        cls = ELEMENTS[kind]
+        assert cls.alias == alias and ALIASES[alias] == kind
+        cells = [anc1, anc2][:len(cls.anchors)]
+        assert [c for c in (anc1, anc2)[len(cls.anchors):]] == ["–"] * (2 - len(cls.anchors))
+        for k, cell in enumerate(cells):
+            assert cls.anchors[k] in cell.split()[0:2], (kind, k, cell)
+            named = re.search(r"\((\w+)\)|point (\w) of", cell)      # (guide), point P of
+            if named:
+                assert cls.roles[k] == (named[1] or named[2]), (kind, k, cell)
+        declared = [re.split(r"[ =]", n)[0] for n in _names(keys)]
+        assert [n for n in declared if not n.startswith('"')] == list(cls.params), kind
+        assert cls.summary == action, kind
+
+
+def test_output_table_matches_the_contract():
+    rows = {r[0]: [v.strip() for v in r[1].split(",")] for r in _rows("Output variables")}
+    assert rows.pop("solid") == [v.name for v in SOLID_OUTPUTS]
+    assert rows == {kind: [v.name for v in cls.outputs]
+                    for kind, cls in ELEMENTS.items() if cls.outputs}
+
+
+def test_contract_output_meanings_are_in_the_declarations():
+    """The contract's words on who acts on whom, and where, are in each force output's
+    meaning (which the reference pages and `pam2exu elements` print)."""
+    rows = {r[0]: r[2].replace("-", "−") for r in _rows("Output variables")}
+    must = {"fixed": ["receives", "local origin"], "revolute": ["solid 1 exerts on solid 2"],
+            "prismatic": ["solid 1 exerts on solid 2", "defining point of solid 2's line"],
+            "pin_slot": ["(guide)", "solid 2", "pin"],
+            "transmission": ["solid 2 receives", "−T·Parell on solid 1", "(T−1)·Parell on the arm",
+                             "no tooth force enters the bearings"],
+            "spring": ["attraction"], "angular_actuator": ["on solid 2"],
+            "linear_actuator": ["repulsion between P and Q"]}
+    for kind, words in must.items():
+        meanings = " ".join(v.meaning for v in ELEMENTS[kind].outputs).replace("guide (solid 1)",
+                                                                               "solid 1 (guide)")
+        for word in words:
+            assert word in rows[kind], (kind, word)      # the contract says it
+            assert word in meanings, (kind, word)        # and so does the declaration
+
+
+def test_law_table_matches_the_contract():
+    rows = _rows("Time laws")
+    names = {_names(r[0])[0]: (_names(r[0])[1:] or [None])[0] for r in rows}
+    assert list(names) == list(LAWS)
+    assert {alias: law for law, alias in names.items() if alias} == LAW_ALIASES
+
+
+def test_solid_and_analysis_keys_match_the_contract():
+    solid_keys = [k for r in _rows("Solids") for k in r[0].split(", ")]
+    assert solid_keys == [f.name for f in dataclasses.fields(Solid) if f.name != "position"]
+    assert [r[0] for r in _rows("Analysis")] == [f.name for f in dataclasses.fields(Analysis)]
+
+
+def test_levels_of_the_reference_are_those_the_analyses_use():
+    for level, analyses in reference.ANALYSES_OF_LEVEL.items():
+        assert set(analyses) == {a for a, levels in LEVELS.items()
+                                 if level in levels and a != "assembly"}
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_generated_regions_are_current(page):
+    text = page.read_text(encoding="utf-8")
+    assert reference.regions(text)
+    assert reference.refresh(text) == text, (
+        f"{page.name} is stale: run python -m pam2exu.reference docs/model-format.md "
+        "docs/glossary.md")
+
+
+def test_refresh_rewrites_a_stale_region_and_check_fails(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("x\n<!-- BEGIN generated: laws -->\nold\n<!-- END generated: laws -->\n",
+                    encoding="utf-8")
+    assert reference.main(["--check", str(page)]) == 1
+    assert reference.main([str(page)]) == 0
+    assert "`bezier_c2`" in page.read_text(encoding="utf-8")
+    assert reference.main(["--check", str(page)]) == 0
+
+
+def test_model_format_page_has_every_element_key_and_output():
+    text = PAGES[0].read_text(encoding="utf-8")
+    for kind, cls in ELEMENTS.items():
+        section = text.split(f'<a id="{kind}"></a>')[1].split("<a id=")[0]
+        for key in cls.keys():
+            assert f"| `{key}` |" in section, (kind, key)
+        for v in cls.outputs:
+            assert f"`<name>.{v.name}` | {v.unit} |" in section, (kind, v.name)
+
+
+def test_glossary_has_a_sketch_for_every_force_output():
+    text = PAGES[1].read_text(encoding="utf-8")
+    for kind, cls in ELEMENTS.items():
+        if any(v.level == FORCE for v in cls.outputs):
+            assert f"](img/fbd_{kind}.png)" in text
+            assert (ROOT / "docs" / "img" / f"fbd_{kind}.png").exists(), kind
+
+
+@pytest.mark.parametrize("name", ["pin_slot", "piu_guia"])
+def test_cli_elements_shows_one_type(name):
+    done = subprocess.run([sys.executable, "-m", "pam2exu", "elements", name],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    assert "`anc1` | line of solid 1 (guide)" in done.stdout
+    assert "`<name>.Fnormal` | N | quasi_static, kinetostatic" in done.stdout
+
+
+def test_cli_elements_lists_every_type_and_law():
+    done = subprocess.run([sys.executable, "-m", "pam2exu", "elements"],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 0
+    for kind, cls in ELEMENTS.items():
+        assert f"{kind} [{cls.alias}]" in done.stdout
+    for law in LAWS:
+        assert f"`{law}`" in done.stdout
+
+
+def test_cli_elements_unknown_type_is_a_model_error():
+    done = subprocess.run([sys.executable, "-m", "pam2exu", "elements", "articulation"],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 2
+    assert "unknown element type 'articulation'" in done.stderr
+    assert "articulacio" in done.stderr
