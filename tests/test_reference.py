@@ -172,3 +172,13 @@ def test_cli_elements_unknown_type_is_a_model_error():
     assert done.returncode == 2
     assert "unknown element type 'articulation'" in done.stderr
     assert "articulacio" in done.stderr
+
+
+def test_migration_page_maps_every_pam_element_and_law():
+    text = (ROOT / "docs" / "migrating.md").read_text(encoding="utf-8")
+    for alias, kind in ALIASES.items():
+        assert f"`{kind}` (`{alias}`)" in text, kind
+    for law in LAWS:
+        assert f'`"{law}"`' in text, law
+    for alias in LAW_ALIASES:
+        assert f'`"{alias}"`' in text, alias
