@@ -160,13 +160,16 @@ def reactions_markdown() -> str:
     lines = []
     for cls in ELEMENTS.values():
         forces = [v for v in cls.outputs if v.level == FORCE]
-        if not forces:
+        if not forces and (cls.equations or cls.outputs):
             continue
         lines += [f'<a id="{cls.type}"></a>', "", f"### `{cls.type}`", "",
                   f"![free-body sketch of {cls.type}](img/fbd_{cls.type}.png)", ""]
         if cls.wrench:
             lines += [f"Reported {reported_at(cls)[0].lower()}{reported_at(cls)[1:]}.", ""]
         lines += [f"- `{v.name}` [{v.unit}]: {v.meaning}" for v in forces]
+        if not forces:         # an applied load: its constants are inputs, not outputs
+            lines += ["An input, not an output: " + "; ".join(
+                f"`{key}`: {param.meaning}" for key, param in cls.params.items()) + "."]
         lines.append("")
     return "\n".join(lines)
 

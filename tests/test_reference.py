@@ -139,10 +139,11 @@ def test_model_format_page_has_every_element_key_and_output():
             assert f"`<name>.{v.name}` | {v.unit} |" in section, (kind, v.name)
 
 
-def test_glossary_has_a_sketch_for_every_force_output():
+def test_glossary_has_a_sketch_for_every_force_output_and_load():
+    from pam2exu.pictures.free_body import FREE_BODY_TYPES
     text = PAGES[1].read_text(encoding="utf-8")
     for kind, cls in ELEMENTS.items():
-        if any(v.level == FORCE for v in cls.outputs):
+        if any(v.level == FORCE for v in cls.outputs) or kind in FREE_BODY_TYPES:
             assert f"](img/fbd_{kind}.png)" in text
             assert (ROOT / "docs" / "img" / f"fbd_{kind}.png").exists(), kind
 

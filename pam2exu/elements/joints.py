@@ -22,7 +22,8 @@ class Fixed(Element):
     outputs = (
         Var("Fx", "N", FORCE, "force the solid receives, at its local origin, global x"),
         Var("Fy", "N", FORCE, "force the solid receives, at its local origin, global y"),
-        Var("Mz", "N·m", FORCE, "moment the solid receives, counter-clockwise"),
+        Var("Mz", "N·m", FORCE, "moment the solid receives, about its local origin, "
+            "counter-clockwise"),
     )
     equations = 3
     wrench = ("Fx", "Fy", "Mz")
@@ -155,7 +156,7 @@ class PinSlot(Element):
     wrench = (None, "Fnormal", None)
 
     def report_frame(self, st):
-        """At the pin, x along the guide."""
+        """At the pin, x along the guide (its own sense)."""
         guide, pin = self.refs
         return (st.point(pin.solid, pin.local).value,
                 st.direction(guide.solid, guide.direction).value)

@@ -332,3 +332,38 @@ class Pen:
         self._line([p, q], color=ACTUATOR, lw=9, alpha=0.45, solid_capstyle="butt",
                    zorder=Z_BAR)
         self._line([p, q], color=ACTUATOR, lw=1.5, zorder=Z_BAR)
+
+    # ---- free-body sketches (pictures/free_body.py) -------------------------------------
+    def arrow(self, a, b, color=INK, width: float = 2.0, head: float = 12) -> None:
+        """A straight arrow from a to b: a force of a free-body sketch, drawn to scale."""
+        self._arrow(a, b, color, width=width, head=head)
+
+    def arc_arrow(self, c, radius: float, start: float, sweep: float, color=INK,
+                  width: float = 1.8) -> None:
+        """An arc arrow about c (a moment) from angle ``start`` through ``sweep`` [rad],
+        counter-clockwise when ``sweep`` > 0, its head at the end."""
+        self._arc_arrow(c, radius, start, sweep, color, width)
+
+    def plate(self, outline, color, alpha: float = 0.30) -> None:
+        """A solid of any shape: the polygon ``outline``, lightly filled and outlined (the
+        look of ``solid`` for a solid with three points or more)."""
+        self._polygon(outline, facecolor=color, alpha=alpha, edgecolor="none", zorder=Z_SOLID)
+        self._polygon(outline, facecolor="none", edgecolor=color, lw=2.2, joinstyle="round",
+                      zorder=Z_SOLID)
+
+    def bar(self, p, q, color, width: float = 7.0) -> None:
+        """A straight solid from p to q with round ends (the look of ``solid`` for a solid
+        whose points are collinear)."""
+        self._line([p, q], color=color, lw=width, alpha=0.85, solid_capstyle="round",
+                   zorder=Z_SOLID)
+
+    def basis(self, p, direction, length: float, names=("x", "y"), color=GROUND) -> None:
+        """Small axes at p: x along ``direction``, y turned +90° from it, each labelled
+        beside its tip (``names``)."""
+        p, d = np.asarray(p, dtype=float), _unit(direction)
+        for axis, name in ((d, names[0]), (_normal(d), names[1])):
+            tip = p + length * axis
+            self._arrow(p, tip, color, width=1.0, head=8, z=Z_GUIDE)
+            side = -_normal(axis) if axis is d else _normal(axis)   # x below, y to the left
+            self.text(tip, name, color, offset=tuple(8.0 * side + 3.0 * axis),
+                      fontstyle="italic")
