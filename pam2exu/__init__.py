@@ -1,5 +1,10 @@
 """pam2exu: PAM planar mechanism models, run on the Exudyn multibody library.
 
+Load a model (``load``, ``loads``) or build one (``Model``), run an analysis (``run``), get a
+``Results`` table of named columns (``crank.fi``, ``motor.Mz``, …), compare it with a
+reference (``compare``) or export the model as a standalone Exudyn script (``export``).
+The API reference is docs/api.md.
+
 >>> import pam2exu
 >>> model = pam2exu.load("examples/slider_crank.toml")      # doctest: +SKIP
 >>> res = pam2exu.run(model, analysis="kinematic")          # doctest: +SKIP
@@ -18,7 +23,98 @@ __version__ = "0.1.0"
 def run(model, analysis=None, **settings):
     """Run an analysis of a model (a Model or a path); returns a Results table.
 
-    See ``pam2exu.analyses.run`` for the settings.
+    The settings default to the model's ``[analysis]`` table (``Model.analysis``); the
+    arguments override them for this run. Columns are ``<name>.<variable>`` under PAM's
+    names, in SI units (``Results.units``). The warnings of the run (redundant constraints,
+    a singular position nearby, a power balance not met) are issued and also kept in
+    ``Results.warnings``. The same as ``pam2exu.analyses.run``.
+
+    Parameters
+    ----------
+    model : Model, str or Path
+        A model, or the path of a model file (read with ``load``).
+    analysis : str, optional
+        ``'assembly'`` (positions at t = 0, free degrees of freedom allowed),
+        ``'quasi_static'`` (positions and static reactions), ``'kinematic'`` (positions,
+        velocities, accelerations) or ``'kinetostatic'`` (kinematic, plus every reaction
+        and actuator force by inverse dynamics). Default: the model's analysis type.
+    **settings
+        Keyword overrides of the model's settings: ``t_end``, ``steps``, ``outputs`` and
+        ``solver``, described below. None (the default of each) keeps the model's.
+    t_end : float, optional
+        End of the interval [0, t_end] [s].
+    steps : int, optional
+        Number of intervals: results have steps + 1 rows, t_k = k t_end / steps (an
+        assembly has one row, t = 0).
+    outputs : list of str, optional
+        Names or patterns of the columns to compute and keep: full names (``crank.fi``),
+        ``crank.*``, ``*.Fx`` or a bare ``Fx`` (every ``*.Fx``); only what they need is
+        computed.
+    solver : pam2exu.backend.SolveSettings, optional
+        Exudyn's static solver settings: ``tolerance`` (Newton's absolute tolerance
+        relative to the mechanism's length, default 1e-13), ``max_iterations``, ``dense``,
+        ``verbose``.
+
+    Returns
+    -------
+    Results
+        The table of columns over time: ``res["crank.fi"]``, ``res.t`` [s], ``res.units``,
+        ``res.warnings``, ``res.info``.
+
+    Raises
+    ------
+    ModelError
+        The model file cannot be read or the model has problems; a setting is out of range
+        (e.g. ``t_end`` ≤ 0, ``steps`` < 1, an unknown analysis type); a pattern of
+        ``outputs`` matches no column of the analysis.
+    MobilityError
+        quasi_static, kinematic, kinetostatic: some degree of freedom is not driven by an
+        actuator (the message names the solids that can move).
+    SolverError
+        Exudyn's solver did not converge, or the mechanism reaches a singular (dead-point)
+        position it cannot pass; ``time`` [s] and ``step`` say where.
+    TranslationError
+        A self-check failed: a bug of pam2exu, to be reported with the model file.
+    TypeError
+        A keyword that is not one of the settings above.
+
+    Warns
+    -----
+    RedundancyWarning
+        Redundant (consistent) constraints: the reactions of the elements named are the
+        minimum-norm solution.
+    ConditionWarning
+        The mechanism passes at or near a singular position.
+    ConsistencyWarning
+        kinetostatic: the power balance does not hold.
+
+    See Also
+    --------
+    pam2exu.analyses.run : the same, with the settings as named arguments.
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> m = pam2exu.Model("crank", gravity=0.0)
+    >>> m.add_solid("ground").name
+    'ground'
+    >>> m.add_solid("crank", points={"O": [0, 0], "A": [0.1, 0]}).name
+    'crank'
+    >>> m.add("fixed", anc1="ground").name
+    'fixed1'
+    >>> m.add("revolute", name="O", anc1="ground", anc2="crank.O").name
+    'O'
+    >>> m.add("angular_actuator", name="motor", anc1="ground", anc2="crank",
+    ...       C=[0.0, 6.0]).name                     # fi = 6 t [rad]
+    'motor'
+    >>> res = pam2exu.run(m, analysis="kinematic", t_end=0.5, steps=10)
+    >>> res
+    <Results kinematic 'crank': 11 rows × 20 columns>
+    >>> round(float(res["crank.fi"][-1]), 12), res.units["crank.Dfi"]
+    (3.0, 'rad/s')
+    >>> res = pam2exu.run("examples/slider_crank.toml", outputs=["motor.Mz"])  # doctest: +SKIP
+    >>> res.columns                                                           # doctest: +SKIP
+    ['motor.Mz']
     """
     from .analyses import run as _run
     return _run(model, analysis=analysis, **settings)

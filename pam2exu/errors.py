@@ -6,12 +6,48 @@ from dataclasses import dataclass
 
 
 class Pam2ExuError(Exception):
-    """Base class of pam2exu's errors: the message is meant for the user, as is."""
+    """Base class of pam2exu's errors: the message is meant for the user, as is.
+
+    Catch this class to handle every error pam2exu raises on purpose (``ModelError``,
+    ``MobilityError``, ``SolverError``, ``TranslationError``, and
+    ``pam2exu.results.CompareInputError``, ``pam2exu.results.plot.PictureError``).
+
+    Parameters
+    ----------
+    message : str
+        What went wrong and what to change, one paragraph (``str(error)``).
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> try:
+    ...     pam2exu.loads("")          # a model without solids
+    ... except pam2exu.Pam2ExuError as error:
+    ...     print(type(error).__name__, "-", error)
+    ModelError - <string>: model: there are no solids: add at least one [[solid]]
+    """
 
 
 @dataclass(frozen=True)
 class Problem:
-    """One thing wrong with a model: where it is and what to change."""
+    """One thing wrong with a model: where it is and what to change.
+
+    ``ModelError.problems`` is a list of these; ``Model.problems()`` returns one.
+    ``str(problem)`` is ``"<where>: <message>"`` (just the message when ``where`` is empty).
+
+    Parameters
+    ----------
+    where : str
+        The place in the model: ``"[[solid]] #2 'crank'"``, ``"[[element]] #3 'A'
+        (revolute)"``, ``"[analysis]"``, ``"[model]"``, … ('' when it concerns no one place).
+    message : str
+        What is wrong and what to change.
+
+    Examples
+    --------
+    >>> str(Problem("[analysis]", "steps must be a positive whole number, got 0"))
+    '[analysis]: steps must be a positive whole number, got 0'
+    """
 
     where: str
     message: str
@@ -23,7 +59,33 @@ class Problem:
 class ModelError(Pam2ExuError):
     """The model is wrong: every problem found is listed, nothing was computed.
 
-    CLI exit code 2.
+    Raised by ``load``, ``loads``, ``Model.validate``, ``Model.mechanism``, ``run`` (also
+    for analysis settings that are out of range and ``outputs`` patterns that match no
+    column) and ``export``. CLI exit code 2.
+
+    Parameters
+    ----------
+    problems : list of Problem, Problem or str
+        Every problem found; a str is a problem without a place.
+    source : str, optional
+        The model file (or ``"<string>"``), put in front of the message.
+
+    Attributes
+    ----------
+    problems : list of Problem
+        Every problem found, in file order.
+    source : str or None
+        The model file, when known.
+
+    Examples
+    --------
+    >>> error = ModelError([Problem("[model]", "gravity must be ≥ 0"), "no solids"], "m.toml")
+    >>> print(error)
+    m.toml: 2 problems in the model:
+      - [model]: gravity must be ≥ 0
+      - no solids
+    >>> [p.where for p in error.problems]
+    ['[model]', '']
     """
 
     def __init__(self, problems: list[Problem] | Problem | str, source: str | None = None):
@@ -43,7 +105,21 @@ class ModelError(Pam2ExuError):
 
 
 class MobilityError(ModelError):
-    """The actuators do not drive every degree of freedom, or the constraints contradict each other."""
+    """The actuators do not drive every degree of freedom.
+
+    A ``ModelError`` (CLI exit code 2): the quasi_static, kinematic and kinetostatic analyses
+    (and ``export``) need every degree of freedom driven by an actuator or a fixed link; the
+    assembly analysis accepts free degrees of freedom. The message names the solids that can
+    still move. (Constraints that contradict each other are found by the solver instead: a
+    ``SolverError`` naming the constraints that cannot all hold.)
+
+    Parameters
+    ----------
+    problems : list of Problem, Problem or str
+        As for ``ModelError``.
+    source : str, optional
+        The model file.
+    """
 
 
 class SolverError(Pam2ExuError):
@@ -51,6 +127,33 @@ class SolverError(Pam2ExuError):
 
     Carries the time and step where it happened and the elements whose constraints are
     violated most. CLI exit code 1.
+
+    Parameters
+    ----------
+    message : str
+        What happened, where, and what to try.
+    time : float, optional
+        Time where it happened [s] (for a dead point: the last time solved before it).
+    step : int, optional
+        Index of the time step where it happened (0 is t = 0).
+    elements : tuple of str
+        Descriptions of the elements whose constraints are violated most, worst first
+        (``"'B' (revolute)"``); empty when not known.
+
+    Attributes
+    ----------
+    time : float or None
+        As the parameter [s].
+    step : int or None
+        As the parameter.
+    elements : tuple of str
+        As the parameter.
+
+    Examples
+    --------
+    >>> error = SolverError("did not converge", time=0.25, step=50)
+    >>> error.time, error.step, error.elements
+    (0.25, 50, ())
     """
 
     def __init__(self, message: str, time: float | None = None, step: int | None = None,
@@ -62,7 +165,14 @@ class SolverError(Pam2ExuError):
 class TranslationError(Pam2ExuError):
     """Exudyn's configuration does not satisfy pam2exu's own constraint equations.
 
-    This is a bug in the translation of the named element, not a user error.
+    This is a bug in the translation of the named element, not a user error. Raised by the
+    self-checks after an analysis: the constraint residual at Exudyn's configuration, and
+    (quasi_static) Exudyn's multipliers against the native equilibrium. CLI exit code 1.
+
+    Parameters
+    ----------
+    message : str
+        The element, the time and the size of the violation.
     """
 
 

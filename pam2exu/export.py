@@ -145,7 +145,53 @@ sys.exit(0 if solved == steps + 1 else 1)
 
 def script(model, t_end: float | None = None, steps: int | None = None,
            forces: bool = False, file: str = "script.py") -> str:
-    """The source of the standalone Exudyn script of a model (see ``export``)."""
+    """The source of the standalone Exudyn script of a model (see ``export``).
+
+    Parameters
+    ----------
+    model : Model, str or Path
+        A model, or the path of a model file.
+    t_end : float, optional
+        End of the interval [s] (default: the model's [analysis] t_end).
+    steps : int, optional
+        Number of intervals (default: the model's [analysis] steps).
+    forces : bool
+        Include masses, gravity, springs and loads (see ``export``).
+    file : str
+        The script's file name, used in its docstring and for its default CSV file
+        (``<stem>.csv``).
+
+    Returns
+    -------
+    str
+        Python source that imports only ``exudyn`` and ``numpy`` (and the standard
+        library).
+
+    Raises
+    ------
+    ModelError
+        The model or a setting has problems; ``MobilityError`` when a degree of freedom is
+        not driven.
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> from pam2exu.export import script
+    >>> m = pam2exu.Model("crank", gravity=0.0)
+    >>> m.add_solid("ground").name, m.add("fixed", anc1="ground").name
+    ('ground', 'fixed1')
+    >>> m.add_solid("crank", points={"O": [0, 0], "A": [0.1, 0]}).name
+    'crank'
+    >>> m.add("revolute", anc1="ground", anc2="crank.O").name
+    'revolute1'
+    >>> m.add("angular_actuator", anc1="ground", anc2="crank", C=[0.0, 6.0]).name
+    'angular_actuator1'
+    >>> source = script(m, t_end=1.0, steps=10, file="crank.py")
+    >>> compile(source, "crank.py", "exec") is not None
+    True
+    >>> "import exudyn as exu" in source, "def polynomial(t, C1, C2, C3, C4):" in source
+    (True, True)
+    """
     from .analyses.common import check_mobility, prepare
     from .backend.script import ScriptSystem, code
     from .backend.system import SolveSettings, solver_options
@@ -233,6 +279,12 @@ def export(model, path, t_end: float | None = None, steps: int | None = None,
            forces: bool = False) -> Path:
     """Write a model as a standalone Exudyn script; returns its path.
 
+    The script (imports: ``exudyn``, ``numpy``) builds the Exudyn system pam2exu builds, one
+    commented block per solid and element, sets the actuators to their laws (plain Python
+    functions) in a pre-step function, solves the positions at every time with Exudyn's
+    static solver and writes x, y, fi of every solid as CSV. ``pam2exu export`` calls this
+    function; the user guide is docs/export.md.
+
     Parameters
     ----------
     model : Model or path
@@ -248,8 +300,29 @@ def export(model, path, t_end: float | None = None, steps: int | None = None,
         Include masses, gravity, springs, dampers' stiffness and loads (the system of the
         quasi-static analysis); positions are the same, the constraints alone decide them.
 
-    Raises ModelError (also MobilityError: the script solves positions, so every degree of
-    freedom must be driven, as for ``run(..., analysis="kinematic")``).
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ModelError
+        The model or a setting has problems.
+    MobilityError
+        A degree of freedom is not driven: the script solves positions, so every degree
+        of freedom must be driven, as for ``run(..., analysis="kinematic")``.
+    OSError
+        The script cannot be written.
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> pam2exu.export("examples/slider_crank.toml", "slider_crank_exudyn.py")  # doctest: +SKIP
+    PosixPath('slider_crank_exudyn.py')
+
+    Then ``python slider_crank_exudyn.py positions.csv`` writes t and x, y, fi of every
+    solid; they equal ``pam2exu.run(model, analysis="kinematic")`` to round-off.
     """
     path = Path(path)
     path.write_text(script(model, t_end, steps, forces, file=path.name), encoding="utf-8")

@@ -89,13 +89,61 @@ LAW_ALIASES = {"polinomica": "polynomial", "harmonica": "harmonic", "rampa": "ra
 
 
 def law_names() -> list[str]:
-    """All accepted law names, canonical first."""
+    """All accepted law names, canonical first.
+
+    Returns
+    -------
+    list of str
+        The names of ``LAWS``, then the Catalan aliases of ``LAW_ALIASES``.
+
+    Examples
+    --------
+    >>> law_names()[:5]
+    ['polynomial', 'harmonic', 'ramp', 'bezier_c1', 'bezier_c2']
+    >>> law_names()[5:]
+    ['polinomica', 'harmonica', 'rampa']
+    """
     return [*LAWS, *LAW_ALIASES]
 
 
 @dataclass(frozen=True)
 class Law:
-    """A time law ``name`` with constants ``C = (C1, C2, C3, C4)``."""
+    """A time law ``name`` with constants ``C = (C1, C2, C3, C4)``.
+
+    The law of an actuator: f(t) is the relative angle fi2 − fi1 [rad] of an
+    angular_actuator, or the distance PQ [m] of a linear_actuator. Below, [u] is that unit.
+
+    - ``polynomial``: f = C1 + C2 t + C3 t² + C4 t³; C1 [u], C2 [u/s], C3 [u/s²], C4 [u/s³].
+    - ``harmonic``: f = C1 + C2 cos(C3 t + C4); C1 [u], C2 [u], C3 [rad/s], C4 [rad].
+    - ``ramp``: f = C3 + (C4 − C3) u with u = (t − C1)/(C2 − C1) on C1 ≤ t < C2, C3 before
+      C1 and C4 from C2 on; C1 [s], C2 [s], C3 [u], C4 [u]. f' jumps at C1 and C2.
+    - ``bezier_c1``: as ramp, with s(u) = 3u² − 2u³ instead of u: f' is continuous.
+    - ``bezier_c2``: as ramp, with s(u) = 6u⁵ − 15u⁴ + 10u³: f' and f'' are continuous.
+
+    The transition laws (ramp, bezier_c1, bezier_c2) need C1 < C2 (checked by the model's
+    validation) and take the right-hand limit at C1 and C2.
+
+    Parameters
+    ----------
+    name : str
+        One of ``law_names()``; a Catalan alias (``polinomica``, ``harmonica``, ``rampa``)
+        is replaced by its canonical name.
+    C : sequence of float
+        Up to four constants C1 … C4, in the units of the list above ([s], [u], [u/s],
+        …); missing ones are 0. Neither the name nor the number of constants is checked
+        here (the model's validation does that): an unknown name fails when the law is
+        evaluated.
+
+    Examples
+    --------
+    >>> law = Law("harmonic", [0.0, 0.5, 6.0])
+    >>> law.C
+    (0.0, 0.5, 6.0, 0.0)
+    >>> law.value(0.0)
+    0.5
+    >>> Law("rampa", [1.0, 2.0, 0.0, 0.3]).name
+    'ramp'
+    """
 
     name: str = "polynomial"
     C: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
@@ -106,7 +154,34 @@ class Law:
         object.__setattr__(self, "C", C + (0.0,) * (4 - len(C)))
 
     def __call__(self, t, xp=np):
-        """(f, f', f'') at time(s) t [s]."""
+        """(f, f', f'') at time(s) t [s].
+
+        Parameters
+        ----------
+        t : float or array_like
+            Time or times [s].
+        xp : module
+            Array namespace with ``where``, ``cos`` and ``sin`` (default NumPy). With NumPy
+            the three arrays have the shape of ``t``; with another namespace they are
+            whatever its operations return.
+
+        Returns
+        -------
+        f, df, ddf : numpy.ndarray
+            The law [u], its first [u/s] and second [u/s²] time derivatives, where [u] is
+            rad (angular actuator) or m (linear actuator).
+
+        Raises
+        ------
+        KeyError
+            The law's name is not one of ``law_names()``.
+
+        Examples
+        --------
+        >>> f, df, ddf = Law("polynomial", [0.0, 2.0, 0.0, 1.0])([0.0, 1.0])
+        >>> f.tolist(), df.tolist(), ddf.tolist()
+        ([0.0, 3.0], [2.0, 5.0], [0.0, 6.0])
+        """
         if xp is np:
             t = np.asarray(t, dtype=float)
             f, df, ddf = LAWS[self.name][0](t, self.C, xp)
@@ -116,9 +191,37 @@ class Law:
         return LAWS[self.name][0](t, self.C, xp)
 
     def value(self, t: float) -> float:
-        """f(t) for a scalar t, as a Python float (used in solver callbacks)."""
+        """f(t) for a scalar t, as a Python float (used in solver callbacks).
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+
+        Returns
+        -------
+        float
+            f(t) [rad or m, as the actuator].
+
+        Raises
+        ------
+        KeyError
+            The law's name is not one of ``law_names()``.
+        """
         return float(self(t)[0])
 
     def breakpoints(self) -> tuple[float, ...]:
-        """Times where f' or f'' may jump: C1 and C2 of the transition laws, none otherwise."""
+        """Times where f' or f'' may jump: C1 and C2 of the transition laws, none otherwise.
+
+        Returns
+        -------
+        tuple of float
+            ``(C1, C2)`` [s] for ramp, bezier_c1 and bezier_c2; ``()`` for polynomial and
+            harmonic.
+
+        Examples
+        --------
+        >>> Law("ramp", [0.5, 1.0, 0.0, 1.0]).breakpoints()
+        (0.5, 1.0)
+        """
         return self.C[:2] if LAWS[self.name][1] else ()

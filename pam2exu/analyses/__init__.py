@@ -1,4 +1,8 @@
-"""The analyses of PAM; ``ANALYSES`` is the registry from type name to function."""
+"""The analyses of PAM; ``ANALYSES`` is the registry from type name to function.
+
+``run`` runs one (``pam2exu.run`` is the same); the warning classes are those the checks
+after an analysis issue.
+"""
 from __future__ import annotations
 
 from ..errors import ModelError, Problem
@@ -16,6 +20,10 @@ ANALYSES = {"assembly": assembly, "quasi_static": quasi_static, "kinematic": kin
 def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None):
     """Run an analysis and return its Results.
 
+    ``pam2exu.run`` is this function, with ``t_end``, ``steps``, ``outputs`` and ``solver``
+    passed as keywords; its documentation has the details and an example. None keeps the
+    model's ``[analysis]`` setting.
+
     Parameters
     ----------
     model : Model or path
@@ -31,6 +39,34 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None)
         Names or patterns of the columns to compute and keep.
     solver : backend.SolveSettings, optional
         Exudyn solver settings.
+
+    Returns
+    -------
+    Results
+        The chosen columns over time; ``Results.t`` are the times [s].
+
+    Raises
+    ------
+    ModelError
+        The model or a setting has problems, or an ``outputs`` pattern matches nothing.
+    MobilityError
+        A degree of freedom is not driven (all analyses but assembly).
+    SolverError
+        Exudyn's solver did not converge, or a singular position was reached.
+    TranslationError
+        A self-check failed (a bug of pam2exu).
+
+    Warns
+    -----
+    RedundancyWarning, ConditionWarning, ConsistencyWarning
+        See each class; the texts are kept in ``Results.warnings`` too.
+
+    Examples
+    --------
+    >>> from pam2exu.analyses import run
+    >>> res = run("examples/four_bar.toml", "quasi_static", steps=20)  # doctest: +SKIP
+    >>> len(res)                                                       # doctest: +SKIP
+    21
     """
     job = prepare(model, analysis, t_end, steps, outputs, solver)
     if job.analysis not in ANALYSES:

@@ -16,7 +16,37 @@ _TABLES = ("model", "solid", "element", "analysis")
 
 
 def load(path: str | Path) -> Model:
-    """Read a model file; raises ModelError naming the file and every problem in it."""
+    """Read a model file; raises ModelError naming the file and every problem in it.
+
+    The file is TOML with the tables ``[model]`` (name, gravity), ``[[solid]]``,
+    ``[[element]]`` and ``[analysis]`` (type, t_end, steps, outputs); the format is
+    docs/model-format.md. Every problem is collected before the error is raised; mobility
+    is checked later, by ``run``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The model file (UTF-8).
+
+    Returns
+    -------
+    Model
+        The model, validated (``problems()`` is empty), with ``source`` set to ``path``.
+
+    Raises
+    ------
+    ModelError
+        The file cannot be read, is not valid TOML, or has problems: unknown tables or
+        keys, unknown element types, bad values or anchors, repeated names, bad
+        ``[analysis]`` settings. The message names the file and lists every problem.
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> model = pam2exu.load("examples/slider_crank.toml")          # doctest: +SKIP
+    >>> model.analysis.type, [s.name for s in model.solids]         # doctest: +SKIP
+    ('kinetostatic', ['ground', 'crank', 'rod', 'slider'])
+    """
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -26,7 +56,54 @@ def load(path: str | Path) -> Model:
 
 
 def loads(text: str, source: str = "<string>") -> Model:
-    """Parse a model from TOML text (see ``load``)."""
+    """Parse a model from TOML text (see ``load``).
+
+    Parameters
+    ----------
+    text : str
+        The model, in the TOML format of a model file.
+    source : str
+        Where the text comes from, named in error messages and used as ``Model.source``;
+        its stem is the model's name when ``[model]`` has none.
+
+    Returns
+    -------
+    Model
+        The model, validated (``problems()`` is empty).
+
+    Raises
+    ------
+    ModelError
+        The text is not valid TOML, or the model has problems (as for ``load``).
+
+    Examples
+    --------
+    >>> model = loads('''
+    ... [model]
+    ... name = "pendulum"
+    ...
+    ... [[solid]]
+    ... name = "ground"
+    ...
+    ... [[solid]]
+    ... name = "bar"
+    ... mass = 1.0
+    ... points = { O = [0.0, 0.0] }
+    ...
+    ... [[element]]
+    ... type = "enllac_fix"
+    ... anc1 = "ground"
+    ...
+    ... [analysis]
+    ... type = "assembly"
+    ... ''')
+    >>> model.name, model.gravity, [e.type for e in model.elements]
+    ('pendulum', 9.81, ['fixed'])
+    >>> loads("solid = [{ name = 'a', mas = 1.0 }]", source="demo.toml")
+    Traceback (most recent call last):
+    ...
+    pam2exu.errors.ModelError: demo.toml: [[solid]] #1 'a': unknown key 'mas' (did you ...
+    """
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -24,7 +24,31 @@ def _number(v) -> bool:
 
 @dataclass
 class Analysis:
-    """What to run: ``type``, the interval [0, ``t_end``] in ``steps`` intervals, ``outputs``."""
+    """What to run: ``type``, the interval [0, ``t_end``] in ``steps`` intervals, ``outputs``.
+
+    The ``[analysis]`` table of a model file, ``Model.analysis`` in Python: the defaults of
+    ``run``, whose arguments override them for one run. Values are checked by
+    ``problems`` (called by ``Model.problems`` and by ``run``), not here.
+
+    Parameters
+    ----------
+    type : str
+        ``'assembly'``, ``'quasi_static'``, ``'kinematic'`` or ``'kinetostatic'``
+        (``ANALYSIS_TYPES``).
+    t_end : float
+        End of the interval [0, t_end] [s], > 0 (not used by an assembly, which solves
+        t = 0 only).
+    steps : int
+        Number of intervals, ≥ 1: results have steps + 1 rows at t_k = k t_end / steps.
+    outputs : list of str, optional
+        Names or patterns of the columns to compute and keep (``crank.fi``, ``crank.*``,
+        ``*.Fx`` or a bare ``Fx``); None keeps every column of the analysis.
+
+    Examples
+    --------
+    >>> Analysis("kinematic", t_end=0.0, steps=10).problems()
+    ['t_end must be a positive number of seconds, got 0.0']
+    """
 
     type: str = "kinematic"
     t_end: float = 1.0
@@ -32,6 +56,14 @@ class Analysis:
     outputs: list[str] | None = None
 
     def problems(self) -> list[str]:
+        """What is wrong with these settings, one message each (empty when they are sound).
+
+        Returns
+        -------
+        list of str
+            Messages without a place (``Model.problems`` puts them under
+            ``"[analysis]"``).
+        """
         out = []
         if self.type not in ANALYSIS_TYPES:
             out.append(f"unknown analysis type '{self.type}'{closest(self.type, ANALYSIS_TYPES)}; "
@@ -50,6 +82,38 @@ class Analysis:
 class Model:
     """A PAM model: solids, elements and the analysis to run.
 
+    Build it in Python with ``add_solid`` and ``add``, or read it from a file with ``load``;
+    run it with ``pam2exu.run``. ``add_solid`` and ``add`` reject unknown keys and element
+    types at once; values, anchors and names are checked by ``problems``, ``validate``,
+    ``mechanism`` and ``run``, which report every problem at once. ``model[name]`` is the
+    solid or element of that name (``KeyError`` when there is none).
+
+    Parameters
+    ----------
+    name : str
+        The model's name, shown in results, pictures and messages.
+    gravity : float
+        Magnitude of the gravitational acceleration, along −y [m/s²], ≥ 0 (0: none).
+        Used by the quasi_static and kinetostatic analyses.
+    source : str, optional
+        The model file, named in error messages (set by ``load``).
+
+    Attributes
+    ----------
+    name : str
+        As the parameter.
+    gravity : float
+        As the parameter [m/s²].
+    source : str or None
+        As the parameter.
+    solids : list of Solid
+        The solids, in the order they were added (the order of the coordinates).
+    elements : list of Element
+        The elements (``pam2exu.ELEMENTS`` classes), in the order they were added.
+    analysis : Analysis
+        The default analysis settings (``[analysis]`` of a file): kinematic, t_end = 1 s,
+        100 steps, every output.
+
     Examples
     --------
     >>> m = Model("pendulum", gravity=9.81)
@@ -59,6 +123,12 @@ class Model:
     Solid(...)
     >>> m.add("fixed", anc1="ground").name
     'fixed1'
+    >>> m.add("revolute", name="O", anc1="ground.O", anc2="bar.O").type
+    'revolute'
+    >>> m["bar"].mass
+    1.0
+    >>> [str(p) for p in m.problems()]
+    []
     """
 
     def __init__(self, name: str = "model", gravity: float = 9.81, source: str | None = None):
@@ -71,7 +141,38 @@ class Model:
 
     # ---- building ----------------------------------------------------------------------
     def add_solid(self, solid: Solid | str, **keys) -> Solid:
-        """Add a solid (a Solid, or a name and its keys); returns it."""
+        """Add a solid (a Solid, or a name and its keys); returns it.
+
+        Parameters
+        ----------
+        solid : Solid or str
+            A Solid, or the name of a new one.
+        **keys
+            The new solid's keys, as for ``Solid``: ``x``, ``y`` [m], ``fi`` [rad],
+            ``mass`` [kg], ``inertia`` [kg·m²], ``cog`` [m], ``points`` [m], ``lines``
+            [m, rad]. Not used when ``solid`` is a Solid.
+
+        Returns
+        -------
+        Solid
+            The solid added (its ``position`` set to its number in the model when unset).
+
+        Raises
+        ------
+        ModelError
+            A key that a solid does not have (the message suggests the nearest). The values
+            and the name are checked later, by ``problems``.
+
+        Examples
+        --------
+        >>> m = Model("demo")
+        >>> m.add_solid("crank", fi=0.3, points={"O": [0, 0], "A": [0.1, 0]}).position
+        1
+        >>> m.add_solid("rod", lenght=0.3)
+        Traceback (most recent call last):
+        ...
+        pam2exu.errors.ModelError: a solid has no key 'lenght'
+        """
         if not isinstance(solid, Solid):
             allowed = [f.name for f in fields(Solid)]
             unknown = [k for k in keys if k not in allowed]
@@ -85,7 +186,45 @@ class Model:
         return solid
 
     def add(self, element: Element | str, **keys) -> Element:
-        """Add an element (an Element, or a type name or Catalan alias and its keys)."""
+        """Add an element (an Element, or a type name or Catalan alias and its keys).
+
+        ``add_element`` is the same method.
+
+        Parameters
+        ----------
+        element : Element or str
+            An element object (``pam2exu.Revolute(name="A", anc1="crank.A",
+            anc2="rod.A")``), or a type name of ``pam2exu.ELEMENTS`` (``"revolute"``) or its
+            Catalan alias (``"articulacio"``).
+        **keys
+            The new element's keys: ``name``, the anchors ``anc1`` and ``anc2`` (a
+            ``"solid"``, ``"solid.point"`` or ``"solid.line"``, as the type requires) and
+            the keys of its type (``law`` and ``C`` of an actuator, ``T``, ``C`` and ``arm``
+            of a transmission, …; see the element types). Not used when ``element`` is an
+            Element.
+
+        Returns
+        -------
+        Element
+            The element added. Without a name it is named ``<type><n>``, n counting the
+            elements of its type (``revolute2``); its ``position`` is set to its number in
+            the model when unset.
+
+        Raises
+        ------
+        ModelError
+            An unknown element type, or a key its type does not have (the message suggests
+            the nearest). Anchors and values are checked later, by ``problems``.
+
+        Examples
+        --------
+        >>> m = Model("demo")
+        >>> m.add("articulacio", anc1="ground.O", anc2="crank.O").name
+        'revolute1'
+        >>> m.add("angular_actuator", anc1="ground", anc2="crank", law="harmonic",
+        ...       C=[0.0, 0.5, 6.0]).type
+        'angular_actuator'
+        """
         if isinstance(element, str):
             kind = ALIASES.get(element, element)
             if kind not in ELEMENTS:
@@ -110,6 +249,7 @@ class Model:
     add_element = add
 
     def __getitem__(self, name: str) -> Solid | Element:
+        """The solid or element named ``name``; KeyError (suggesting the nearest) if none."""
         for item in (*self.solids, *self.elements):
             if item.name == name:
                 return item
@@ -118,7 +258,28 @@ class Model:
 
     # ---- validation --------------------------------------------------------------------
     def problems(self) -> list[Problem]:
-        """Every problem in the model, in file order (empty when the model is sound)."""
+        """Every problem in the model, in file order (empty when the model is sound).
+
+        Checks gravity, each solid's values, each element's keys and anchors, that names are
+        unique (solids and elements share one namespace), and the ``analysis`` settings. It
+        does not check mobility, which needs the numerics: ``run`` does, and raises
+        ``MobilityError`` when a degree of freedom is not driven.
+
+        Returns
+        -------
+        list of Problem
+            Each with ``where`` (``"[[element]] #3 'A' (revolute)"``) and ``message``.
+
+        Examples
+        --------
+        >>> m = Model("demo", gravity=-9.81)
+        >>> m.add_solid("crank", mass=-1.0).name
+        'crank'
+        >>> for problem in m.problems():
+        ...     print(problem)
+        [model]: gravity is the magnitude along −y, a number ≥ 0; got -9.81
+        [[solid]] #1 'crank': mass is negative (-1.0): it must be ≥ 0
+        """
         out: list[Problem] = []
         if not _number(self.gravity) or self.gravity < 0:
             out.append(Problem("[model]", f"gravity is the magnitude along −y, a number ≥ 0; "
@@ -138,13 +299,30 @@ class Model:
         return out
 
     def validate(self) -> None:
-        """Raise ModelError listing every problem, if there is any."""
+        """Raise ModelError listing every problem, if there is any.
+
+        Raises
+        ------
+        ModelError
+            ``problems()`` is not empty; the error's ``problems`` lists them all.
+        """
         problems = self.problems()
         if problems:
             raise ModelError(problems, self.source)
 
     def mechanism(self) -> "Mechanism":
-        """The validated, resolved model (raises ModelError)."""
+        """The validated, resolved model (raises ModelError).
+
+        Returns
+        -------
+        Mechanism
+            A snapshot: the solids, and copies of the elements with their anchors resolved.
+
+        Raises
+        ------
+        ModelError
+            The model has problems (see ``problems``).
+        """
         self.validate()
         return Mechanism(self)
 
@@ -205,7 +383,29 @@ class Mechanism:
     """A validated model with its anchors resolved: what translation and analyses use.
 
     The generalized coordinates are q = (x, y, fi) of each solid in order, so solid i
-    owns q[3i:3i+3].
+    owns q[3i:3i+3]. Made by ``Model.mechanism()``, which validates the model first.
+
+    Parameters
+    ----------
+    model : Model
+        A model without problems (not checked here: use ``Model.mechanism``).
+
+    Attributes
+    ----------
+    model : Model
+        The model it was made from.
+    solids : list of Solid
+        The model's solids, in order.
+    elements : list of Element
+        Copies of the model's elements, bound to their anchors (``ref1``, ``ref2``).
+    constraints : list of Element
+        The elements that add constraint equations, in order.
+    rows : list of slice
+        The rows of each constraint element's equations in C(q, t) = 0.
+    n_equations : int
+        Number of constraint equations.
+    index : dict
+        Solid name → index i (its coordinates are q[3i:3i+3]).
     """
 
     model: Model
@@ -230,29 +430,62 @@ class Mechanism:
 
     @property
     def name(self) -> str:
+        """The model's name."""
         return self.model.name
 
     @property
     def gravity(self) -> float:
+        """Magnitude of the gravitational acceleration, along −y [m/s²]."""
         return float(self.model.gravity)
 
     @property
     def nq(self) -> int:
+        """Number of generalized coordinates, 3 per solid."""
         return 3 * len(self.solids)
 
     def initial_q(self):
-        """The initial guess q0 from the solids' x, y, fi."""
+        """The initial guess q0 from the solids' x, y, fi.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (nq,): x [m], y [m], fi [rad] of each solid in order.
+        """
         import numpy as np
         return np.array([float(v) for s in self.solids for v in (s.x, s.y, s.fi)])
 
     def owner_of_row(self, row: int) -> Element:
+        """The constraint element whose equations include row ``row``.
+
+        Parameters
+        ----------
+        row : int
+            A row of C(q, t) = 0, 0 … n_equations − 1.
+
+        Returns
+        -------
+        Element
+            One of ``constraints``.
+
+        Raises
+        ------
+        IndexError
+            ``row`` is not a row of the equations.
+        """
         for el, rows in zip(self.constraints, self.rows):
             if rows.start <= row < rows.stop:
                 return el
         raise IndexError(row)
 
     def scale(self) -> float:
-        """A length typical of the mechanism [m]: the largest point or pose offset, at least 1e-3."""
+        """A length typical of the mechanism [m]: the largest point or pose offset, at least 1e-3.
+
+        Returns
+        -------
+        float
+            max(1e-3, |x|, |y| of every solid, |coordinates| of every point) [m]; the
+            scale of the solver tolerances and self-checks.
+        """
         values = [abs(float(v)) for s in self.solids for v in (s.x, s.y)]
         values += [abs(float(c)) for s in self.solids for p in s.points.values() for c in p]
         return max([1e-3, *values])

@@ -12,24 +12,41 @@ from ..errors import closest
 class Solid:
     """A rigid solid: pose (x, y, fi) of its local frame, inertia, named points and lines.
 
+    Usually made by ``Model.add_solid`` (or a ``[[solid]]`` table of a model file), which
+    takes the same keys. Values are checked by ``Model.problems``, not here.
+
     Parameters
     ----------
     name : str
-        Unique name (shared namespace with elements).
+        Unique name (one namespace with the elements); no '.'.
     x, y : float
-        Origin of the local frame [m]; an initial guess, or the pose of a fixed solid.
+        Origin of the local frame in the global frame [m]; an initial guess, or the pose of
+        a solid held by a fixed link.
     fi : float
-        Angle of the local x axis, counter-clockwise [rad].
+        Angle of the local x axis from the global x axis, counter-clockwise [rad]; an
+        initial guess, like x and y.
     mass : float
-        [kg]
+        Mass [kg], ≥ 0 (0: a massless solid).
     inertia : float
-        Moment of inertia about the centre of mass G [kg·m²].
+        Moment of inertia about the centre of mass G [kg·m²], ≥ 0.
     cog : (float, float)
-        G in the local frame [m].
+        Centre of mass G in the local frame [m].
     points : dict
-        ``{name: [x, y]}`` in the local frame [m].
+        ``{name: [x, y]}`` in the local frame [m]; anchors ``"<solid>.<point>"``.
     lines : dict
-        ``{name: {"point": [x, y], "angle": a}}`` in the local frame [m, rad].
+        ``{name: {"point": [x, y], "angle": a}}`` in the local frame: a point of the line
+        [m] and the angle of its direction from the local x axis [rad]; anchors
+        ``"<solid>.<line>"``.
+    position : int, optional
+        1-based position in the model file's ``[[solid]]`` array, for messages (set by the
+        loader, or by ``Model.add_solid`` to the solid's number in the model).
+
+    Examples
+    --------
+    >>> crank = Solid("crank", fi=0.3, mass=0.5, inertia=1e-3, cog=[0.05, 0.0],
+    ...               points={"O": [0, 0], "A": [0.1, 0]})
+    >>> crank.points["A"]
+    [0.1, 0]
     """
 
     name: str
@@ -46,6 +63,7 @@ class Solid:
 
     @property
     def where(self) -> str:
+        """Where the solid is in the model, for messages: ``"[[solid]] #2 'crank'"``."""
         at = f" #{self.position}" if self.position else ""
         return f"[[solid]]{at} '{self.name}'"
 

@@ -41,7 +41,37 @@ def _model(model):
 def configurations(model, t_end: float | None = None, steps: int | None = None,
                    analysis: str = "kinematic") -> tuple[object, np.ndarray, np.ndarray]:
     """(mechanism, t (n,), q (n, 3·solids)) of a run: the assembly (one row at t = 0), or
-    the positions of a kinematic run over [0, t_end] in ``steps`` intervals."""
+    the positions of a kinematic run over [0, t_end] in ``steps`` intervals.
+
+    Parameters
+    ----------
+    model : Model, str or Path
+        A model, or the path of a model file.
+    t_end : float, optional
+        End of the interval [s] (default: the model's t_end); not used by an assembly.
+    steps : int, optional
+        Number of intervals (default: the model's steps); not used by an assembly.
+    analysis : str
+        ``'kinematic'`` (default; needs every degree of freedom driven) or
+        ``'assembly'`` (t = 0 only; free degrees of freedom allowed).
+
+    Returns
+    -------
+    mechanism : Mechanism
+        ``model.mechanism()``.
+    t : numpy.ndarray
+        Times [s], shape (n,).
+    q : numpy.ndarray
+        Shape (n, 3·solids): x [m], y [m], fi [rad] of each solid in order.
+
+    Raises
+    ------
+    ModelError
+        The model has problems (``MobilityError``: a degree of freedom is not driven, for
+        a kinematic run).
+    SolverError
+        Exudyn's solver did not converge.
+    """
     from ..analyses import run
     model = _model(model)
     mech = model.mechanism()
@@ -55,7 +85,35 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
 
 def pose(model, t: float = 0.0):
     """(mechanism, q) at time t: the assembly at t = 0, else a kinematic run from 0 to t
-    with the model's step length."""
+    with the model's step length.
+
+    Parameters
+    ----------
+    model : Model, str or Path
+        A model, or the path of a model file.
+    t : float
+        Time [s], ≥ 0. 0: the assembly (free degrees of freedom allowed); else the last
+        row of a kinematic run over [0, t] in ceil(steps · t / t_end) intervals (the
+        model's step length, or a little shorter), so it follows the same branch as
+        ``run``.
+
+    Returns
+    -------
+    mechanism : Mechanism
+        ``model.mechanism()``.
+    q : numpy.ndarray
+        Shape (3·solids,): x [m], y [m], fi [rad] of each solid at t.
+
+    Raises
+    ------
+    PictureError
+        ``t`` is negative or not a number.
+    ModelError
+        The model has problems (``MobilityError`` for t > 0 when a degree of freedom is not
+        driven).
+    SolverError
+        Exudyn's solver did not converge.
+    """
     model = _model(model)
     if not t:
         mech, _, q = configurations(model, analysis="assembly")
@@ -73,6 +131,19 @@ class Scene:
     ``show(t, q)`` to draw one configuration (removing the previous one).
 
     ``extra`` points (n, 2) widen the box (traced paths).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The Axes to draw on; its limits, aspect, labels (``x [m]``, ``y [m]``) and grid
+        are set here.
+    mech : Mechanism
+        The mechanism (``Model.mechanism()``).
+    q_all : numpy.ndarray
+        Every configuration that will be shown, shape (n, 3·solids) [m, m, rad]: the box
+        holds all of them.
+    extra : array_like
+        More points to keep inside the box, shape (k, 2) [m].
     """
 
     def __init__(self, ax, mech, q_all: np.ndarray, extra=()):
@@ -121,7 +192,15 @@ class Scene:
         return pts.min(axis=0), pts.max(axis=0)
 
     def show(self, t: float, q: np.ndarray) -> None:
-        """Draw the configuration q (3·solids,) at time t."""
+        """Draw the configuration q (3·solids,) at time t.
+
+        Parameters
+        ----------
+        t : float
+            Time [s] (for elements whose symbol depends on it).
+        q : array_like
+            x [m], y [m], fi [rad] of each solid, shape (3·solids,).
+        """
         self.pen.clear()
         st = State([t], np.asarray(q, dtype=float)[None, :])
         pen = self.pen
@@ -140,15 +219,56 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
          size: tuple[float, float] = DRAW_SIZE):
     """Draw the mechanism at time t; returns the matplotlib Figure.
 
+    Solids, joints, guides, springs, actuators, torsors and the global frame, on axes
+    ``x [m]``, ``y [m]`` with equal scales. ``pam2exu draw`` calls this function; the
+    figure is on the Agg canvas (no window opens).
+
     Parameters
     ----------
-    model : Model or path
+    model : Model, str or Path
+        A model, or the path of a model file.
     t : float
-        0 (default): the assembled configuration at t = 0; else the positions of a
-        kinematic run from 0 to t [s] (with the model's step length).
+        Time [s], ≥ 0. 0 (default): the assembled configuration at t = 0; else the
+        positions of a kinematic run from 0 to t (with the model's step length, see
+        ``pose``).
     path : str or Path, optional
-        Image file to write (.png, .svg, .pdf, …).
-    dpi, size : resolution and size [in] of the figure (``size`` × ``dpi`` pixels).
+        Image file to write (.png, .svg, .pdf, …); None writes nothing.
+    dpi : float
+        Resolution [dots per inch].
+    size : (float, float)
+        Width and height of the figure [in] (``size`` × ``dpi`` pixels).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Raises
+    ------
+    PictureError
+        ``t`` is negative or not a number, or the image format of ``path`` is not
+        supported.
+    ModelError
+        The model has problems (``MobilityError`` for t > 0 when a degree of freedom is not
+        driven).
+    SolverError
+        Exudyn's solver did not converge.
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> from pam2exu.pictures import draw
+    >>> m = pam2exu.Model("crank", gravity=0.0)
+    >>> m.add_solid("ground").name, m.add("fixed", anc1="ground").name
+    ('ground', 'fixed1')
+    >>> m.add_solid("crank", fi=0.5, points={"O": [0, 0], "A": [0.1, 0]}).name
+    'crank'
+    >>> m.add("revolute", anc1="ground", anc2="crank.O").name
+    'revolute1'
+    >>> fig = draw(m)                                     # free crank: the assembly is allowed
+    >>> fig.axes[0].get_title()
+    "'crank' — assembled at t = 0"
+    >>> draw("examples/four_bar.toml", t=0.25, path="four_bar.svg")   # doctest: +SKIP
+    <Figure size 800x600 with 1 Axes>
     """
     model = _model(model)
     mech, q = pose(model, t)
@@ -202,24 +322,54 @@ def animate(model, path: str | Path, steps: int | None = None, t_end: float | No
             size: tuple[float, float] = ANIMATION_SIZE) -> Path:
     """Write an animation of the model's kinematic run; returns the path.
 
+    The frames are the positions of a kinematic run over [0, t_end] (the branch ``run``
+    follows), with a clock and the paths of the traced points. A progress bar shows on
+    stderr while the frames are written, when it is a terminal. ``pam2exu animate`` calls
+    this function.
+
     Parameters
     ----------
-    model : Model or path
+    model : Model, str or Path
+        A model, or the path of a model file; every degree of freedom must be driven.
     path : str or Path
         ``.gif`` (Pillow), or ``.mp4`` when ffmpeg is installed.
     steps : int, optional
         Number of intervals: steps + 1 frames (default: the model's steps, at most
-        ``FRAMES``).
+        ``FRAMES`` = 100).
     t_end : float, optional
         End of the motion [s] (default: the model's t_end).
     trace : list of str
-        Points whose paths are drawn (``coupler.P``): the whole path faintly, the part
-        travelled so far in full.
+        Points whose paths are drawn (``coupler.P``; a solid's name for its origin): the
+        whole path faintly, the part travelled so far in full.
     fps : float, optional
-        Frames per second; default steps / t_end (real time) within ``FPS``.
-    dpi, size : resolution and size [in] of each frame.
+        Frames per second [1/s]; default steps / t_end (real time) within ``FPS`` (2 to
+        30).
+    dpi : float
+        Resolution of each frame [dots per inch].
+    size : (float, float)
+        Width and height of each frame [in].
 
-    A progress bar shows on stderr while the frames are written, when it is a terminal.
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    PictureError
+        ``path`` is not .gif or .mp4, or it is .mp4 and ffmpeg is not installed (checked
+        before the run).
+    ModelError
+        The model has problems, or a traced point does not exist (``MobilityError``: a
+        degree of freedom is not driven).
+    SolverError
+        Exudyn's solver did not converge.
+
+    Examples
+    --------
+    >>> from pam2exu.pictures import animate
+    >>> animate("examples/four_bar.toml", "four_bar.gif", trace=["coupler.P"])  # doctest: +SKIP
+    PosixPath('four_bar.gif')
     """
     path = Path(path)
     model = _model(model)

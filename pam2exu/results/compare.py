@@ -39,13 +39,47 @@ _SHOWN = 8                  # names listed in a note before "… and n more"
 class CompareInputError(Pam2ExuError):
     """The tables cannot be compared (missing file, no ``t`` column, nothing in common, …).
 
-    The message names the file and what to change. CLI exit code 2.
+    The message names the file (and the line and column, for a bad value) and what to
+    change. Raised by ``compare``, ``read_names``, ``read_csv`` and ``plot`` (for a CSV
+    file). CLI exit code 2.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong with which file, and what to change.
     """
 
 
 @dataclass(frozen=True)
 class VariableComparison:
-    """One variable found in both tables, over the reference rows compared."""
+    """One variable found in both tables, over the reference rows compared.
+
+    A row of ``Comparison.rows`` (``comparison["crank.fi"]``). Errors, scale and tolerance
+    are in the variable's SI unit [unit].
+
+    Attributes
+    ----------
+    name : str
+        The variable (pam2exu's spelling).
+    max_abs_error : float
+        max_k |result(t_k) − reference(t_k)| [unit]; inf when one table only has a
+        non-finite value at some t_k.
+    max_rel_error : float
+        max_abs_error / scale [–]; nan when scale == 0.
+    t_at_max : float
+        First reference time of the maximum [s]; nan when there is no error.
+    scale : float
+        max_k |reference(t_k)| over its finite values [unit].
+    tolerance : float
+        atol + rtol · scale [unit].
+    passed : bool
+        max_abs_error ≤ tolerance.
+    interpolation_error : float
+        Estimate of the interpolation's own error [unit]; nan when the times are the same
+        or the result has fewer than 7 rows.
+    unit : str
+        The SI unit, from the Results tables ('' when both are CSV files).
+    """
 
     name: str
     max_abs_error: float        # max_k |result(t_k) - reference(t_k)|
@@ -62,8 +96,46 @@ class VariableComparison:
 class Comparison:
     """The comparison table: one row per common variable, and the variables of one table only.
 
-    ``passed`` is True when every common variable is within its tolerance (variables found in
-    one table only do not count). ``str(comparison)`` is ``to_markdown()``.
+    What ``compare`` returns. ``passed`` is True when every common variable is within its
+    tolerance (variables found in one table only do not count). ``str(comparison)`` is
+    ``to_markdown()``; ``comparison["crank.fi"]`` is the row of one variable (KeyError when
+    it was not compared).
+
+    Attributes
+    ----------
+    rows : list of VariableComparison
+        One per variable in both tables, in the result's column order.
+    only_in_result, only_in_reference : list of str
+        Variables found in one table only (not compared).
+    result, reference : str
+        How each table was given: its path, or a description of a Results table.
+    rtol : float
+        Relative tolerance [–].
+    atol : float
+        Absolute tolerance [SI unit of each variable].
+    result_rows, reference_rows : int
+        Number of rows of each table.
+    rows_compared : int
+        Reference rows inside the result's time interval (all when the times are equal).
+    method : str or None
+        ``'cubic'`` or ``'linear'``: how the result was interpolated onto the reference
+        times; None when the times are equal (compared row by row).
+    overlap : (float, float)
+        The time interval compared [s].
+    notes : list of str
+        What was done to read the tables: renamed columns, separators, encodings, unused
+        names-map entries.
+
+    Examples
+    --------
+    >>> from pam2exu.results import Results, compare
+    >>> a = Results([0.0, 1.0], {"crank.fi": [0.0, 6.0], "B.Fx": [1.0, 2.0]})
+    >>> b = Results([0.0, 1.0], {"crank.fi": [0.0, 6.0 + 1e-7]})
+    >>> c = compare(a, b, rtol=1e-6)
+    >>> c.passed, c.only_in_result, c["crank.fi"].max_abs_error < 2e-7
+    (True, ['B.Fx'], True)
+    >>> print(c.verdict())
+    PASS: all 1 common variables within the tolerance
     """
 
     rows: list[VariableComparison]
@@ -96,13 +168,21 @@ class Comparison:
         return self.reference_rows - self.rows_compared
 
     def __getitem__(self, name: str) -> VariableComparison:
+        """The row of variable ``name``; KeyError (suggesting the nearest) if not compared."""
         for r in self.rows:
             if r.name == name:
                 return r
         raise KeyError(f"'{name}' is not compared{closest(name, [r.name for r in self.rows])}")
 
     def header(self) -> list[str]:
-        """The lines above the table: the two tables, how times were matched, the rule, notes."""
+        """The lines above the table: the two tables, how times were matched, the rule, notes.
+
+        Returns
+        -------
+        list of str
+            One line each: the result, the reference, how the times were matched, the
+            pass rule with rtol and atol, then the ``notes``.
+        """
         lo, hi = self.overlap
         if self.method is None:
             times = (f"times: the same {self.reference_rows} times in both, "
@@ -122,7 +202,14 @@ class Comparison:
                 *self.notes]
 
     def verdict(self) -> str:
-        """One line: PASS or FAIL, with the failing variables."""
+        """One line: PASS or FAIL, with the failing variables.
+
+        Returns
+        -------
+        str
+            ``PASS: all n common variables within the tolerance`` or ``FAIL: k of n common
+            variables outside the tolerance: …`` (at most 20 names).
+        """
         n = len(self.rows)
         if self.passed:
             return f"PASS: all {n} common variables within the tolerance"
@@ -131,7 +218,17 @@ class Comparison:
                + _listing(bad, 20)
 
     def to_markdown(self) -> str:
-        """Header as a bullet list, the table, the variables of one table only, the verdict."""
+        """Header as a bullet list, the table, the variables of one table only, the verdict.
+
+        What ``pam2exu compare`` prints. Numbers have 3 significant digits (t 6), '–' where
+        a number does not apply; a unit column when some variable has a unit, an
+        ``interp. error`` column when the result was interpolated.
+
+        Returns
+        -------
+        str
+            Markdown text.
+        """
         cols = ["variable", "max abs error", "max rel error", "at t [s]", "scale", "tolerance"]
         cols += ["interp. error"] if self.method else []
         units = any(r.unit for r in self.rows)
@@ -160,7 +257,23 @@ class Comparison:
 
         Header ``variable,unit,verdict,max_abs_error,max_rel_error,t_at_max,scale,tolerance,
         interpolation_error``; verdict is pass, fail, only in result or only in reference;
-        a number that does not apply is empty.
+        a number that does not apply is empty. Errors, scale and tolerance are in the
+        variable's SI unit, t_at_max in s.
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            The CSV file to write (UTF-8); None returns the text instead.
+
+        Returns
+        -------
+        str or Path
+            The CSV text when ``path`` is None, else ``path``.
+
+        Raises
+        ------
+        OSError
+            The file cannot be written.
         """
         out = io.StringIO()
         w = csv.writer(out, lineterminator="\n")
@@ -304,8 +417,29 @@ def read_names(path: str | Path) -> dict[str, str]:
     """A names map file: two-column CSV ``pam_name,pam2exu_name`` (',' or ';'), one pair a line.
 
     A name with a dot renames one column (``Solid1.fi,crank.fi``); without, a solid or element
-    in every column (``Solid1,crank``). Blank lines, lines starting with '#' and a first line
-    ``pam_name,pam2exu_name`` are skipped.
+    in every column (``Solid1,crank``). Blank lines, lines starting with '#' and a
+    ``pam_name,pam2exu_name`` header line are skipped.
+
+    Parameters
+    ----------
+    path : str or Path
+        The names map file (UTF-8, else read as Windows-1252).
+
+    Returns
+    -------
+    dict
+        PAM name → pam2exu name, for ``compare(..., names=...)``.
+
+    Raises
+    ------
+    CompareInputError
+        The file is missing, a line does not have two names, or a name is mapped twice to
+        different names.
+
+    Examples
+    --------
+    >>> read_names("tests/data/compare/crank_names.csv")      # doctest: +SKIP
+    {'Solid1': 'crank', ...}
     """
     lines = _lines(_text(Path(path), "names map")[0])
     out: dict[str, str] = {}
@@ -521,14 +655,21 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
             names=None, method: str = "cubic") -> Comparison:
     """Compare ``result`` with ``reference`` variable by variable.
 
+    Rows are matched by ``t``. When the times differ, the result is interpolated onto the
+    reference times inside the result's interval (reference rows outside it are not
+    compared) and the interpolation's own error is estimated. ``pam2exu compare`` calls
+    this function; the user guide is docs/compare.md.
+
     Parameters
     ----------
     result, reference : str, Path or Results
         CSV files (header ``t,<name>.<variable>,…``; ',' or ';' separated, decimal comma
         with ';') or Results tables.
-    rtol, atol : float
-        A variable passes when max |result − reference| ≤ atol + rtol · max |reference|
-        [atol in the variable's SI unit].
+    rtol : float
+        Relative tolerance [–], ≥ 0, times the scale max |reference| of each variable.
+    atol : float
+        Absolute tolerance [SI unit of each variable], ≥ 0. A variable passes when
+        max |result − reference| ≤ atol + rtol · max |reference|.
     columns : list of str, optional
         Patterns of the variables to compare: full names, ``crank.*``, ``*.Fx``, bare ``Fx``.
     names : dict, str or Path, optional
@@ -548,7 +689,22 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
     Raises
     ------
     CompareInputError
-        A file is missing or unreadable, has no ``t``, or the tables have nothing in common.
+        A file is missing or unreadable, has no ``t``, the tables have nothing in common or
+        their times do not overlap, a ``columns`` pattern matches nothing, ``rtol`` or
+        ``atol`` is not a number ≥ 0, or ``method`` is unknown.
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> model = pam2exu.load("examples/four_bar.toml")                  # doctest: +SKIP
+    >>> fine = pam2exu.run(model, analysis="kinematic", steps=400)        # doctest: +SKIP
+    >>> coarse = pam2exu.run(model, analysis="kinematic", steps=200)      # doctest: +SKIP
+    >>> table = pam2exu.compare(coarse, fine, rtol=1e-5)                  # doctest: +SKIP
+    >>> table.passed                                                       # doctest: +SKIP
+    True
+    >>> print(table)                                                       # doctest: +SKIP
+    - result: 'four-bar' kinematic results (201 rows)
+    ...
     """
     for label, value in (("rtol", rtol), ("atol", atol)):
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):

@@ -22,11 +22,32 @@ LEGEND_INSIDE = 4
 
 class PictureError(Pam2ExuError):
     """A picture cannot be made as asked: an image format that is not supported, ffmpeg
-    missing for an MP4 file, nothing to plot. CLI exit code 2."""
+    missing for an MP4 file, nothing to plot. CLI exit code 2.
+
+    Raised by ``plot``, ``pictures.draw`` and ``pictures.animate``; the message says what to
+    change.
+
+    Parameters
+    ----------
+    message : str
+        What cannot be done, and what to do instead.
+    """
 
 
 def figure(width: float, height: float, dpi: float = DPI):
-    """A matplotlib Figure on the Agg canvas (never a window), constrained layout."""
+    """A matplotlib Figure on the Agg canvas (never a window), constrained layout.
+
+    Parameters
+    ----------
+    width, height : float
+        Size of the figure [in].
+    dpi : float
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     fig = Figure(figsize=(width, height), dpi=dpi, layout="constrained")
@@ -35,7 +56,25 @@ def figure(width: float, height: float, dpi: float = DPI):
 
 
 def save(fig, path: str | Path) -> Path:
-    """Write the figure at its own size and resolution; the format from the suffix."""
+    """Write the figure at its own size and resolution; the format from the suffix.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        A figure with a canvas (``figure``).
+    path : str or Path
+        The image file; its suffix chooses the format (.png, .svg, .pdf, …).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    PictureError
+        The canvas cannot write that format.
+    """
     path = Path(path)
     fmt = path.suffix[1:].lower()
     formats = fig.canvas.get_supported_filetypes()
@@ -47,13 +86,35 @@ def save(fig, path: str | Path) -> Path:
 
 
 def label(name: str, unit: str) -> str:
-    """``crank.fi [rad]`` (no brackets for a variable without a known unit)."""
+    """``crank.fi [rad]`` (no brackets for a variable without a known unit).
+
+    Parameters
+    ----------
+    name : str
+        A variable's name.
+    unit : str
+        Its SI unit, or ''.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> label("crank.fi", "rad"), label("crank.fi", "")
+    ('crank.fi [rad]', 'crank.fi')
+    """
     return f"{name} [{unit}]" if unit else name
 
 
 def plot(source, names=None, path: str | Path | None = None, model=None,
          title: str | None = None, dpi: float = DPI):
     """Plot variables of a result table against t; returns the matplotlib Figure.
+
+    Variables with the same unit share a panel, panels in the order the variables are
+    asked for; every line is labelled with its name and unit (``motor.Mz [N·m]``), the x
+    axis is ``t [s]``. ``pam2exu plot`` and ``pam2exu run --plot`` call this function.
+    The figure is on the Agg canvas: no window opens.
 
     Parameters
     ----------
@@ -62,23 +123,43 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
         output declarations, see ``units.unit_of``).
     names : str or list of str, optional
         Variables: full names (``crank.fi``), ``crank.*``, ``*.Fx`` or a bare ``Fx``, as for
-        ``--outputs``. Default: every column.
+        ``--outputs``; PAM spellings (``Forca``, ``f``, ``Df``) are accepted. Default:
+        every column.
     path : str or Path, optional
-        Image file to write (.png, .svg, .pdf, …).
+        Image file to write (.png, .svg, .pdf, …); None writes nothing.
     model : Model or path, optional
         For a CSV file: the model, which gives the units of ``f(t)`` and ``Df(t)``.
     title : str, optional
-        Default: the model's name and the analysis.
+        Default: the model's name and the analysis (for a CSV file: its name).
     dpi : float
-        Resolution; the image is ``WIDTH`` × (``MARGIN`` + ``PANEL`` × panels) inches.
+        Resolution [dots per inch]; the image is ``WIDTH`` × (``MARGIN`` + ``PANEL`` ×
+        panels) inches (8.8 × (0.9 + 2.4 × panels) in).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One Axes per unit, sharing the t axis.
 
     Raises
     ------
     PictureError
-        A name matches no column (the message suggests the nearest), or the image format
-        of ``path`` is not supported.
+        A name matches no column (the message suggests the nearest), nothing is left to
+        plot, or the image format of ``path`` is not supported.
     CompareInputError
         The CSV file is missing or unreadable.
+    ModelError
+        ``model`` is a model file with problems.
+
+    Examples
+    --------
+    >>> from pam2exu.results import Results, plot
+    >>> res = Results([0.0, 0.5, 1.0], {"crank.fi": [0.0, 3.0, 6.0], "B.Fx": [1.0, 0.0, -1.0],
+    ...               "B.Fy": [0.0, 2.0, 0.0]}, {"crank.fi": "rad", "B.Fx": "N", "B.Fy": "N"})
+    >>> fig = plot(res, ["B.*", "crank.fi"])
+    >>> [ax.get_ylabel() for ax in fig.axes]
+    ['Fx, Fy [N]', 'crank.fi [rad]']
+    >>> plot("results.csv", "motor.Mz", "torque.png")        # doctest: +SKIP
+    <Figure size 880x330 with 1 Axes>
     """
     from ..model import Model, load
     from .table import Results, read_csv, select_columns

@@ -12,20 +12,69 @@ from ..errors import ModelError, Problem, closest
 class Results:
     """Columns ``<name>.<variable>`` over time, stored as one array.
 
-    ``res["crank.fi"]`` is a NumPy view of a column, ``res.t`` the times [s],
-    ``res.columns`` the column names (without ``t``), ``res.units`` their SI units,
-    ``res.to_numpy()`` the (steps + 1, 1 + columns) array with ``t`` first (a view, no copy)
-    and ``res.to_csv(path)`` the CSV file of the contract.
+    What ``pam2exu.run`` returns (and ``read_csv`` reads). ``res["crank.fi"]`` is a NumPy
+    view of a column (writing to it changes the table; KeyError, suggesting the nearest
+    name, for a column that does not exist), ``res.t`` the times [s], ``res.columns`` the
+    column names (without ``t``), ``res.units`` their SI units, ``res.to_numpy()`` the
+    (steps + 1, 1 + columns) array with ``t`` first (a view, no copy) and
+    ``res.to_csv(path)`` the CSV file of the contract. ``"crank.fi" in res`` tests for a
+    column, ``len(res)`` is the number of rows (times).
+
+    Column names are ``<solid>.<variable>`` (``x``, ``y`` [m], ``fi`` [rad], ``Dx``, ``Dy``
+    [m/s], ``Dfi`` [rad/s], ``DDx``, ``DDy`` [m/s²], ``DDfi`` [rad/s²]) and
+    ``<element>.<variable>`` (``Fx``, ``Fy``, ``Fnormal``, ``Força`` [N], ``Mz``,
+    ``Parell`` [N·m], ``f(t)``, ``Df(t)``, ``ro``, ``fi_rel``, …), in the order of the
+    model: solids, then elements.
+
+    Parameters
+    ----------
+    t : array_like
+        Times [s], shape (rows,).
+    columns : dict
+        Column name → values (rows,), in the order of the table; copied into the table.
+    units : dict, optional
+        Column name → SI unit (``"rad"``, ``"N·m"``, …); ``t`` is always ``"s"``.
+    analysis : str
+        The analysis that made the table (``'kinematic'``, …; '' when unknown).
+    model : str
+        The model's name ('' when unknown).
+    warnings : list of str, optional
+        Warnings issued during the run.
+    info : dict, optional
+        Facts about the run (see Attributes).
 
     Attributes
     ----------
+    units : dict
+        Column name → SI unit, ``t`` included (``"s"``); a column read from a CSV file
+        without a known unit has ''.
     analysis : str
+        The analysis type.
     model : str
         The model's name.
-    warnings : list[str]
-        Warnings raised during the run (redundant constraints, …).
+    warnings : list of str
+        Warnings raised during the run (redundant constraints, singular positions, the
+        power balance), also issued as Python warnings.
     info : dict
-        Run facts: degrees of freedom, redundancy, maximum constraint residual, timings.
+        Run facts: ``dof`` and ``redundant_equations`` (rank test at the initial guess),
+        ``condition_number`` of the constraint Jacobian at the initial guess,
+        ``max_residual`` (largest constraint residual at Exudyn's positions [m or rad]),
+        ``exudyn_seconds`` (time in Exudyn's solver [s]), and per analysis
+        ``max_condition_number``, ``branch_resolves``, ``equilibrium_error`` (relative),
+        ``reactions_from``, ``power_balance_error`` and ``power_balance_tolerance`` [W].
+
+    Examples
+    --------
+    >>> res = Results([0.0, 0.5, 1.0], {"crank.fi": [0.0, 3.0, 6.0], "motor.Mz": [1.0, 2.0, 1.5]},
+    ...               {"crank.fi": "rad", "motor.Mz": "N·m"}, "kinetostatic", "demo")
+    >>> res
+    <Results kinetostatic 'demo': 3 rows × 2 columns>
+    >>> res["crank.fi"].tolist(), res.units["motor.Mz"], len(res), "motor.Mz" in res
+    ([0.0, 3.0, 6.0], 'N·m', 3, True)
+    >>> res["crank.Fi"]
+    Traceback (most recent call last):
+    ...
+    KeyError: "no column 'crank.Fi' (did you mean 'crank.fi'?)"
     """
 
     def __init__(self, t, columns: dict[str, np.ndarray], units: dict[str, str] | None = None,
@@ -44,15 +93,16 @@ class Results:
 
     @property
     def t(self) -> np.ndarray:
-        """Times [s]."""
+        """Times [s]: a view of the table's ``t`` column, shape (rows,)."""
         return self._data[0]
 
     @property
     def columns(self) -> list[str]:
-        """Column names, without ``t``."""
+        """Column names, without ``t``, in the order of the table (a new list)."""
         return self._names[1:]
 
     def __getitem__(self, name: str) -> np.ndarray:
+        """The column ``name`` (``t`` included), a view; KeyError naming the nearest."""
         if name not in self._index:
             raise KeyError(f"no column '{name}'{closest(name, self._names)}")
         return self._data[self._index[name]]
@@ -64,11 +114,50 @@ class Results:
         return self._data.shape[1]
 
     def to_numpy(self) -> np.ndarray:
-        """(rows, 1 + columns) array, ``t`` first: a transposed view of the storage."""
+        """(rows, 1 + columns) array, ``t`` first: a transposed view of the storage.
+
+        Returns
+        -------
+        numpy.ndarray
+            Column 0 is ``t`` [s], column j the values of ``columns[j - 1]`` (SI units of
+            ``units``). A view: copy it before changing it.
+
+        Examples
+        --------
+        >>> res = Results([0.0, 1.0], {"crank.fi": [0.0, 6.0]})
+        >>> res.to_numpy().tolist()
+        [[0.0, 0.0], [1.0, 6.0]]
+        """
         return self._data.T
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write UTF-8 CSV: header ``t,<name>.<variable>,…``, full float precision."""
+        """Write UTF-8 CSV: header ``t,<name>.<variable>,…``, full float precision.
+
+        One line per time, ',' separated, ``%.17g`` (floats read back exactly). The file is
+        written under a temporary name and then renamed, so a failure never leaves half a
+        file. ``read_csv`` and ``pam2exu compare`` read it; units are not written.
+
+        Parameters
+        ----------
+        path : str or Path
+            The CSV file to write (replaced if it exists).
+
+        Returns
+        -------
+        Path
+            ``path``.
+
+        Raises
+        ------
+        OSError
+            The file cannot be written.
+
+        Examples
+        --------
+        >>> res = Results([0.0, 1.0], {"crank.fi": [0.0, 6.0]})
+        >>> res.to_csv("crank.csv")                     # doctest: +SKIP
+        PosixPath('crank.csv')
+        """
         path = Path(path)
         tmp = path.with_name(path.name + ".part")
         with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
@@ -78,13 +167,61 @@ class Results:
         return path
 
     def select(self, patterns) -> "Results":
-        """A new table with the columns that match ``patterns`` (see ``select_columns``)."""
+        """A new table with the columns that match ``patterns`` (see ``select_columns``).
+
+        Parameters
+        ----------
+        patterns : str or list of str
+            Full names (``crank.fi``), ``crank.*``, ``*.Fx`` or a bare ``Fx``; None keeps
+            every column.
+
+        Returns
+        -------
+        Results
+            The matching columns in the order of this table (copied), with the same ``t``,
+            units, analysis, model, warnings and info.
+
+        Raises
+        ------
+        ModelError
+            A pattern matches no column.
+
+        Examples
+        --------
+        >>> res = Results([0.0], {"crank.fi": [0.1], "B.Fx": [2.0], "B.Fy": [3.0]})
+        >>> res.select(["Fy", "crank.*"]).columns
+        ['crank.fi', 'B.Fy']
+        """
         names = select_columns(self.columns, patterns)
         return Results(self.t, {n: self[n] for n in names}, self.units, self.analysis,
                        self.model, self.warnings, self.info)
 
     def summary(self, max_rows: int = 60) -> str:
-        """A short text table: unit, first and last value, minimum and maximum of each column."""
+        """A short text table: unit, first and last value, minimum and maximum of each column.
+
+        What ``pam2exu run`` prints: a head line (analysis, model, rows, interval), one line
+        per column, the self-checks (``checks``) and the warnings.
+
+        Parameters
+        ----------
+        max_rows : int
+            Most columns listed; a last line says how many more there are.
+
+        Returns
+        -------
+        str
+            Lines separated by newlines, no final newline.
+
+        Examples
+        --------
+        >>> res = Results([0.0, 1.0], {"crank.fi": [0.0, 6.0]}, {"crank.fi": "rad"},
+        ...               "kinematic", "demo")
+        >>> print(res.summary())
+        kinematic analysis of 'demo': 2 rows, t = 0 … 1 s, 1 columns
+        <BLANKLINE>
+        variable  unit            first          last           min           max
+        crank.fi  rad                 0             6             0             6
+        """
         head = f"{self.analysis} analysis of '{self.model}': {len(self)} rows, " \
                f"t = {self.t[0]:g} … {self.t[-1]:g} s, {len(self.columns)} columns"
         width = max([len(c) for c in self.columns] + [8])
@@ -106,7 +243,20 @@ class Results:
         return "\n".join(lines)
 
     def checks(self) -> list[str]:
-        """The consistency checks the analysis ran, one phrase each (from ``info``)."""
+        """The consistency checks the analysis ran, one phrase each (from ``info``).
+
+        Returns
+        -------
+        list of str
+            The constraint residual [m], Exudyn's multipliers against the native
+            equilibrium (quasi_static, relative), the power balance (kinetostatic, [W]);
+            only those in ``info``.
+
+        Examples
+        --------
+        >>> Results([0.0], {}, info={"max_residual": 3e-15}).checks()
+        ['constraint residual 3.0e-15 m']
+        """
         info, out = self.info, []
         if "max_residual" in info:
             out.append(f"constraint residual {info['max_residual']:.1e} m")
@@ -131,7 +281,35 @@ def _pattern(p: str) -> str:
 def select_columns(columns: list[str], patterns) -> list[str]:
     """Columns matching any pattern: full names, ``solid.*``, ``*.Fx`` or a bare ``Fx``.
 
-    Raises ModelError for a pattern that matches no column of this analysis.
+    Patterns are shell-style (``fnmatch``, case-sensitive); one without a dot means that
+    variable of every solid and element (``Fx`` is ``*.Fx``). ``t`` matches nothing and is
+    no error (it is always in a table).
+
+    Parameters
+    ----------
+    columns : list of str
+        The column names to choose from.
+    patterns : str or list of str
+        The patterns; None chooses every column.
+
+    Returns
+    -------
+    list of str
+        The columns matching any pattern, in the order of ``columns``.
+
+    Raises
+    ------
+    ModelError
+        A pattern matches no column (one problem per pattern, with the nearest name).
+
+    Examples
+    --------
+    >>> select_columns(["crank.fi", "crank.Dfi", "B.Fx", "C.Fx"], ["Fx", "crank.fi"])
+    ['crank.fi', 'B.Fx', 'C.Fx']
+    >>> select_columns(["crank.fi"], "crank.fy")
+    Traceback (most recent call last):
+    ...
+    pam2exu.errors.ModelError: outputs: 'crank.fy' matches no variable...(did you mean 'crank.fi'?)
     """
     if patterns is None:
         return list(columns)
@@ -153,10 +331,36 @@ def read_csv(path: str | Path, model=None) -> Results:
     """A result CSV file as a Results table, with units from the output declarations.
 
     Reads what ``pam2exu compare`` reads: ``Results.to_csv`` files and PAM-style exports
-    (',' or ';' separated, decimal comma with ';', PAM spellings such as ``Forca``).
-    ``model`` (a Model or a model file) gives the units of ``f(t)`` and ``Df(t)``, which
-    depend on the actuator type (see ``units.unit_of``). Raises CompareInputError for a
-    missing or unreadable file.
+    (',' or ';' separated, decimal comma with ';', PAM spellings such as ``Forca``, which
+    become pam2exu's: ``Força``). ``model`` (a Model or a model file) gives the units of
+    ``f(t)`` and ``Df(t)``, which depend on the actuator type (see ``units.unit_of``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file: a header line ``t,<name>.<variable>,…``, then one line per time.
+    model : Model, str or Path, optional
+        The model the file was computed from, for the units of ``f(t)`` and ``Df(t)``
+        (rad or m); also gives the table's ``model`` name (else the file's stem).
+
+    Returns
+    -------
+    Results
+        The columns of the file (``t`` first), ``analysis`` ''.
+
+    Raises
+    ------
+    CompareInputError
+        The file is missing or unreadable: no ``t`` column, a line with the wrong number of
+        values, a value that is not a number, two columns with one name.
+    ModelError
+        ``model`` is a model file with problems.
+
+    Examples
+    --------
+    >>> res = read_csv("slider.csv", model="examples/slider_crank.toml")  # doctest: +SKIP
+    >>> res.units["motor.f(t)"]                                          # doctest: +SKIP
+    'rad'
     """
     from ..model import Model, load
     from .compare import _load

@@ -14,7 +14,19 @@ import functools
 
 @functools.cache
 def declared_units() -> dict[str, tuple[str, ...]]:
-    """Variable name → the units it is declared with (one unit: unambiguous)."""
+    """Variable name → the units it is declared with (one unit: unambiguous).
+
+    Returns
+    -------
+    dict
+        PAM variable name (``fi``, ``Fx``, ``f(t)``, …) → tuple of the SI units it is
+        declared with by ``SOLID_OUTPUTS`` and the element classes' ``outputs``.
+
+    Examples
+    --------
+    >>> declared_units()["Mz"], declared_units()["f(t)"]
+    (('N·m',), ('rad', 'm'))
+    """
     from ..analyses.common import SOLID_OUTPUTS
     from ..elements import ELEMENTS
     out: dict[str, list[str]] = {}
@@ -35,6 +47,17 @@ def unit_of(column: str, model=None) -> str:
     model : Model, optional
         Resolves the variables whose unit depends on the element type (``f(t)``, ``Df(t)``):
         the unit declared by the class of the solid or element named ``<name>``.
+
+    Returns
+    -------
+    str
+        The SI unit (``"s"`` for ``t``), or '' when the variable is unknown, or declared
+        with several units and not resolved by ``model``.
+
+    Examples
+    --------
+    >>> unit_of("crank.fi"), unit_of("B.Fx"), unit_of("motor.Forca"), unit_of("motor.f(t)")
+    ('rad', 'N', 'N', '')
     """
     from .compare import canonical_name
     if column == "t":
