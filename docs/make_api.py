@@ -51,12 +51,12 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
       *[("pam2exu", cls.__name__) for cls in ELEMENTS.values()]]),
     ("Results",
      "Every analysis returns a `Results` table; `read_csv` reads one back from a file.",
-     [("pam2exu.results", "Results"), ("pam2exu.results", "read_csv"),
+     [("pam2exu", "Results"), ("pam2exu", "read_csv"),
       ("pam2exu.results", "select_columns"), ("pam2exu.results.units", "unit_of")]),
     ("Comparing results",
      ("`compare` checks a result against a reference, variable by variable; the user guide "
       "is [compare.md](compare.md)."),
-     [("pam2exu", "compare"), ("pam2exu.results", "Comparison"),
+     [("pam2exu", "compare"), ("pam2exu", "Comparison"),
       ("pam2exu.results", "VariableComparison"), ("pam2exu.results", "read_names")]),
     ("Exporting to Exudyn",
      "A standalone Exudyn script of a model; the user guide is [export.md](export.md).",
@@ -64,8 +64,8 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
     ("Pictures",
      ("Plots of variables against time, drawings and animations of the mechanism. Figures "
       "use matplotlib's Agg canvas (no window); the user guide is [pictures.md](pictures.md)."),
-     [("pam2exu.results", "plot"), ("pam2exu.pictures", "draw"),
-      ("pam2exu.pictures", "animate"), ("pam2exu.pictures", "pose"),
+     [("pam2exu", "plot"), ("pam2exu", "draw"),
+      ("pam2exu", "animate"), ("pam2exu.pictures", "pose"),
       ("pam2exu.pictures", "configurations")]),
     ("Time laws",
      "The laws f(t) the actuators follow (`law` and `C` of an actuator).",
@@ -76,12 +76,12 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
       "`CompareInputError`, `PictureError`), 1 for the others."),
      [("pam2exu", "Pam2ExuError"), ("pam2exu", "ModelError"), ("pam2exu", "MobilityError"),
       ("pam2exu", "SolverError"), ("pam2exu", "TranslationError"), ("pam2exu.errors", "Problem"),
-      ("pam2exu.results", "CompareInputError"), ("pam2exu.results.plot", "PictureError")]),
+      ("pam2exu", "CompareInputError"), ("pam2exu", "PictureError")]),
     ("Warnings",
      ("Issued with `warnings.warn` at the caller's line and kept in `Results.warnings`; "
       "filter them with the `warnings` module."),
-     [("pam2exu.analyses", "RedundancyWarning"), ("pam2exu.analyses", "ConsistencyWarning"),
-      ("pam2exu.analyses", "ConditionWarning")]),
+     [("pam2exu", "RedundancyWarning"), ("pam2exu", "ConsistencyWarning"),
+      ("pam2exu", "ConditionWarning")]),
 ]
 
 #: descriptions of data objects (they have no docstring of their own)

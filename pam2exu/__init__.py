@@ -14,8 +14,12 @@ from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
 from .errors import (MobilityError, ModelError, Pam2ExuError, SolverError, TranslationError)
 from .export import export
+from .analyses.common import ConditionWarning, ConsistencyWarning, RedundancyWarning
 from .model import Law, Model, Solid, load, loads
+from .pictures import animate, draw
+from .results import CompareInputError, Comparison, Results, plot, read_csv
 from .results.compare import compare
+from .results.plot import PictureError
 
 __version__ = "0.1.0"
 
@@ -120,7 +124,9 @@ def run(model, analysis=None, **settings):
     return _run(model, analysis=analysis, **settings)
 
 
-__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "compare", "export", "ELEMENTS",
+__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "Results", "read_csv", "compare",
+           "Comparison", "export", "plot", "draw", "animate", "ELEMENTS",
            "Fixed", "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor", "Spring",
            "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError", "ModelError",
-           "MobilityError", "SolverError", "TranslationError"]
+           "MobilityError", "SolverError", "TranslationError", "CompareInputError",
+           "PictureError", "RedundancyWarning", "ConsistencyWarning", "ConditionWarning"]

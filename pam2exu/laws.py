@@ -67,7 +67,8 @@ def _transition(shape: Callable) -> Callable:
         ddf = xp.where(before, 0.0, xp.where(inside, rise * dds / (span * span), 0.0))
         return f, df, ddf
 
-    law.__doc__ = _transition.__doc__.replace("s(u)", f"s(u) with {shape.__doc__}")
+    s = shape.__doc__.split("=", 1)[1].strip().rstrip(".")       # "3u² − 2u³"
+    law.__doc__ = _transition.__doc__.replace(" s(u)", " " + s if s == "u" else f"({s})")
     return law
 
 
@@ -130,9 +131,13 @@ class Law:
         is replaced by its canonical name.
     C : sequence of float
         Up to four constants C1 … C4, in the units of the list above ([s], [u], [u/s],
-        …); missing ones are 0. Neither the name nor the number of constants is checked
-        here (the model's validation does that): an unknown name fails when the law is
-        evaluated.
+        …); missing ones are 0.
+
+    Raises
+    ------
+    ValueError
+        An unknown law name (the message lists the known ones), or more than four
+        constants.
 
     Examples
     --------
@@ -150,7 +155,11 @@ class Law:
 
     def __post_init__(self):
         object.__setattr__(self, "name", LAW_ALIASES.get(self.name, self.name))
-        C = tuple(float(c) for c in self.C)
+        if self.name not in LAWS:
+            raise ValueError(f"unknown law '{self.name}'; known laws: {', '.join(law_names())}")
+        C = tuple(float(c) for c in (self.C if np.ndim(self.C) else [self.C]))
+        if len(C) > 4:
+            raise ValueError(f"a law has at most four constants C1 … C4, got {len(C)}")
         object.__setattr__(self, "C", C + (0.0,) * (4 - len(C)))
 
     def __call__(self, t, xp=np):

@@ -269,15 +269,15 @@ UNITS = {
 MUST_CHECK = [
     ("pam2exu.run", "t_end"), ("pam2exu.analyses.run", "t_end"), ("pam2exu.export", "t_end"),
     ("pam2exu.export.script", "t_end"), ("pam2exu.model.Analysis", "t_end"),
-    ("pam2exu.pictures.animate", "t_end"), ("pam2exu.pictures.configurations", "t_end"),
-    ("pam2exu.pictures.draw", "t"), ("pam2exu.pictures.pose", "t"),
+    ("pam2exu.animate", "t_end"), ("pam2exu.pictures.configurations", "t_end"),
+    ("pam2exu.draw", "t"), ("pam2exu.pictures.pose", "t"),
     ("pam2exu.compare", "rtol"), ("pam2exu.compare", "atol"),
-    ("pam2exu.results.Comparison", "rtol"), ("pam2exu.results.Comparison", "atol"),
+    ("pam2exu.Comparison", "rtol"), ("pam2exu.Comparison", "atol"),
     ("pam2exu.Model", "gravity"), ("pam2exu.Solid", "x"), ("pam2exu.Solid", "y"),
     ("pam2exu.Solid", "fi"), ("pam2exu.Solid", "mass"), ("pam2exu.Solid", "inertia"),
-    ("pam2exu.Solid", "cog"), ("pam2exu.SolverError", "time"), ("pam2exu.results.plot", "dpi"),
-    ("pam2exu.pictures.animate", "fps"), ("pam2exu.Law.__call__", "t"),
-    ("pam2exu.Law.value", "t"), ("pam2exu.results.Results", "t"),
+    ("pam2exu.Solid", "cog"), ("pam2exu.SolverError", "time"), ("pam2exu.plot", "dpi"),
+    ("pam2exu.animate", "fps"), ("pam2exu.Law.__call__", "t"),
+    ("pam2exu.Law.value", "t"), ("pam2exu.Results", "t"),
 ]
 #: float parameters without a unit: ratios, counts of the variable's own unit
 DIMENSIONLESS = {"T"}

@@ -239,7 +239,7 @@ def derivative(f: np.ndarray, k: np.ndarray, h: int, dt: float) -> np.ndarray:
 
 def power_balance(mech, t: np.ndarray, actuator_power: np.ndarray, energy: np.ndarray,
                   dissipation: np.ndarray, external_power: np.ndarray) -> PowerBalance | None:
-    """Check the power balance at the steps k = 4 … n−5 (None with fewer than 9 steps)."""
+    """Check the power balance at the steps k = 4 … n−5 (None with fewer than 9 rows)."""
     n = len(t)
     if n < 9:
         return None

@@ -50,7 +50,7 @@ def check_power_balance(job: Job, power, energy, dissipation, external) -> None:
     """Σ actuator power = dE/dt + dissipation − torsor power; warns when it does not hold."""
     balance = forces.power_balance(job.mech, job.times, power, energy, dissipation, external)
     if balance is None:
-        job.info["power_balance"] = "not checked (fewer than 9 steps)"
+        job.info["power_balance"] = "not checked (fewer than 9 rows: steps < 8)"
         return
     job.info.update(power_balance_error=balance.error,
                     power_balance_tolerance=balance.tolerance,

@@ -150,7 +150,7 @@ class Model:
         **keys
             The new solid's keys, as for ``Solid``: ``x``, ``y`` [m], ``fi`` [rad],
             ``mass`` [kg], ``inertia`` [kg·m²], ``cog`` [m], ``points`` [m], ``lines``
-            [m, rad]. Not used when ``solid`` is a Solid.
+            [m, rad]. None when ``solid`` is a Solid.
 
         Returns
         -------
@@ -162,6 +162,8 @@ class Model:
         ModelError
             A key that a solid does not have (the message suggests the nearest). The values
             and the name are checked later, by ``problems``.
+        TypeError
+            Keys given together with a Solid object.
 
         Examples
         --------
@@ -180,6 +182,9 @@ class Model:
                 raise ModelError([f"a solid has no key '{k}'{closest(k, allowed)}" for k in unknown],
                                  self.source)
             solid = Solid(solid, **keys)
+        elif keys:
+            raise TypeError(f"add_solid: keys {', '.join(map(repr, keys))} given with a Solid "
+                            f"object; set them on the Solid, or pass its name and the keys")
         if solid.position is None:
             solid.position = len(self.solids) + 1
         self.solids.append(solid)
@@ -200,7 +205,7 @@ class Model:
             The new element's keys: ``name``, the anchors ``anc1`` and ``anc2`` (a
             ``"solid"``, ``"solid.point"`` or ``"solid.line"``, as the type requires) and
             the keys of its type (``law`` and ``C`` of an actuator, ``T``, ``C`` and ``arm``
-            of a transmission, …; see the element types). Not used when ``element`` is an
+            of a transmission, …; see the element types). None when ``element`` is an
             Element.
 
         Returns
@@ -215,6 +220,8 @@ class Model:
         ModelError
             An unknown element type, or a key its type does not have (the message suggests
             the nearest). Anchors and values are checked later, by ``problems``.
+        TypeError
+            Keys given together with an Element object.
 
         Examples
         --------
@@ -238,6 +245,9 @@ class Model:
                                   f"are: {', '.join(cls.keys()[1:])}" for k in unknown],
                                  self.source)
             element = cls(**keys)
+        elif keys:
+            raise TypeError(f"add: keys {', '.join(map(repr, keys))} given with an element "
+                            f"object; set them on the element, or pass its type and the keys")
         if element.position is None:
             element.position = len(self.elements) + 1
         if element.name is None:

@@ -707,7 +707,8 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
     ...
     """
     for label, value in (("rtol", rtol), ("atol", atol)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+        if not (isinstance(value, (int, float)) and not isinstance(value, bool)
+                and math.isfinite(value) and value >= 0):
             raise CompareInputError(f"`{label}` must be a number ≥ 0, not {value!r}")
     if method not in METHODS:
         raise CompareInputError(f"`method` must be one of {', '.join(METHODS)}, not "

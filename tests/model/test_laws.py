@@ -312,3 +312,11 @@ def test_catalan_aliases_are_the_same_law(alias, canonical):
     t = np.linspace(-1.0, 2.0, 31)
     for a, b in zip(Law(alias, C)(t), Law(canonical, C)(t)):
         assert np.array_equal(a, b)
+
+
+def test_unknown_law_or_too_many_constants_fail_at_construction():
+    with pytest.raises(ValueError, match="unknown law 'cubic'; known laws: polynomial"):
+        Law("cubic", [0.0])
+    with pytest.raises(ValueError, match="at most four constants"):
+        Law("polynomial", [1.0, 2.0, 3.0, 4.0, 5.0])
+    assert Law("polynomial", 2.0).C == (2.0, 0.0, 0.0, 0.0)

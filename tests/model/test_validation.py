@@ -877,3 +877,12 @@ def test_python_api_unknown_keywords_are_model_errors():
         m.add_solid("g", mas=1.0)
     with pytest.raises(ModelError, match="a revolute has no key 'anc3' \\(did you mean 'anc2'\\?\\)"):
         m.add("revolute", anc1="a.O", anc3="b.O")
+
+
+def test_keys_with_an_object_are_refused_not_ignored():
+    m = Model()
+    with pytest.raises(TypeError, match="keys 'x' given with a Solid object"):
+        m.add_solid(Solid("crank"), x=1.0)
+    with pytest.raises(TypeError, match="keys 'name' given with an element object"):
+        m.add(pam2exu.Revolute(anc1="ground", anc2="crank"), name="O")
+    assert m.solids == [] and m.elements == []

@@ -368,3 +368,10 @@ def test_cli_csv_format_and_options(data, tmp_path, capsys):
         "PASS: all 3 common variables within the tolerance")
     assert main(["compare", str(res), str(folder / "crank_pam.csv"), "--columns", "Mz"]) == 2
     assert "no variable in common" in capsys.readouterr().err
+
+
+def test_a_bool_is_not_a_tolerance(tmp_path):
+    t = np.linspace(0.0, 1.0, 5)
+    good = write(tmp_path / "good.csv", t, {"a.x": t})
+    with pytest.raises(CompareInputError, match=r"`rtol` must be a number ≥ 0, not True"):
+        compare(good, good, rtol=True)
