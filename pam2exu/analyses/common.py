@@ -250,6 +250,18 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
     violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)
     drivers = ", ".join(f"'{e.name}'" for e in mech.constraints if hasattr(e, "time_law"))
     elements = tuple(n for n, _ in worst)
+    disagreement, among = native.contradiction(mech, t, start)
+    if worst and disagreement > can_hold:
+        since = (f"at t = {t:.6g} s" if solved == 0 else
+                 f"from t = {float(times[solved - 1]):.6g} s to t = {t:.6g} s")
+        names = ", ".join(f"'{n}'" for n in among)
+        return SolverError(
+            f"the constraints of {names} contradict each other {since} (step {solved} of "
+            f"{len(times) - 1}): they are redundant (between them they fix a coordinate "
+            f"more than once) and their targets disagree by {disagreement:.3g} (m or rad), so no "
+            f"configuration satisfies them all. Remove the extra constraint, or make the "
+            f"laws or the geometry agree. Exudyn said: {system.error}",
+            time=t, step=solved, elements=tuple(among))
     if worst and solved > 0:
         t0 = float(times[solved - 1])
         return SolverError(

@@ -279,6 +279,30 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
     return Mobility(dof, redundant, free, dependent, condition)
 
 
+def contradiction(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> tuple[float, list[str]]:
+    """How far redundant constraints contradict each other at time t, near configuration q.
+
+    With N the left null space of Cq(q) (the combinations of equations that no change of q
+    can alter, to first order), |Nᵀ C(q, t)| is a violation no configuration near q can
+    remove: the constraints' targets disagree. Returns that size (length units) and the
+    elements whose equations make it up. Zero when Cq has full row rank.
+    """
+    J = equations(mech, State([t], q[None, :])).jacobian[0]
+    J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
+    if J.shape[0] == 0:
+        return 0.0, []
+    U, s, _ = np.linalg.svd(J)
+    rank = int(np.sum(s > rtol * max(1.0, s[0] if s.size else 1.0)))
+    left = U[:, rank:]                                     # (m, redundant)
+    if left.shape[1] == 0:
+        return 0.0, []
+    disagreement = left.T @ residuals(mech, np.array([t]), q[None, :])[0]
+    share = np.abs(left @ disagreement)                    # each equation's part in it
+    names = [el.name for el, rows in zip(mech.constraints, mech.rows)
+             if np.max(share[rows]) > 1e-6 * max(float(np.max(share)), 1e-300)]
+    return float(np.linalg.norm(disagreement)), names
+
+
 def require_driven(mech, mob: Mobility, analysis: str) -> None:
     """Raise MobilityError when some degree of freedom is not driven."""
     if mob.dof <= 0:

@@ -73,3 +73,40 @@ def test_quasi_static_through_a_singular_position_is_an_error(request):
     with pytest.warns(RedundancyWarning):
         with pytest.raises(pam2exu.SolverError, match=r"t = 0\.25 s .*singular"):
             pam2exu.run(model, analysis="quasi_static", steps=400)
+
+
+def _two_motors(c2):
+    """A crank driven by two angular actuators: m1 at fi = t, m2 at fi = c2[0] + c2[1] t."""
+    m = pam2exu.Model("two motors", gravity=0.0)
+    m.add_solid("ground")
+    m.add_solid("crank", points={"O": [0, 0], "A": [0.1, 0]})
+    m.add("fixed", anc1="ground")
+    m.add("revolute", name="O", anc1="ground", anc2="crank.O")
+    m.add("angular_actuator", name="m1", anc1="ground", anc2="crank", C=[0.0, 1.0])
+    m.add("angular_actuator", name="m2", anc1="ground", anc2="crank", C=c2)
+    return m
+
+
+@pytest.mark.parametrize("c2,since", [([0.0, 2.0], r"from t = 0 s to t = 0\.01 s"),
+                                      ([0.5, 1.0], r"at t = 0 s")])
+def test_contradicting_constraints_are_named_not_taken_for_a_dead_point(c2, since):
+    """Contract ("Degrees of freedom"): constraints that contradict each other get a clear
+    error that says so and names the elements. The two drives agree at t = 0 and part
+    at once (first case), or disagree from the start by 0.5 rad (second case)."""
+    with pytest.warns(RedundancyWarning) if c2[0] == 0 else _no_warning():
+        with pytest.raises(pam2exu.SolverError, match=rf"'m1', 'm2' contradict each other "
+                                                      rf"{since}") as info:
+            pam2exu.run(_two_motors(c2), analysis="kinematic", t_end=1.0, steps=100)
+    assert "dead-point" not in str(info.value)
+    assert info.value.elements == ("m1", "m2")
+
+
+def test_agreeing_redundant_drives_run():
+    with pytest.warns(RedundancyWarning, match="m1"):
+        res = pam2exu.run(_two_motors([0.0, 1.0]), analysis="kinematic", t_end=1.0, steps=10)
+    np.testing.assert_allclose(res["crank.fi"], res.t, rtol=0, atol=1e-14)
+
+
+def _no_warning():
+    import contextlib
+    return contextlib.nullcontext()
