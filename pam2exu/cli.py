@@ -218,7 +218,7 @@ def _elements(args) -> int:
         classes = [reference.element_class(name) for name in args.types]
     except KeyError as exc:
         raise ModelError(exc.args[0]) from None
-    print("\n".join(reference.element_markdown(cls) for cls in classes), end="")
+    print("\n".join(reference.element_markdown(cls, anchor=False) for cls in classes), end="")
     return 0
 
 

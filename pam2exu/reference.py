@@ -18,7 +18,8 @@ import re
 import sys
 from pathlib import Path
 
-from .elements import ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY, ACCELERATION, Element
+from .elements import ACCELERATION, ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY, Element
+from .errors import closest
 from .laws import LAW_ALIASES, LAWS
 
 #: which analyses give a variable of each level (PAM's analyses; assembly gives x, y, fi)
@@ -41,7 +42,8 @@ def element_class(name: str) -> type[Element]:
     kind = ALIASES.get(name, name)
     if kind not in ELEMENTS:
         known = ", ".join(ELEMENTS)
-        raise KeyError(f"unknown element type '{name}'; known types: {known} "
+        raise KeyError(f"unknown element type '{name}'{closest(name, [*ELEMENTS, *ALIASES])}; "
+                       f"known types: {known} "
                        f"(Catalan names: {', '.join(ALIASES)})")
     return ELEMENTS[kind]
 
@@ -89,11 +91,13 @@ def _table(header: tuple[str, ...], rows) -> list[str]:
     return lines
 
 
-def element_markdown(cls: type[Element], level: int = 3) -> str:
-    """One element's section: what it does, its keys, its equations and its outputs."""
+def element_markdown(cls: type[Element], level: int = 3, anchor: bool = True) -> str:
+    """One element's section: what it does, its keys, its equations and its outputs
+    (``anchor``: with an HTML anchor named after the type, for links within a page)."""
     alias = f" [`{cls.alias}`]" if cls.alias != cls.type else ""
-    lines = [f'<a id="{cls.type}"></a>', "", f"{'#' * level} `{cls.type}`{alias}", "",
-             cls.summary[0].upper() + cls.summary[1:] + ".", ""]
+    lines = [f'<a id="{cls.type}"></a>', ""] if anchor else []
+    lines += [f"{'#' * level} `{cls.type}`{alias}", "", cls.summary[0].upper() + cls.summary[1:]
+              + ".", ""]
     keys = [("type", f'`"{cls.type}"` (or `"{cls.alias}"`)', "required"),
             ("name", "unique name", f"`{cls.type}<n>`")]
     for k in range(len(cls.anchors)):
