@@ -123,7 +123,8 @@ class MobilityError(ModelError):
 
 
 class SolverError(Pam2ExuError):
-    """Exudyn's solver did not converge, or the mechanism reached a singular position.
+    """Exudyn's solver did not converge, the mechanism reached a singular position, or
+    redundant constraints contradict each other.
 
     Carries the time and step where it happened and the elements whose constraints are
     violated most. CLI exit code 1.

@@ -261,7 +261,8 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
             f"more than once) and their targets disagree by {disagreement:.3g} (m or rad), so no "
             f"configuration satisfies them all. Remove the extra constraint, or make the "
             f"laws or the geometry agree. Exudyn said: {system.error}",
-            time=t, step=solved, elements=tuple(among))
+            time=t, step=solved,
+            elements=tuple(f"'{e.name}' ({e.type})" for e in mech.constraints if e.name in among))
     if worst and solved > 0:
         t0 = float(times[solved - 1])
         return SolverError(

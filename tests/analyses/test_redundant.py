@@ -98,7 +98,7 @@ def test_contradicting_constraints_are_named_not_taken_for_a_dead_point(c2, sinc
                                                       rf"{since}") as info:
             pam2exu.run(_two_motors(c2), analysis="kinematic", t_end=1.0, steps=100)
     assert "dead-point" not in str(info.value)
-    assert info.value.elements == ("m1", "m2")
+    assert info.value.elements == ("'m1' (angular_actuator)", "'m2' (angular_actuator)")
 
 
 def test_agreeing_redundant_drives_run():
