@@ -44,6 +44,9 @@ import pytest
 import pam2exu
 from pam2exu.analyses import RedundancyWarning
 
+#: the ill-conditioning warnings these cases raise on purpose are checked in res.warnings
+pytestmark = pytest.mark.filterwarnings("ignore::pam2exu.ConditionWarning")
+
 DATA = Path(__file__).resolve().parents[1] / "data"
 RTOL = 1e-9
 TWO_PI = 2.0 * math.pi
