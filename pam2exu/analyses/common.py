@@ -258,8 +258,8 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
         return SolverError(
             f"the constraints of {names} contradict each other {since} (step {solved} of "
             f"{len(times) - 1}): they are redundant (between them they fix a coordinate "
-            f"more than once) and their targets disagree by {disagreement:.3g} (m or rad), so no "
-            f"configuration satisfies them all. Remove the extra constraint, or make the "
+            f"more than once) and their targets disagree by {disagreement:.3g} (m or rad), "
+            f"so no configuration satisfies them all. Remove the extra constraint, or make the "
             f"laws or the geometry agree. Exudyn said: {system.error}",
             time=t, step=solved,
             elements=tuple(f"'{e.name}' ({e.type})" for e in mech.constraints if e.name in among))

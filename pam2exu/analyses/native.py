@@ -252,17 +252,24 @@ class Mobility:
         return text
 
 
-def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
-    """Rank test of Cq at (q, t): free degrees of freedom and redundant equations."""
+def _rank(mech, t: float, q: np.ndarray, rtol: float):
+    """(U, s, Vt, rank) of the SVD of Cq at (q, t), with the angle columns scaled by the
+    length scale so that all columns have units of length; None without equations."""
     J = equations(mech, State([t], q[None, :])).jacobian[0]
-    # scale the angle columns by the length scale so that all columns have units of length
     J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
     if J.shape[0] == 0:
-        return Mobility(mech.nq, 0, [s.name for s in mech.solids], [], np.inf)
+        return None
     U, s, Vt = np.linalg.svd(J)
-    tol = rtol * max(1.0, s[0] if s.size else 1.0)
-    rank = int(np.sum(s > tol))
-    dof, redundant = mech.nq - rank, J.shape[0] - rank
+    return U, s, Vt, int(np.sum(s > rtol * max(1.0, s[0] if s.size else 1.0)))
+
+
+def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
+    """Rank test of Cq at (q, t): free degrees of freedom and redundant equations."""
+    svd = _rank(mech, t, q, rtol)
+    if svd is None:
+        return Mobility(mech.nq, 0, [s.name for s in mech.solids], [], np.inf)
+    U, s, Vt, rank = svd
+    dof, redundant = mech.nq - rank, U.shape[0] - rank
     free = []
     if dof:
         null = Vt[rank:].T                           # (nq, dof)
@@ -284,18 +291,13 @@ def contradiction(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> tuple[fl
 
     With N the left null space of Cq(q) (the combinations of equations that no change of q
     can alter, to first order), |Nᵀ C(q, t)| is a violation no configuration near q can
-    remove: the constraints' targets disagree. Returns that size (length units) and the
-    elements whose equations make it up. Zero when Cq has full row rank.
+    remove: the constraints' targets disagree. Returns that size (in the equations' units,
+    m or rad) and the elements whose equations make it up. Zero when Cq has full row rank.
     """
-    J = equations(mech, State([t], q[None, :])).jacobian[0]
-    J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
-    if J.shape[0] == 0:
+    svd = _rank(mech, t, q, rtol)
+    if svd is None or svd[3] == svd[0].shape[0]:
         return 0.0, []
-    U, s, _ = np.linalg.svd(J)
-    rank = int(np.sum(s > rtol * max(1.0, s[0] if s.size else 1.0)))
-    left = U[:, rank:]                                     # (m, redundant)
-    if left.shape[1] == 0:
-        return 0.0, []
+    left = svd[0][:, svd[3]:]                              # (m, redundant)
     disagreement = left.T @ residuals(mech, np.array([t]), q[None, :])[0]
     share = np.abs(left @ disagreement)                    # each equation's part in it
     names = [el.name for el, rows in zip(mech.constraints, mech.rows)
