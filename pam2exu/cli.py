@@ -28,7 +28,9 @@ def _parser() -> argparse.ArgumentParser:
                                      "table, overridden by the options).")
     run.add_argument("model", help="model file (TOML)")
     run.add_argument("--analysis", "-a", metavar="TYPE",
-                     help="assembly, kinematic, quasi_static or kinetostatic")
+                     help="assembly, kinematic, quasi_static or kinetostatic (or PAM's "
+                          "Catalan names: ensamblatge, cinematica, quasi_estatica, "
+                          "cinetostatica)")
     run.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
     run.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
     run.add_argument("--outputs", nargs="+", metavar="PAT",

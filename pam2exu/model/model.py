@@ -16,6 +16,9 @@ from .solid import Scope, Solid
 
 #: analysis types of the contract
 ANALYSIS_TYPES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
+#: PAM's Catalan names of the analyses (an extension of the contract)
+ANALYSIS_ALIASES = {"ensamblatge": "assembly", "quasi_estatica": "quasi_static",
+                    "cinematica": "kinematic", "cinetostatica": "kinetostatic"}
 
 
 def _number(v) -> bool:
@@ -34,7 +37,8 @@ class Analysis:
     ----------
     type : str
         ``'assembly'``, ``'quasi_static'``, ``'kinematic'`` or ``'kinetostatic'``
-        (``ANALYSIS_TYPES``).
+        (``ANALYSIS_TYPES``); PAM's Catalan names (``'ensamblatge'``,
+        ``'quasi_estatica'``, ``'cinematica'``, ``'cinetostatica'``) are read as these.
     t_end : float
         End of the interval [0, t_end] [s], > 0 (not used by an assembly, which solves
         t = 0 only).
@@ -55,6 +59,14 @@ class Analysis:
     steps: int = 100
     outputs: list[str] | None = None
 
+    def __post_init__(self):
+        self._canonical_type()
+
+    def _canonical_type(self) -> None:
+        """A Catalan analysis name becomes the contract's."""
+        if isinstance(self.type, str):
+            self.type = ANALYSIS_ALIASES.get(self.type, self.type)
+
     def problems(self) -> list[str]:
         """What is wrong with these settings, one message each (empty when they are sound).
 
@@ -65,9 +77,12 @@ class Analysis:
             ``"[analysis]"``).
         """
         out = []
+        self._canonical_type()
         if self.type not in ANALYSIS_TYPES:
-            out.append(f"unknown analysis type '{self.type}'{closest(self.type, ANALYSIS_TYPES)}; "
-                       f"known types: {', '.join(ANALYSIS_TYPES)}")
+            known = [*ANALYSIS_TYPES, *ANALYSIS_ALIASES]
+            out.append(f"unknown analysis type '{self.type}'{closest(self.type, known)}; "
+                       f"known types: {', '.join(ANALYSIS_TYPES)} (Catalan: "
+                       f"{', '.join(ANALYSIS_ALIASES)})")
         if not _number(self.t_end) or self.t_end <= 0:
             out.append(f"t_end must be a positive number of seconds, got {self.t_end!r}")
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:

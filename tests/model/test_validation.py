@@ -886,3 +886,21 @@ def test_keys_with_an_object_are_refused_not_ignored():
     with pytest.raises(TypeError, match="keys 'name' given with an element object"):
         m.add(pam2exu.Revolute(anc1="ground", anc2="crank"), name="O")
     assert m.solids == [] and m.elements == []
+
+
+@pytest.mark.parametrize("catalan,kind", [("ensamblatge", "assembly"),
+                                          ("quasi_estatica", "quasi_static"),
+                                          ("cinematica", "kinematic"),
+                                          ("cinetostatica", "kinetostatic")])
+def test_catalan_analysis_names_are_read_as_the_contracts(catalan, kind):
+    """Extension (docs/model-format.md, "Analysis"): PAM's names of the four analyses."""
+    model = loads(SOLIDS + f'\n[analysis]\ntype = "{catalan}"\n')
+    assert model.analysis.type == kind and model.problems() == []
+    model.analysis.type = catalan                    # set later, from Python
+    assert model.problems() == [] and model.analysis.type == kind
+
+
+def test_unknown_analysis_name_lists_both_spellings():
+    with pytest.raises(ModelError, match=r"'cinematic' \(did you mean 'cinematica'\?\).*"
+                                         r"\(Catalan: ensamblatge, quasi_estatica"):
+        loads(SOLIDS + '\n[analysis]\ntype = "cinematic"\n')
