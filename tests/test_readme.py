@@ -76,15 +76,80 @@ def test_shell_blocks_run(page, tmp_path):
             continue            # installing, and the full benchmark (minutes): not in CI
         if "ffmpeg" in command and shutil.which("ffmpeg") is None:
             continue
-        shell = re.sub(r"^(pam2exu|python)\b",
-                       lambda m: shlex.quote(sys.executable)
-                       + (" -m pam2exu" if m.group(1) == "pam2exu" else ""), command)
-        done = subprocess.run(shell, shell=True, cwd=work, capture_output=True, text=True,
-                              env={**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"})
+        done = subprocess.run(_shell(command), shell=True, cwd=work, capture_output=True,
+                              text=True, env=_env())
         assert done.returncode == expected, (page.name, command, done.stdout[-2000:],
                                              done.stderr[-2000:])
         ran += 1
     assert ran
+    for command, shown in _outputs(page):      # after the page's commands made their files
+        done = subprocess.run(_shell(command), shell=True, cwd=work, capture_output=True,
+                              text=True, env=_env())
+        _assert_shows(done.stdout, shown, f"{page.name}: output of {command}")
+
+
+def _shell(command: str) -> str:
+    """`pam2exu` and `python` at the start of a line mean this interpreter's."""
+    return re.sub(r"^(pam2exu|python)\b", lambda m: shlex.quote(sys.executable)
+                  + (" -m pam2exu" if m.group(1) == "pam2exu" else ""), command)
+
+
+def _env() -> dict:
+    return {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
+
+
+def _outputs(page: Path) -> list[tuple[str, str]]:
+    """(command, output shown) for every ```text block marked `<!-- output of: COMMAND -->`."""
+    return re.findall(r"<!-- output of: (.*?) -->\s*```text\n(.*?)```",
+                      page.read_text(encoding="utf-8"), re.S)
+
+
+def _same_line(got: str, shown: str) -> bool:
+    """Equal word by word; numbers to 5 % (the docs print 2 to 6 digits) or 1e-9 (round-off
+    zeros such as -3.8e-17 may differ in sign and size between machines)."""
+    a, b = got.split(), shown.split()
+    if b and b[-1] == "…":                       # a line cut short: its beginning
+        b, a = b[:-1], a[:len(b) - 1]
+    if len(a) != len(b):
+        return False
+    for x, y in zip(a, b):
+        try:
+            fx, fy = float(x), float(y)
+        except ValueError:
+            if x != y:
+                return False
+            continue
+        if abs(fx - fy) > 1e-9 + 0.05 * abs(fy):
+            return False
+    return True
+
+
+def _assert_shows(output: str, shown: str, what: str) -> None:
+    """Every line shown appears in the output, in order; a line holding only `…` (or a
+    table row `| …`) stands for lines left out, and a line ending in ` …` for its end."""
+    lines = output.splitlines()
+    k = 0
+    for line in shown.splitlines():
+        if line.strip() in ("…", "| …", "") or line.strip().startswith("| …"):
+            continue
+        while k < len(lines) and not _same_line(lines[k], line):
+            k += 1
+        assert k < len(lines), f"{what}: the docs show\n  {line}\nbut the output is\n{output}"
+        k += 1
+
+
+def test_output_blocks_are_checked():
+    """The convention is in use (docs/README.md, "Runnable blocks")."""
+    assert sum(len(_outputs(p)) for p in PAGES) >= 4
+
+
+def test_output_comparison_can_fail():
+    assert _same_line("x  0.1   -3.8e-17", "x 0.1 1e-17")
+    assert not _same_line("x 0.1", "x 0.2")
+    assert not _same_line("PASS: all", "FAIL: all")
+    assert _same_line("FAIL: a, b, c", "FAIL: a, …") and not _same_line("FAIL: b, c", "FAIL: a, …")
+    with pytest.raises(AssertionError, match="the docs show"):
+        _assert_shows("a 1\nb 2\n", "b 2\n…\na 1", "order")
 
 
 TOML_PAGES = [p for p in PAGES if p.name != "README.md"
