@@ -1,4 +1,7 @@
-"""The Python blocks of the README and of docs/*.md run as written (from the repository root)."""
+"""The README and docs/*.md as a user meets them: every ```python block runs (from the
+repository root), every ```bash line runs with the exit code it states (from a scratch
+directory), marked output blocks match a fresh run, and the models shown are valid and
+equal the shipped files they name. The conventions are in docs/README.md."""
 import os
 import re
 import shlex
