@@ -81,8 +81,10 @@ def _first_line(function) -> str:
 
 
 def reported_at(cls: type[Element]) -> str:
-    """Where and in which basis a constraint element's reaction is reported, in words."""
-    return _first_line(cls.report_frame).rstrip(".")
+    """Where and in which basis a constraint element's reaction is reported, in words,
+    to follow "reported" ('at the joint, global basis')."""
+    text = _first_line(cls.report_frame).rstrip(".")
+    return text[:1].lower() + text[1:]
 
 
 def _table(header: tuple[str, ...], rows) -> list[str]:
@@ -120,7 +122,7 @@ def element_markdown(cls: type[Element], level: int = 3, anchor: bool = True) ->
                          for v in cls.outputs))
         lines.append("")
     if cls.wrench:
-        lines += [f"Reaction reported: {reported_at(cls)[0].lower()}{reported_at(cls)[1:]}.", ""]
+        lines += [f"Reaction reported: {reported_at(cls)}.", ""]
     return "\n".join(lines)
 
 
@@ -169,7 +171,7 @@ def reactions_markdown() -> str:
         lines += [f'<a id="{cls.type}"></a>', "", f"### `{cls.type}`", "",
                   f"![free-body sketch of {cls.type}](img/fbd_{cls.type}.png)", ""]
         if cls.wrench:
-            lines += [f"Reported {reported_at(cls)[0].lower()}{reported_at(cls)[1:]}.", ""]
+            lines += [f"Reported {reported_at(cls)}.", ""]
         lines += [f"- `{v.name}` [{v.unit}]: {v.meaning}" for v in forces]
         if not forces:         # an applied load: its constants are inputs, not outputs
             lines += ["An input, not an output: " + "; ".join(
