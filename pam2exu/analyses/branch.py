@@ -151,7 +151,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
                   "on along the branch it was on, and the velocities and accelerations "
                   "there are interpolated from the neighbouring steps (error of order "
                   "(ω dt)⁴).", ConditionWarning)
-    near = np.nonzero(_spikes(defect) | np.convolve(singular, [1, 1, 1], "same").astype(bool))[0]
+    near = np.nonzero(_spikes(defect) | _with_neighbours(singular))[0]
     _warn_ill_conditioned(job, q, singular, near)
     return q, qd, (qdd if accelerations else None)
 
@@ -216,6 +216,14 @@ def _spikes(defect) -> np.ndarray:
         windows = np.lib.stride_tricks.sliding_window_view(np.pad(finite, 8, mode="edge"), 17)
         background = np.median(windows[candidates], axis=1)
         out[candidates] = defect[candidates] > SPIKE * background
+    return out
+
+
+def _with_neighbours(mask: np.ndarray) -> np.ndarray:
+    """m_k | m_{k−1} | m_{k+1}: the steps marked and those next to them (any length)."""
+    out = mask.copy()
+    out[1:] |= mask[:-1]
+    out[:-1] |= mask[1:]
     return out
 
 

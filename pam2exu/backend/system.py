@@ -26,6 +26,9 @@ from .symbolic import offset_function
 #: Exudyn's dense linear solver up to this many coordinates, the sparse one above (measured:
 #: sparse is faster from 27–51 coordinates on, 14× faster at 300; docs/performance.md)
 DENSE_UP_TO = 40
+#: Exudyn's static solver may cut a load step that fails into smaller ones: not below this
+#: fraction of a step (bounds the work of a step that cannot be solved)
+MIN_STEP_FRACTION = 1.0 / 64
 
 
 @dataclass
@@ -304,7 +307,9 @@ class ExudynSystem:
         self.error, self.multipliers = None, None
         if not self.sensors:                     # every solid is fixed: nothing to solve
             return np.tile(self.mech.initial_q(), (n, 1)), n
-        dt = float(times[1] - times[0]) if n > 1 else 1.0
+        # one time alone (an assembly, a restart at the last step) is step k0 = 1 of a grid
+        # of spacing t (or 1 s at t = 0)
+        dt = float(times[1] - times[0]) if n > 1 else (float(times[0]) or 1.0)
         k0 = int(round(times[0] / dt))          # global index of the first step
         tables = [(obj, par, law, shift, law(times)[0] + shift)
                   for obj, par, law, shift in self.drivers]
@@ -353,6 +358,9 @@ class ExudynSystem:
         ss.staticSolver.numberOfLoadSteps = n
         ss.staticSolver.loadStepStart = k0 * dt
         ss.staticSolver.loadStepDuration = n * dt
+        # where Newton fails, Exudyn retries with smaller steps: at most MIN_STEP_FRACTION
+        # of a step (its default, 1e-8 s, lets a long step be cut into ~1e15 pieces)
+        ss.staticSolver.minimumStepSize = MIN_STEP_FRACTION * dt
         error = None
         exu.config.printToConsole = settings.verbose > 0
         try:
