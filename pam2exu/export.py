@@ -198,7 +198,8 @@ def script(model, t_end: float | None = None, steps: int | None = None,
 
     # the job and the checks of a kinematic run: same interval, same mobility errors
     job = prepare(model, "kinematic", t_end, steps, ["*.x", "*.y", "*.fi"])
-    mech, times = job.mech, job.times
+    # the user's times (a run solves long steps in sub-steps, the script does not)
+    mech, times = job.mech, job.times[::job.every]
     mob = check_mobility(job, mech.initial_q(), need_driven=True)
     system = ScriptSystem(mech, forces=forces)
     options = solver_options(mech, SolveSettings(), mob.redundant > 0, system.roundoff(times))

@@ -182,15 +182,14 @@ def _track(job: Job, j0: int, k1: int, start, redundant: bool, count: int = SUBS
 
 def _unturn(mech, t, part, solved, start):
     """``part`` with whole turns removed from its angles so that it starts nearest
-    ``start`` (when the constraints still hold after it)."""
-    turns = np.rint((part[0, 2::3] - start[2::3]) / (2 * np.pi))
+    ``start`` (where the constraints still hold after it)."""
+    turns = native.whole_turns(mech, float(t[0]), part[0], start)
     if not turns.any():
         return part
     out = part.copy()
     out[:, 2::3] -= 2 * np.pi * turns
-    before = np.max(np.abs(native.residuals(mech, t[:1], part[:1])))
-    after = np.max(np.abs(native.residuals(mech, t[:1], out[:1])))
-    return out if after <= max(before, 1e-12 * mech.scale()) * 10 else part
+    return out
+
 
 
 def _compare(job, q, qd, qdd, j, k, candidate, scale, redundant) -> str:

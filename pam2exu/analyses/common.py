@@ -14,7 +14,7 @@ from ..errors import ModelError, Problem, SolverError, TranslationError
 from ..kinematics import State
 from ..model import Model, load
 from ..results import Results, select_columns
-from . import native
+from . import grid, native
 
 #: the outputs of every solid
 SOLID_OUTPUTS = (
@@ -102,7 +102,11 @@ class ConditionWarning(UserWarning):
 
 @dataclass
 class Job:
-    """One analysis of one mechanism, with everything decided before the numerics."""
+    """One analysis of one mechanism, with everything decided before the numerics.
+
+    ``times`` is the grid positions are solved on; the results keep every ``every``-th row
+    of it (the user's times, ``grid.Plan``).
+    """
 
     mech: object
     analysis: str
@@ -113,6 +117,9 @@ class Job:
     solver: object = None
     warnings: list[str] = field(default_factory=list)
     info: dict = field(default_factory=dict)
+    every: int = 1
+    #: (actuator, its largest motion per user step, unit), for messages
+    motion: tuple | None = None
 
 
 def available_columns(mech, analysis: str) -> dict[str, Var]:
@@ -144,22 +151,26 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
         raise ModelError(problems, model.source)
     mech = model.mechanism()
     kind = settings.type
-    if kind == "assembly":
-        times = np.zeros(1)
-    else:
-        times = np.linspace(0.0, float(settings.t_end), int(settings.steps) + 1)
     available = available_columns(mech, kind)
     try:
         columns = select_columns(list(available), settings.outputs)
     except ModelError as exc:
         raise ModelError(exc.problems, model.source) from None
+    if kind == "assembly":
+        plan = grid.Plan(np.zeros(1), 1, None)
+    else:
+        plan = grid.plan(mech, settings.t_end, settings.steps, len(columns))
     levels = {available[c].level for c in columns} | {POSITION}
     if FORCE in levels and kind == "kinetostatic":
         levels.add(ACCELERATION)                 # the inertia forces need qdd
     if ACCELERATION in levels:
         levels.add(VELOCITY)
-    return Job(mech, kind, times, columns, {c: available[c].unit for c in columns}, levels,
-               solver)
+    job = Job(mech, kind, plan.times, columns, {c: available[c].unit for c in columns},
+              levels, solver, every=plan.every, motion=plan.motion)
+    if plan.every > 1:
+        job.info["substeps"] = plan.every
+    return job
+
 
 
 def check_mobility(job: Job, q0: np.ndarray, need_driven: bool) -> native.Mobility:
@@ -208,12 +219,16 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     """
     from ..backend import ExudynSystem, SolveSettings
     mech = job.mech
-    start = _time.perf_counter()
-    system = ExudynSystem(mech, forces=forces, velocity_forces=False,
-                          anchor_stiffness=anchor_stiffness)
-    q, solved = system.solve_positions(job.times, job.solver or SolveSettings(),
-                                       redundant=redundant, multipliers=forces)
-    job.info["exudyn_seconds"] = _time.perf_counter() - start
+    clock = _time.perf_counter()
+    start = assemble(job, redundant, anchor_stiffness)
+    if len(job.times) == 1 and not forces:          # the assembly itself
+        q, solved, system = start[None], 1, None
+    else:
+        system = ExudynSystem(mech, forces=forces, velocity_forces=False, start=start)
+        q, solved = system.solve_positions(job.times, job.solver or SolveSettings(),
+                                           redundant=redundant, multipliers=forces)
+    job.info["exudyn_seconds"] = _time.perf_counter() - clock
+
     if solved < len(job.times) and not (partial and solved > 0):
         raise _position_failure(job, system, q, solved)
     if check:
@@ -225,7 +240,29 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     return (q, system) if forces else q
 
 
+def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.ndarray:
+    """x, y, fi of every solid at the first time, solved by Exudyn from the model's guess.
+
+    What the assembly analysis returns, and where every other analysis starts: each angle
+    keeps the whole turn nearest its guess where the constraints allow (Newton's iteration
+    may land a whole turn away, and the guess says which numbering the user means).
+    ``anchor_stiffness``: see ``ExudynSystem`` (free degrees of freedom).
+    """
+    from ..backend import ExudynSystem, SolveSettings
+    mech = job.mech
+    system = ExudynSystem(mech, anchor_stiffness=anchor_stiffness)
+    t0 = job.times[:1]
+    q, solved = system.solve_positions(t0, job.solver or SolveSettings(), redundant=redundant)
+    if not solved:
+        raise _position_failure(job, system, q, 0)
+    guess = mech.initial_q()
+    q0 = q[0].copy()
+    q0[2::3] -= 2 * np.pi * native.whole_turns(mech, float(t0[0]), q0, guess)
+    return q0
+
+
 def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverError:
+
     """The error for Exudyn's static solver stopping at step ``solved``, with a diagnosis.
 
     A least-squares solve at the failing time (native, for the message only) tells whether
@@ -342,8 +379,15 @@ def velocities(job: Job, q: np.ndarray, redundant: bool):
 
 
 def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Results:
-    """The Results table of the chosen columns."""
-    mech, t = job.mech, job.times
+    """The Results table of the chosen columns, on the user's times (rows of the solve grid).
+
+    The last guard of every analysis: a value that is not finite is a SolverError naming
+    the columns and the first time, never a result.
+    """
+    mech, rows = job.mech, slice(None, None, job.every)
+    t = job.times[rows]
+    q, qd, qdd = (None if a is None else a[rows] for a in (q, qd, qdd))
+    extra = {k: v[rows] for k, v in (extra or {}).items()}
     wanted = set(job.columns)
     values: dict[str, np.ndarray] = {}
     for i, s in enumerate(mech.solids):
@@ -359,7 +403,28 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
             for var, v in el.compute(st, names).items():
                 if var in names:
                     values[f"{el.name}.{var}"] = v
-    values.update(extra or {})
+    values.update(extra)
     values = {k: v + 0.0 for k, v in values.items()}    # no negative zeros in tables
+    check_finite(job, t, values)
     return Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
                    mech.name, job.warnings, job.info)
+
+
+def check_finite(job: Job, t: np.ndarray, values: dict[str, np.ndarray]) -> None:
+    """SolverError when a column has a value that is not finite (NaN, ±inf)."""
+    bad = {name: np.nonzero(~np.isfinite(v))[0] for name, v in values.items()}
+    bad = {name: rows for name, rows in bad.items() if rows.size}
+    if not bad:
+        return
+    k = min(int(rows[0]) for rows in bad.values())
+    names = [name for name, rows in bad.items() if rows[0] == k]
+    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    raise SolverError(
+        f"the {job.analysis} analysis gave values that are not numbers (NaN or infinite) "
+        f"first at t = {t[k]:.6g} s (row {k}), in {shown}"
+        + (f"; {len(bad)} columns in all" if len(bad) > len(names) else "")
+        + ". The mechanism is at or near a position where these are not defined (a "
+          "singular position, two points of an element that coincide): end the interval "
+          "before this time, or change the model so it avoids that position.",
+        time=float(t[k]), step=k)
+

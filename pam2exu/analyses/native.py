@@ -158,7 +158,38 @@ def turns_jumped(t, q, qd, solids: int) -> np.ndarray:
     return n
 
 
+def whole_turns(mech, t: float, q: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """n (solids,): whole turns to take from each angle of q (a configuration at time t) to
+    bring it nearest the angle of ``target``, where the constraints still hold after it.
+
+    Joints are 2π-periodic in the angles, actuators and transmissions are not: a solid whose
+    angle an actuator sets keeps its turn. Each solid is tried alone, then all together
+    (gears coupled by a transmission turn together).
+    """
+    wanted = np.rint((q[2::3] - target[2::3]) / (2 * np.pi))
+    wanted[~np.isfinite(wanted)] = 0.0
+    if not wanted.any() or mech.n_equations == 0:
+        return wanted
+    tol = 10 * max(float(np.max(np.abs(residuals(mech, [t], q)))), 1e-12 * mech.scale())
+
+    def holds(turns):
+        moved = q.copy()
+        moved[2::3] -= 2 * np.pi * turns
+        return float(np.max(np.abs(residuals(mech, [t], moved)))) <= tol
+
+    if holds(wanted):
+        return wanted
+    accepted = np.zeros_like(wanted)
+    for i in np.nonzero(wanted)[0]:
+        trial = accepted.copy()
+        trial[i] = wanted[i]
+        if holds(trial):
+            accepted = trial
+    return accepted
+
+
 def continuity_defect(t, qd, qdd, scale, breakpoints=()) -> np.ndarray:
+
     """d_k = max |qd_k − qd_{k−1} − dt (qdd_k + qdd_{k−1})/2| / scale (k ≥ 1; d_0 = 0).
 
     On a smooth motion d_k = O(dt³); a jump of the velocities, as when Newton's iteration

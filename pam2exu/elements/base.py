@@ -10,14 +10,13 @@ builder, ``draw`` a pen (``pictures.pen.Pen``).
 """
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import closest
+from ..limits import VALUE, is_number, shown
 from ..kinematics import Quantity, State
 from ..laws import LAW_ALIASES, LAWS, Law, law_names
 
@@ -37,10 +36,6 @@ class Var:
 
 # --- parameter kinds: each returns an error message for a bad value, or None -------------
 
-def _is_number(v) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
-
-
 @dataclass(frozen=True)
 class Param:
     """A key an element takes besides name, anc1 and anc2."""
@@ -50,6 +45,7 @@ class Param:
     size: int = 4        # for constants: at most this many
     choices: tuple = ()
     required: bool = False
+    limit: float = VALUE     # for numbers and constants: the largest magnitude allowed
 
     def problem(self, key: str, value: Any) -> str | None:
         if value is None:
@@ -59,14 +55,22 @@ class Param:
             if len(values) > self.size:
                 return (f"'{key}' has {len(values)} constants, at most {self.size} are allowed "
                         f"({self.meaning})")
-            bad = [repr(v) for v in values if not _is_number(v)]
+            bad = [repr(v) for v in values if not is_number(v)]
             if bad:
                 return f"'{key}' must hold numbers, got {', '.join(bad)}"
+            large = [f"C{k + 1} = {v:g}" for k, v in enumerate(values) if abs(v) > self.limit]
+            if large:
+                return (f"'{key}' is out of range: {', '.join(large)}; constants must lie "
+                        f"within ±{self.limit:g} ({self.meaning}; are the units right?)")
         elif self.kind == "number":
             if isinstance(value, (list, tuple)) and len(value) == 1:
                 value = value[0]
-            if not _is_number(value):
+            if not is_number(value):
                 return f"'{key}' must be a number ({self.meaning}), got {value!r}"
+            if abs(value) > self.limit:
+                return (f"'{key}' = {value:g} is out of range: it must lie within "
+                        f"±{self.limit:g} ({self.meaning}; are the units right?)")
+
         elif self.kind == "law":
             if not isinstance(value, str) or (value not in LAWS and value not in LAW_ALIASES):
                 return (f"unknown law '{value}'{closest(value, law_names())}; "
@@ -141,6 +145,8 @@ class Element:
     #: the element holds its (first) solid at its pose: a constraints-only Exudyn system
     #: may model that solid as ground instead
     grounds: ClassVar[bool] = False
+    #: the element drives a coordinate by a time law f(t) (an actuator: ``time_law``)
+    drives: ClassVar[bool] = False
 
     #: 1-based position in the file's [[element]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
@@ -154,7 +160,8 @@ class Element:
     @property
     def where(self) -> str:
         at = f" #{self.position}" if self.position else ""
-        return f"[[element]]{at} '{self.name}' ({self.type})"
+        return f"[[element]]{at} '{shown(self.name)}' ({self.type})"
+
 
     def problems(self, scope) -> list[str]:
         """Every problem with this element's keys and references (empty when it is sound)."""
@@ -256,6 +263,9 @@ class Element:
 
 class Actuator(Element):
     """An element whose constraint follows a time law f(t)."""
+
+    drives = True
+
 
     def more_problems(self, scope):
         law = LAW_ALIASES.get(self.law, self.law)

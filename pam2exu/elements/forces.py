@@ -130,7 +130,15 @@ class Spring(_SpringDamper):
 
     variable, force = "ro", "Força"
 
+    def more_problems(self, scope):
+        P, Q = (scope.point(a) for a in (self.anc1, self.anc2))
+        if P.solid == Q.solid and P.local == Q.local:
+            return [f"anc1 and anc2 are the same point '{self.anc1}': a spring of length 0 "
+                    "has no direction for its force; attach it between two different points"]
+        return []
+
     def measure(self, st):
+
         """ro = |Q − P| (F > 0 attracts P and Q)."""
         P, Q = (st.point(r.solid, r.local) for r in self.refs)
         return (Q - P).norm()

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from ..kinematics import stack
+from ..limits import ANGLE
 from .base import FORCE, Element, Param, Var, number
 
 
@@ -197,8 +198,8 @@ class Transmission(Element):
                "hinged to by revolute joints (ground included); name it with `arm` when that "
                "is ambiguous")
     params = {
-        "T": Param("number", "transmission ratio", required=True),
-        "C": Param("number", "initial angle [rad]"),
+        "T": Param("number", "transmission ratio", required=True, limit=1e6),
+        "C": Param("number", "initial angle [rad]", limit=ANGLE),
         "arm": Param("solid", "the solid both gears are hinged to (found when unambiguous)"),
     }
     outputs = (Var("Parell", "N·m", FORCE, "torque solid 2 receives from the transmission "
@@ -208,8 +209,13 @@ class Transmission(Element):
     wrench = (None, None, "Parell")
 
     def more_problems(self, scope):
+        if number(self.T) == 0:
+            return ["T = 0 is not a gear ratio: it would hold solid 2 to the arm and leave "
+                    "solid 1 free; give the ratio of the angular velocities (fi2 − fi_arm)' / "
+                    "(fi1 − fi_arm)', e.g. T = -0.5 for a pinion driving a gear twice its size"]
         if self.arm is not None:
             return []
+
         arms = self.candidate_arms(scope)
         s1, s2 = (scope.solids[scope.solid(a).solid].name for a in (self.anc1, self.anc2))
         if not arms:

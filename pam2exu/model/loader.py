@@ -49,10 +49,40 @@ def load(path: str | Path) -> Model:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except OSError as exc:
-        raise ModelError(f"cannot read the model file: {exc.strerror}", str(path)) from None
-    return loads(text, source=str(path))
+        raise ModelError(f"cannot read the model file: {exc.strerror or exc}", str(path)) \
+            from None
+    model = loads(decode(raw, str(path)), source=str(path))
+    model.encoding = "cp1252" if _cp1252(raw) else "utf-8"
+    return model
+
+
+def _cp1252(raw: bytes) -> bool:
+    """The bytes are not UTF-8 (so ``decode`` read them as Windows-1252)."""
+    try:
+        raw.decode("utf-8-sig")
+        return False
+    except UnicodeDecodeError:
+        return True
+
+
+def decode(raw: bytes, source: str) -> str:
+    """A model file's text: UTF-8 (with or without BOM), else Windows-1252.
+
+    Windows editors and PAM's exports save Windows-1252 ("ANSI"): its accented letters
+    (``Força``, ``molla_amortidor``) are read as they are meant. Bytes that are neither
+    are a ModelError that says to save the file as UTF-8.
+    """
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as utf8:
+        try:
+            return raw.decode("cp1252")
+        except UnicodeDecodeError:
+            raise ModelError(
+                f"the file is not text in UTF-8 or Windows-1252 (byte 0x{raw[utf8.start]:02x} at "
+                f"position {utf8.start}): save it as UTF-8 text", source) from None
 
 
 def loads(text: str, source: str = "<string>") -> Model:
@@ -108,6 +138,10 @@ def loads(text: str, source: str = "<string>") -> Model:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"not valid TOML: {exc}", source) from None
+    except RecursionError:
+        raise ModelError("not valid TOML for a model: arrays or tables are nested too deeply "
+                         "(no model value is nested more than three levels)", source) from None
+
     problems: list[Problem] = []
     for key in data:
         if key not in _TABLES:

@@ -6,12 +6,12 @@ returns the validated, resolved form the translation and the analyses work on.
 from __future__ import annotations
 
 import copy
-import math
-import numbers
 from dataclasses import dataclass, field, fields
 
+from .. import limits
 from ..elements import ALIASES, ELEMENTS, Element
 from ..errors import ModelError, Problem, closest
+from ..limits import is_number as _number
 from .solid import Scope, Solid
 
 #: analysis types of the contract
@@ -20,9 +20,6 @@ ANALYSIS_TYPES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
 ANALYSIS_ALIASES = {"ensamblatge": "assembly", "quasi_estatica": "quasi_static",
                     "cinematica": "kinematic", "cinetostatica": "kinetostatic"}
 
-
-def _number(v) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
 
 
 @dataclass
@@ -83,13 +80,21 @@ class Analysis:
             out.append(f"unknown analysis type '{self.type}'{closest(self.type, known)}; "
                        f"known types: {', '.join(ANALYSIS_TYPES)} (Catalan: "
                        f"{', '.join(ANALYSIS_ALIASES)})")
+        low, high = limits.T_END
         if not _number(self.t_end) or self.t_end <= 0:
             out.append(f"t_end must be a positive number of seconds, got {self.t_end!r}")
+        elif not low <= self.t_end <= high:
+            out.append(f"t_end = {self.t_end:g} s is out of range: it must lie between "
+                       f"{low:g} s and {high:g} s")
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
             out.append(f"steps must be a positive whole number, got {self.steps!r}")
+        elif self.steps > limits.STEPS:
+            out.append(f"steps = {self.steps} is more than pam2exu runs ({limits.STEPS:,}): "
+                       "use fewer steps")
         if self.outputs is not None and (
-                isinstance(self.outputs, str)
+                not isinstance(self.outputs, (list, tuple))
                 or not all(isinstance(o, str) for o in self.outputs)):
+
             out.append("outputs must be a list of names or patterns, e.g. [\"crank.*\", \"Fx\"]")
         return out
 
@@ -150,6 +155,9 @@ class Model:
         self.name = name
         self.gravity = gravity
         self.source = source
+        #: how the model file was read: "utf-8", or "cp1252" (Windows-1252, see ``load``)
+        self.encoding = "utf-8"
+
         self.solids: list[Solid] = []
         self.elements: list[Element] = []
         self.analysis = Analysis()
@@ -309,6 +317,11 @@ class Model:
         if not _number(self.gravity) or self.gravity < 0:
             out.append(Problem("[model]", f"gravity is the magnitude along −y, a number ≥ 0; "
                                           f"got {self.gravity!r}"))
+        elif self.gravity > limits.VALUE:
+            out.append(Problem("[model]", f"gravity = {self.gravity:g} m/s² is out of range "
+                                          f"(at most {limits.VALUE:g})"))
+        if not isinstance(self.name, str):
+            out.append(Problem("[model]", f"name must be a string, got {self.name!r}"))
         seen: dict[str, str] = {}
         for solid in self.solids:
             out += [Problem(solid.where, m) for m in _solid_problems(solid)]
@@ -353,12 +366,11 @@ class Model:
 
 
 def _unique(name, where, seen, out):
-    if not isinstance(name, str) or not name:
-        out.append(Problem(where, "name must be a non-empty string"))
-        return
-    if "." in name:
-        out.append(Problem(where, f"name '{name}' contains '.', which separates a solid "
-                                  "from its point or line: rename it"))
+    problem = limits.name_problem(name)
+    if problem:
+        out.append(Problem(where, problem))
+        if not isinstance(name, str) or len(name) > limits.NAME:
+            return
     if name in seen:
         out.append(Problem(where, f"name '{name}' is already used by {seen[name]}: "
                                   "solids and elements share one namespace, rename one of them"))
@@ -370,22 +382,48 @@ def _pair(v) -> bool:
     return isinstance(v, (list, tuple)) and len(v) == 2 and all(_number(x) for x in v)
 
 
+#: a solid's numbers: (key, range, unit)
+_SOLID_NUMBERS = (("x", limits.LENGTH, "m"), ("y", limits.LENGTH, "m"),
+                  ("fi", limits.ANGLE, "rad"), ("mass", limits.VALUE, "kg"),
+                  ("inertia", limits.VALUE, "kg·m²"))
+
+
+def range_problems(what: str, value, limit: float, unit: str) -> list[str]:
+    """A message when a number's magnitude exceeds its range (a unit error, most likely)."""
+    if limits.out_of_range(value, limit):
+        return [f"{what} = {value:g} {unit} is out of range: its magnitude must be at most "
+                f"{limit:g} {unit} (are the units right?)"]
+    return []
+
+
+def _point_range(what: str, p) -> list[str]:
+    """Range messages of the coordinates [x, y] of a point [m]."""
+    return [m for c, v in zip("xy", p)
+            for m in range_problems(f"{what} {c}", v, limits.LENGTH, "m")]
+
+
 def _solid_problems(s: Solid) -> list[str]:
     out = []
-    for key in ("x", "y", "fi", "mass", "inertia"):
-        if not _number(getattr(s, key)):
-            out.append(f"{key} must be a number, got {getattr(s, key)!r}")
+    for key, limit, unit in _SOLID_NUMBERS:
+        value = getattr(s, key)
+        if not _number(value):
+            out.append(f"{key} must be a number, got {value!r}")
+        out += range_problems(key, value, limit, unit)
     for key in ("mass", "inertia"):
         if _number(getattr(s, key)) and getattr(s, key) < 0:
             out.append(f"{key} is negative ({getattr(s, key)}): it must be ≥ 0")
     if not _pair(s.cog):
         out.append(f"cog must be [x, y] in the local frame, got {s.cog!r}")
+    else:
+        out += _point_range("cog", s.cog)
     if not isinstance(s.points, dict):
         out.append(f"points must be a table {{ A = [x, y] }}, got {s.points!r}")
     else:
         for name, p in s.points.items():
             if not _pair(p):
                 out.append(f"point '{name}' must be [x, y], got {p!r}")
+            else:
+                out += _point_range(f"point '{name}'", p)
     if not isinstance(s.lines, dict):
         out.append(f"lines must be a table {{ l = {{ point = [x, y], angle = a }} }}, got {s.lines!r}")
         return out
@@ -398,8 +436,12 @@ def _solid_problems(s: Solid) -> list[str]:
                 out.append(f"line '{name}' has an unknown key '{key}'{closest(key, ('point', 'angle'))}")
         if "point" in line and not _pair(line["point"]):
             out.append(f"line '{name}': point must be [x, y], got {line['point']!r}")
+        elif "point" in line:
+            out += _point_range(f"line '{name}' point", line["point"])
         if "angle" in line and not _number(line["angle"]):
             out.append(f"line '{name}': angle must be a number [rad], got {line['angle']!r}")
+        out += range_problems(f"line '{name}' angle", line.get("angle"), limits.ANGLE, "rad")
+
     return out
 
 
@@ -445,6 +487,9 @@ class Mechanism:
         for el in self.elements:
             el.bind(scope)
         self.constraints = [e for e in self.elements if e.equations]
+        #: the actuators: constraint elements that drive a coordinate by a time law
+        self.drivers = [e for e in self.constraints if e.drives]
+
         rows, start = [], 0
         for el in self.constraints:
             rows.append(slice(start, start + el.equations))

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import closest
+from ..limits import shown
 
 
 @dataclass(eq=False)
@@ -65,7 +66,7 @@ class Solid:
     def where(self) -> str:
         """Where the solid is in the model, for messages: ``"[[solid]] #2 'crank'"``."""
         at = f" #{self.position}" if self.position else ""
-        return f"[[solid]]{at} '{self.name}'"
+        return f"[[solid]]{at} '{shown(self.name)}'"
 
 
 @dataclass(frozen=True)
@@ -115,7 +116,9 @@ class Scope:
 
     def __init__(self, solids: list[Solid]):
         self.solids = solids
-        self.index = {s.name: i for i, s in enumerate(solids)}
+        # a name that is not a string is reported by the validation, never found here
+        self.index = {s.name: i for i, s in enumerate(solids) if isinstance(s.name, str)}
+
 
     def solid(self, text: str) -> SolidRef:
         name = str(text)

@@ -1,0 +1,141 @@
+"""The time grid of a run, decided before any numerics: laws, motion per step, work.
+
+``plan(mech, t_end, steps)`` returns the grid positions are solved on. It checks that
+
+- every actuator's law f(t), f'(t), f''(t) is finite and within range over the run, and a
+  linear actuator's distance f(t) stays positive (a length of zero has no direction);
+- no actuator moves more than ``MAX_ANGLE_STEP`` [rad] or ``MAX_LENGTH_STEP`` × the
+  mechanism's length [m] from one position solve to the next: Newton's iteration started
+  from the previous configuration then stays on the mechanism's branch. Where the user's
+  steps are longer, each is solved in ``every`` equal sub-steps and the results are
+  reported on the user's grid (``Plan.output``);
+- the run's position solves and memory stay within ``limits.SOLVE_STEPS`` and
+  ``limits.MEMORY``: a run that would need more is a ModelError that says how far each
+  actuator moves per step and how many steps would do.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import limits
+from ..errors import ModelError, Problem
+
+#: the most an angular actuator may turn between two position solves [rad]
+MAX_ANGLE_STEP = 0.25
+#: the most a linear actuator may move between two position solves [× the length scale]
+MAX_LENGTH_STEP = 0.05
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The grid positions are solved on, and which of its rows the user asked for.
+
+    times:  the solve grid, t_k = k t_end / (steps · every) [s]
+    every:  sub-steps per user step (1: the user's grid itself)
+    motion: (actuator name, its motion per user step, unit) of the actuator that moves
+            most per step relative to its limit; None without actuators
+    """
+
+    times: np.ndarray
+    every: int
+    motion: tuple[str, float, str] | None
+
+    @property
+    def output(self) -> slice:
+        """The rows of the solve grid that are the user's times."""
+        return slice(None, None, self.every)
+
+
+def driver_unit(el) -> tuple[str, float]:
+    """(unit, most motion per solve step) of an actuator: rad, or m for a linear one."""
+    return ("m", MAX_LENGTH_STEP) if el.type == "linear_actuator" else ("rad", MAX_ANGLE_STEP)
+
+
+def motion_per_step(law, times: np.ndarray) -> float:
+    """max_k max(|f(t_k+1) − f(t_k)|, |f'(t_k)| Δt): the most the law moves in one step."""
+    with np.errstate(all="ignore"):
+        f, df, _ = law(times)
+        dt = float(times[1] - times[0])
+        return float(max(np.max(np.abs(np.diff(f))), np.max(np.abs(df)) * dt))
+
+
+def check_laws(mech, times: np.ndarray, ranges: bool = True) -> None:
+    """ModelError unless every law is finite (and, with ``ranges``, within range) at every
+    time of the grid."""
+    problems = []
+    for el in mech.drivers:
+        law = el.time_law()
+        with np.errstate(all="ignore"):
+            values = law(times)
+        unit, _ = driver_unit(el)
+        limit = limits.LENGTH if unit == "m" else limits.ANGLE
+        for order, v in enumerate(values):
+            bad = ~np.isfinite(v)
+            if order == 0 and ranges:
+                bad |= np.abs(v) > limit
+            if bad.any():
+                k = int(np.argmax(bad))
+                name = ("f(t)", "f'(t)", "f''(t)")[order]
+                value = f"{v[k]:g}" if np.isfinite(v[k]) else "not finite"
+                range_ = f" (at most {limit:g} {unit})" if order == 0 else ""
+                problems.append(Problem(el.where, (
+                    f"law '{law.name}' with C = {list(law.C)}: {name} is {value} at "
+                    f"t = {times[k]:g} s{range_}; check the constants and their units")))
+                break
+        else:
+            if ranges and unit == "m" and np.min(values[0]) <= 0:
+                k = int(np.argmin(values[0]))
+                problems.append(Problem(el.where, (
+                    f"the distance PQ must stay positive, but law '{law.name}' with "
+                    f"C = {list(law.C)} gives f(t) = {values[0][k]:g} m at t = {times[k]:g} s: "
+                    f"the actuator would have no direction; change the constants")))
+    if problems:
+        raise ModelError(problems, mech.model.source)
+
+
+def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
+    """The solve grid of a run over [0, t_end] in ``steps`` steps (see the module's doc).
+
+    ``columns`` is the number of result columns, for the memory bound.
+    """
+    user = np.linspace(0.0, float(t_end), int(steps) + 1)
+    check_laws(mech, user, ranges=False)     # the motion per step is said first
+    every, worst = 1, None
+    for el in mech.drivers:
+        unit, most = driver_unit(el)
+        size = most * (mech.scale() if unit == "m" else 1.0)
+        moved = motion_per_step(el.time_law(), user)
+        # (a motion of exactly the limit, up to round-off, needs no sub-step)
+        needed = math.ceil(moved / size - 1e-9) if math.isfinite(moved) else math.inf
+        if needed > every or worst is None:
+            worst = (el, moved, unit)
+        every = max(every, needed)
+    if every > 1 and steps * every > max(limits.SOLVE_STEPS, steps):
+        el, moved, unit = worst
+        verb = "turns" if unit == "rad" else "moves"
+        _, most = driver_unit(el)
+        total = steps * every
+        raise ModelError(Problem(
+            "[analysis]",
+            f"'{el.name}' {verb} {moved:.2g} {unit} per step (t_end = {t_end:g} s in {steps} "
+            f"steps). Positions are solved in steps of at most {most:g} "
+            f"{unit if unit == 'rad' else '× the mechanism size'}, so that the solver stays "
+            f"on the mechanism's branch: this run would take {total:.2g} position solves, more "
+            f"than pam2exu runs ({limits.SOLVE_STEPS:,}). Shorten t_end, or slow the law down "
+            f"(were degrees given where radians are expected?)."), mech.model.source)
+    every = int(every)
+    times = np.linspace(0.0, float(t_end), int(steps) * every + 1) if every > 1 else user
+    check_laws(mech, times)
+
+    memory = 8 * (len(times) * (4 * mech.nq + mech.n_equations) + len(user) * (columns + 1))
+    if memory > limits.MEMORY:
+        raise ModelError(Problem(
+            "[analysis]",
+            f"this run would hold {memory / 2**30:.3g} GiB of coordinates and results "
+            f"({len(times):,} solve steps, {columns} columns), more than pam2exu allows "
+            f"({limits.MEMORY / 2**30:g} GiB): use fewer steps, or fewer outputs "
+            f"(--outputs)"), mech.model.source)
+    return Plan(times, every, (worst[0].name, *worst[1:]) if worst else None)
