@@ -42,8 +42,17 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--plot-file", metavar="FIG.png",
                      help="image file of --plot (default: <model>_plot.png)")
 
-    check = sub.add_parser("check", help="validate a model, print its mobility and elements")
+    check = sub.add_parser(
+        "check", help="validate a model, print its mobility and elements",
+        description="Everything run checks before solving: the model, the analysis settings, "
+                    "the plan of the run (laws over the interval, sub-steps, work), the "
+                    "mobility. Exit 2, with run's message, when the analysis needs every "
+                    "degree of freedom driven and one is not.")
     check.add_argument("model", help="model file (TOML)")
+    check.add_argument("--analysis", "-a", metavar="TYPE",
+                       help="the analysis to check for (default: the model's)")
+    check.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
+    check.add_argument("--steps", type=int, metavar="N", help="number of intervals")
 
     elements = sub.add_parser(
         "elements", help="the element types: keys, anchors, outputs and sign conventions",
@@ -177,13 +186,17 @@ def _run_plot(args, res) -> int:
 
 
 def _check(args) -> int:
+    """What ``run`` checks before the numerics (the model, the settings, the plan of the run,
+    the mobility), printed; exit 2 with ``run``'s message when the analysis needs every
+    degree of freedom driven and one is not."""
     import numpy as np
 
-    from .analyses.native import mobility
-    from .model import load
-    model = load(args.model)
-    mech = model.mechanism()
-    mob = mobility(mech, 0.0, mech.initial_q())
+    from .analyses.common import check_mobility, prepare
+    from .analyses.native import require_driven
+    job = prepare(args.model, args.analysis, args.t_end, args.steps)
+    mech = job.mech
+    model = mech.model
+    mob = check_mobility(job, mech.initial_q(), need_driven=False)
     print(f"model '{model.name}' ({args.model}): {len(mech.solids)} solids, "
           f"{len(mech.elements)} elements, {mech.nq} coordinates, "
           f"{mech.n_equations} constraint equations")
@@ -194,13 +207,23 @@ def _check(args) -> int:
     if np.isfinite(mob.condition):
         print(f"condition number of the constraint Jacobian at the initial guess: "
               f"{mob.condition:.3g}")
-    a = model.analysis
-    print(f"analysis: {a.type}, t = 0 … {a.t_end} s in {a.steps} steps")
+    steps = (len(job.times) - 1) // job.every
+    print(f"analysis: {job.analysis}, t = 0 … {job.times[-1]:g} s in {steps} steps"
+          if job.analysis != "assembly" else "analysis: assembly, t = 0")
+    if job.every > 1:
+        name, moved, unit = job.motion
+        print(f"'{name}' moves {moved:.3g} {unit} per step: positions are solved in "
+              f"{job.every} sub-steps per step")
+    if model.encoding != "utf-8":
+        print("the file is not UTF-8: it was read as Windows-1252")
     print()
     width = max([len(e.name) for e in mech.elements] + [4])
     for e in mech.elements:
         anchors = ", ".join(str(getattr(e, f"anc{k + 1}")) for k in range(len(e.anchors)))
         print(f"  {e.name:<{width}}  {e.type:<17} {anchors}")
+    if job.analysis != "assembly":
+        sys.stdout.flush()
+        require_driven(mech, mob, job.analysis)
     return 0
 
 

@@ -66,9 +66,23 @@ def test_check_names_free_solids(tmp_path, examples, capsys):
     src = src[:src.index('[[element]]\ntype = "angular_actuator"')]
     path = tmp_path / "free.toml"
     path.write_text(src)
-    assert main(["check", str(path)]) == 0
+    assert main(["check", str(path), "-a", "assembly"]) == 0
     assert "degrees of freedom not driven: 1 (solids free to move: crank, rod, slider)" \
         in capsys.readouterr().out
+
+
+def test_check_fails_like_run_when_the_analysis_needs_every_dof_driven(tmp_path, examples,
+                                                                      capsys):
+    """Issue 10, fault 6: check passed a model that run refuses (exit 0 before)."""
+    src = (examples / "slider_crank.toml").read_text()
+    path = tmp_path / "free.toml"
+    path.write_text(src[:src.index('[[element]]\ntype = "angular_actuator"')])
+    assert main(["run", str(path)]) == 2
+    run_message = capsys.readouterr().err
+    assert main(["check", str(path)]) == 2              # the model's kinetostatic analysis
+    out, err = capsys.readouterr()
+    assert "degrees of freedom not driven: 1" in out
+    assert err == run_message and "free degree(s) of freedom" in err
 
 
 def test_console_script_and_debug_traceback(tmp_path):

@@ -5,7 +5,7 @@ after an analysis issue.
 """
 from __future__ import annotations
 
-from ..errors import ModelError, Problem
+from ..errors import Pam2ExuError, SolverError
 from .assembly import assembly
 from .common import ConditionWarning, ConsistencyWarning, RedundancyWarning, prepare
 from .kinematic import kinematic
@@ -69,12 +69,27 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None)
     >>> len(res)                                                       # doctest: +SKIP
     21
     """
-    job = prepare(model, analysis, t_end, steps, outputs, solver)
-    if job.analysis not in ANALYSES:
-        raise ModelError(Problem("[analysis]", f"the {job.analysis} analysis is not available "
-                                 f"in this version; available: {', '.join(ANALYSES)}"),
-                         job.mech.model.source)
-    return ANALYSES[job.analysis](job)
+    job = None
+    try:
+        job = prepare(model, analysis, t_end, steps, outputs, solver)
+        return ANALYSES[job.analysis](job)
+    except Pam2ExuError:
+        raise
+    except Exception as exc:         # a fault of pam2exu: say what was being done
+        raise unexpected(exc, job, model) from exc
+
+
+def unexpected(exc: Exception, job, model) -> SolverError:
+    """The SolverError for an exception that is not pam2exu's own (its cause kept)."""
+    source = getattr(model, "source", None) or str(model)
+    doing = job.stage if job is not None else "reading and checking the model"
+    what = ("ran out of memory" if isinstance(exc, MemoryError)
+            else f"failed unexpectedly ({type(exc).__name__}: {exc})")
+    analysis = f"the {job.analysis} analysis" if job is not None else "pam2exu"
+    return SolverError(
+        f"{analysis} of {source} {what} while {doing}. This is a fault of pam2exu: please "
+        "report it with the model file (rerun with --debug for the traceback, or catch "
+        "the error's __cause__ in Python).")
 
 
 __all__ = ["ANALYSES", "run", "RedundancyWarning", "ConsistencyWarning", "ConditionWarning"]

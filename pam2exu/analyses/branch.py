@@ -21,7 +21,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SolverError
-from ..kinematics import State
 from . import native
 from .common import (ConditionWarning, Job, _position_failure, check_residual, singular_error,
                      warn)
@@ -83,6 +82,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
     verified: set[int] = set()
     resolves = 0
     while True:
+        job.stage = "computing velocities and following the branch"
         tk, qk = t[:solved], q[:solved]
         with np.errstate(all="ignore"):
             qd, qdd, residual = native.rates(mech, tk, qk, True, redundant)
@@ -96,7 +96,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
         k = _first_jump(defect, singular, verified)
         while k is not None:         # numerically singular steps: their rates are round-off
             near = [i for i in (k - 1, k) if i > 0 and not singular[i]]
-            at = [i for i, c in zip(near, condition_numbers(mech, tk[near], qk[near]))
+            at = [i for i, c in zip(near, native.condition_numbers(mech, tk[near], qk[near]))
                   if c > SINGULAR]
             if not at:
                 break
@@ -256,17 +256,6 @@ def _interpolate_singular(t, qd, qdd, singular):
     return qd, qdd
 
 
-def condition_numbers(mech, t, q) -> np.ndarray:
-    """Condition number of Cq at each step, rows and columns equilibrated (units drop out)."""
-    J = native.equations(mech, State(t, q)).jacobian
-    for _ in range(3):
-        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
-        J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
-    s = np.linalg.svd(J, compute_uv=False)
-    with np.errstate(divide="ignore"):
-        return s[:, 0] / s[:, mech.nq - 1]
-
-
 def _warn_ill_conditioned(job: Job, q, singular, near=()) -> None:
     """Warn when the constraint Jacobian is ill-conditioned somewhere: at sampled steps,
     and at the steps ``near`` singular positions or velocity jumps."""
@@ -280,7 +269,7 @@ def _warn_ill_conditioned(job: Job, q, singular, near=()) -> None:
     steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), samples)).astype(int),
                             np.asarray(near, dtype=int)[:samples]])
     steps = steps[~singular[steps]]
-    condition = condition_numbers(mech, t[steps], q[steps])
+    condition = native.condition_numbers(mech, t[steps], q[steps])
     i = int(np.argmax(condition))
     worst = float(condition[i])
     job.info["max_condition_number"] = worst

@@ -120,6 +120,8 @@ class Job:
     every: int = 1
     #: (actuator, its largest motion per user step, unit), for messages
     motion: tuple | None = None
+    #: what the analysis is doing, for the message of an unexpected failure
+    stage: str = "checking the analysis settings"
 
 
 def available_columns(mech, analysis: str) -> dict[str, Var]:
@@ -176,6 +178,7 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
 def check_mobility(job: Job, q0: np.ndarray, need_driven: bool) -> native.Mobility:
     """Rank test at the initial guess, before any Exudyn call (``warn_redundant`` follows
     once positions are solved)."""
+    native.require_defined(job.mech, float(job.times[0]), q0)
     mob = native.mobility(job.mech, float(job.times[0]), q0)
     job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
                     condition_number=mob.condition)
@@ -220,6 +223,7 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     from ..backend import ExudynSystem, SolveSettings
     mech = job.mech
     clock = _time.perf_counter()
+    job.stage = "solving the positions with Exudyn's static solver"
     start = assemble(job, redundant, anchor_stiffness)
     if len(job.times) == 1 and not forces:          # the assembly itself
         q, solved, system = start[None], 1, None
@@ -262,7 +266,6 @@ def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nda
 
 
 def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverError:
-
     """The error for Exudyn's static solver stopping at step ``solved``, with a diagnosis.
 
     A least-squares solve at the failing time (native, for the message only) tells whether
@@ -367,6 +370,7 @@ def velocities(job: Job, q: np.ndarray, redundant: bool):
     SolverError at a singular position (``branch.motion`` follows the branch instead)."""
     mech, t = job.mech, job.times
     accelerations = ACCELERATION in job.levels
+    job.stage = "computing velocities and accelerations"
     with np.errstate(all="ignore"):
         qd, qdd, residual = native.rates(mech, t, q, accelerations, redundant)
     check_residual(mech, t, q, job, residual)
@@ -384,6 +388,7 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
     The last guard of every analysis: a value that is not finite is a SolverError naming
     the columns and the first time, never a result.
     """
+    job.stage = "collecting the result columns"
     mech, rows = job.mech, slice(None, None, job.every)
     t = job.times[rows]
     q, qd, qdd = (None if a is None else a[rows] for a in (q, qd, qdd))

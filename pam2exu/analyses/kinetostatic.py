@@ -29,6 +29,7 @@ def inverse_dynamics(job: Job, q, qd, qdd, redundant: bool) -> dict[str, np.ndar
     """Reactions, spring and actuator forces at every step, then the power balance check."""
     mech, t = job.mech, job.times
     n = len(t)
+    job.stage = "computing the reactions and actuator forces (inverse dynamics)"
     out: dict[str, np.ndarray] = {}
     energy, dissipation, external = np.zeros(n), np.zeros(n), np.zeros(n)
     for s in native.chunks(mech, n, sparse=mech.n_equations >= native.SPARSE_FROM):

@@ -6,6 +6,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..errors import SolverError
 from ..kinematics import Quantity, generalized_force, rotate, torque
 from .base import FORCE, POSITION, VELOCITY, Element, Load, Param, Var, constants
 
@@ -138,10 +139,19 @@ class Spring(_SpringDamper):
         return []
 
     def measure(self, st):
-
-        """ro = |Q − P| (F > 0 attracts P and Q)."""
+        """ro = |Q − P| (F > 0 attracts P and Q); SolverError where the points coincide."""
         P, Q = (st.point(r.solid, r.local) for r in self.refs)
-        return (Q - P).norm()
+        gap = Q - P
+        length = np.hypot(gap.value[:, 0], gap.value[:, 1])
+        if st.n and np.min(length) <= 1e-12 * max(1.0, float(np.max(np.abs(P.value)))):
+            k = int(np.argmin(length))
+            raise SolverError(
+                f"at t = {st.t[k]:.6g} s the points of spring '{self.name}' coincide (ro = "
+                f"{length[k]:.3g} m): a spring of length 0 has no direction for its force. "
+                f"Attach it between points that stay apart, or end the interval before "
+                f"this time.", time=float(st.t[k]), elements=(f"'{self.name}' (spring)",))
+        return gap.norm()
+
 
     def build(self, ex):
         c1, c2, c3, c4 = constants(self.C)
