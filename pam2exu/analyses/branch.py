@@ -55,7 +55,7 @@ def _scales(mech, qd) -> np.ndarray:
 
 
 def _breakpoints(mech) -> list[float]:
-    return [b for el in mech.constraints if hasattr(el, "time_law")
+    return [b for el in mech.drivers
             for b in el.time_law().breakpoints()]
 
 

@@ -14,7 +14,7 @@ from ..errors import ModelError, Problem, SolverError, TranslationError
 from ..kinematics import State
 from ..model import Model, load
 from ..results import Results, select_columns
-from . import grid, native
+from . import grid, loops, native
 
 #: the outputs of every solid
 SOLID_OUTPUTS = (
@@ -284,47 +284,76 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
              if w[1] > can_hold]
     # actuators and fixed links can always hold on their own: name the joints, if any
     setters = {f"'{e.name}' ({e.type})" for e in mech.constraints
-               if hasattr(e, "time_law") or e.grounds}
+               if e.drives or e.grounds}
     if any(name not in setters for name, _ in worst):
         worst = [w for w in worst if w[0] not in setters]
     violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)
-    drivers = ", ".join(f"'{e.name}'" for e in mech.constraints if hasattr(e, "time_law"))
+    drivers = ", ".join(f"'{e.name}'" for e in mech.drivers)
     elements = tuple(n for n, _ in worst)
     disagreement, among = native.contradiction(mech, t, start)
+    step = _step_text(job, solved)
     if worst and disagreement > can_hold:
         since = (f"at t = {t:.6g} s" if solved == 0 else
                  f"from t = {float(times[solved - 1]):.6g} s to t = {t:.6g} s")
         names = ", ".join(f"'{n}'" for n in among)
         return SolverError(
-            f"the constraints of {names} contradict each other {since} (step {solved} of "
-            f"{len(times) - 1}): they are redundant (between them they fix a coordinate "
-            f"more than once) and their targets disagree by {disagreement:.3g} (m or rad), "
-            f"so no configuration satisfies them all. Remove the extra constraint, or make the "
-            f"laws or the geometry agree. Exudyn said: {system.error}",
-            time=t, step=solved,
+            f"the constraints of {names} contradict each other {since} ({step}): they are "
+            f"redundant (between them they fix a coordinate more than once) and their targets "
+            f"disagree by {disagreement:.3g} (m or rad), so no configuration satisfies them "
+            f"all. Remove the extra constraint, or make the laws or the geometry agree. "
+            f"Exudyn said: {system.error}",
+            time=t, step=solved // job.every,
             elements=tuple(f"'{e.name}' ({e.type})" for e in mech.constraints if e.name in among))
-    if worst and solved > 0:
+    if worst and solved == 0:
+        by_name = {f"'{el.name}' ({el.type})": el for el in mech.constraints}
+        loop = loops.diagnose(mech, [by_name[name] for name in elements], t)
+        if loop is not None:          # the joints of that loop only
+            worst = [w for w in worst if by_name[w[0]].name in loop.elements]
+            violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)
+            elements = tuple(n for n, _ in worst)
+        return SolverError(
+            f"the mechanism cannot be assembled at t = {t:.6g} s: "
+            + (f"{loop.text}. " if loop else "")
+            + f"The constraints cannot all hold: still violated at the closest configuration: "
+              f"{violated}. Exudyn said: {system.error}", time=t, step=0, elements=elements)
+    if worst:
         t0 = float(times[solved - 1])
         return SolverError(
-            f"between t = {t0:.6g} s and t = {t:.6g} s (step {solved} of {len(times) - 1}) "
+            f"between t = {t0:.6g} s and t = {t:.6g} s ({step}) "
             f"the mechanism reached a singular (dead-point) position: the actuator(s) "
             f"{drivers or '(none)'} drive it to a limit position it cannot pass. After it "
             f"the constraints cannot all hold (still violated at the closest "
             f"configuration: {violated}). Drive the mechanism by another member, change the "
             f"law so it stays within the limit, or end the interval before t = {t0:.6g} s. "
-            f"Exudyn said: {system.error}", time=t0, step=solved, elements=elements)
-    where = (f"the constraints cannot all hold; still violated at the closest "
-             f"configuration: {violated}" if worst else
-             "the constraints can all hold, so the Newton iteration diverged (a singular "
-             "position or too large a step)")
-    step = f"step {solved} of {len(times) - 1}" if job.analysis != "assembly" else "assembly"
+            f"Exudyn said: {system.error}", time=t0, step=solved // job.every,
+            elements=elements)
+    if solved == 0:
+        return SolverError(
+            f"Exudyn's static solver did not converge at t = {t:.6g} s (the assembly): the "
+            "constraints can all hold there, but the Newton iteration diverged from the "
+            "initial guess. Give the solids x, y, fi closer to an assembled position (angles "
+            "in radians). Exudyn said: " f"{system.error}", time=t, step=0, elements=elements)
+    motion = ""
+    if job.motion:
+        name, moved, unit = job.motion
+        motion = (f" ('{name}' moves {moved:.3g} {unit} per step, solved in {job.every} "
+                  "sub-steps)")
     return SolverError(
-        f"Exudyn's static solver did not converge at t = {t:.6g} s ({step}). "
-        f"At that time {where}. "
-        "Try: an initial guess (x, y, fi of the solids) closer to an assembled position; "
-        "more steps, so the actuators move less per step; or check whether the mechanism "
-        "cannot close at this time or reaches a singular (dead-point) position. "
-        f"Exudyn said: {system.error}", time=t, step=solved, elements=elements)
+        f"Exudyn's static solver did not converge at t = {t:.6g} s ({step}){motion}: the "
+        "constraints can all hold there, so the Newton iteration diverged near a singular "
+        "position. Try more steps, so that the actuators move less per step, or check "
+        "whether the mechanism reaches a singular (dead-point) position there. "
+        f"Exudyn said: {system.error}", time=t, step=solved // job.every, elements=elements)
+
+
+def _step_text(job: Job, k: int) -> str:
+    """Where step k of the solve grid is, in the user's steps."""
+    steps = (len(job.times) - 1) // job.every
+    if job.analysis == "assembly":
+        return "the assembly"
+    if job.every == 1:
+        return f"step {k} of {steps}"
+    return f"between steps {k // job.every} and {k // job.every + 1} of {steps}"
 
 
 def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = None) -> None:
@@ -355,7 +384,7 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
 def singular_error(job: Job, k: int) -> SolverError:
     """The error for a singular (dead-point) position at step k, where rates are undefined."""
     t = job.times
-    drivers = [f"'{e.name}'" for e in job.mech.constraints if hasattr(e, "time_law")]
+    drivers = [f"'{e.name}'" for e in job.mech.drivers]
     return SolverError(
         f"at t = {t[k]:.6g} s (step {k}) the mechanism is at a singular (dead-point) "
         f"position: the constraint Jacobian loses rank, so the actuator(s) "

@@ -247,10 +247,9 @@ def power_balance(mech, t: np.ndarray, actuator_power: np.ndarray, energy: np.nd
     k = np.arange(4, n - 4)
     d1, d2 = derivative(energy, k, 1, dt), derivative(energy, k, 2, dt)
     keep = np.ones(len(k), dtype=bool)
-    for el in mech.constraints:
-        if hasattr(el, "time_law"):
-            for b in el.time_law().breakpoints():
-                keep &= ~((t[k - 4] < b) & (b <= t[k + 4]))
+    for el in mech.drivers:
+        for b in el.time_law().breakpoints():
+            keep &= ~((t[k - 4] < b) & (b <= t[k + 4]))
     if not keep.any():
         return PowerBalance(0.0, 0.0, 0)
     residual = actuator_power[k] - (d1 + dissipation[k] - external_power[k])
@@ -266,10 +265,9 @@ def power_balance(mech, t: np.ndarray, actuator_power: np.ndarray, energy: np.nd
 def actuator_power(mech, st: State, outputs: dict[str, np.ndarray]) -> np.ndarray:
     """Σ (actuator force or torque) × Df(t): Mz·Df of angular, Força·Df of linear actuators."""
     power = np.zeros(st.n)
-    for el in mech.constraints:
-        if hasattr(el, "time_law"):
-            name = next(n for n in el.wrench if n is not None)
-            power += outputs[f"{el.name}.{name}"] * el.time_law()(st.t)[1]
+    for el in mech.drivers:
+        name = next(n for n in el.wrench if n is not None)
+        power += outputs[f"{el.name}.{name}"] * el.time_law()(st.t)[1]
     return power
 
 

@@ -412,7 +412,7 @@ def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, 
     # so that what is left shows in the joints that cannot close
     weight = np.ones(mech.n_equations)
     for el, rows in zip(mech.constraints, mech.rows):
-        if hasattr(el, "time_law") or el.grounds:
+        if el.drives or el.grounds:
             weight[rows] = 1e3
 
     def fun(q):

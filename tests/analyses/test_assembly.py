@@ -108,8 +108,10 @@ def test_free_mechanism_assembles_near_the_guess():
 
 def test_four_bar_that_cannot_close_names_its_joints():
     """Coupler b = 0.1 with the crank at θ = π: δ = |O4 − A| = d + a = 0.5 > b + c = 0.4,
-    so the loop cannot close (by 0.1 m). The SolverError names the loop's four revolutes,
-    whose constraints stay violated, and not the fixed link or the motor, which can hold."""
+    so the loop cannot close (by 0.1 m). The SolverError names the loop, the gap δ and the
+    span |c − b| … b + c of the chain that cannot reach across it (issue 10, fault 5), and
+    as violated the loop's four revolutes, not the fixed link or the motor, which can hold
+    (the motor is named as what places the crank)."""
     m = pam2exu.load(EXAMPLES / "four_bar.toml")
     m["coupler"].points["B"] = [0.1, 0.0]
     m["motor"].C = [math.pi, 2 * math.pi, 0.0, 0.0]
@@ -119,7 +121,12 @@ def test_four_bar_that_cannot_close_names_its_joints():
     message = str(info.value)
     for joint in ("O2", "A", "B", "O4"):
         assert f"'{joint}' (revolute)" in message
-    assert "'motor'" not in message and "'base'" not in message
+    assert "'motor' (angular_actuator) by" not in message and "'base'" not in message
+    assert "the loop ground –O4– rocker –B– coupler –A– crank –O2– ground cannot close" \
+        in message
+    assert "ground.O4 and crank.A are 0.5 m apart" in message
+    assert "spans only 0.2 … 0.4 m" in message
+    assert "more steps" not in message          # cannot help at t = 0
     assert {name.split("'")[1] for name in info.value.elements} == {"O2", "A", "B", "O4"}
     assert info.value.time == 0.0
 

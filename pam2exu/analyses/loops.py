@@ -1,0 +1,281 @@
+"""Which loop of a mechanism cannot close, and which lengths conflict (failure diagnosis).
+
+The solids and the joints that tie points together (revolute, prismatic, pin_slot and
+linear_actuator) form a graph; the solids held by fixed links are one node, the frame. A
+joint that cannot hold closes a loop: the shortest cycle through it. Around a loop each
+solid contributes the distance between the two points its joints use (its *link*), and a
+linear actuator its distance f(t). A loop of pins and actuators closes only if
+
+    the longest link ≤ the sum of the others                        (a polygon),
+
+and, where actuators fix the angles of some solids, the part of the loop that is still free
+(a chain of links between two points whose places are known) must reach across the gap
+between those points: |Σ l − …| ≤ gap ≤ Σ l. ``diagnose`` says which loop and which of these fails.
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kinematics import rotate
+
+#: element types whose equations tie two points (the edges of the loop graph)
+TIES = ("revolute", "prismatic", "pin_slot", "linear_actuator")
+#: the node of the solids held by fixed links
+FRAME = -1
+
+
+@dataclass(frozen=True)
+class Edge:
+    """A tie between two solids: the element, its two solids and its local points."""
+
+    element: object
+    a: int
+    b: int
+    pa: tuple[float, float]
+    pb: tuple[float, float]
+
+
+def _point(ref) -> tuple[float, float]:
+    """The local point of an anchor (a point, or a line's defining point)."""
+    return tuple(getattr(ref, "local", getattr(ref, "point", (0.0, 0.0))))
+
+
+def edges(mech) -> list[Edge]:
+    """The ties of the mechanism, in the order of its elements."""
+    return [Edge(el, el.ref1.solid, el.ref2.solid, _point(el.ref1), _point(el.ref2))
+            for el in mech.constraints if el.type in TIES]
+
+
+def held(mech) -> set[int]:
+    """The solids held by fixed links (they form the frame)."""
+    return {el.ref1.solid for el in mech.constraints if el.grounds}
+
+
+def cycle_through(mech, element) -> list[tuple[Edge, bool]] | None:
+    """The shortest loop through ``element``: its edges in order, each with True when it
+    is walked from its solid a to its solid b; None when the element closes no loop."""
+    frame = held(mech)
+    node = (lambda s: FRAME if s in frame else s)
+    graph = edges(mech)
+    start = next((e for e in graph if e.element is element), None)
+    if start is None or node(start.a) == node(start.b):
+        return None
+    # breadth-first from b back to a, without the element's own edge
+    goal, origin = node(start.a), node(start.b)
+    previous = {origin: None}
+    queue = deque([origin])
+    while queue and goal not in previous:
+        here = queue.popleft()
+        for e in graph:
+            if e is start:
+                continue
+            for u, v, forward in ((node(e.a), node(e.b), True), (node(e.b), node(e.a), False)):
+                if u == here and v not in previous:
+                    previous[v] = (e, forward, here)
+                    queue.append(v)
+    if goal not in previous:
+        return None
+    path, here = [], goal
+    while previous[here] is not None:
+        e, forward, before = previous[here]
+        path.append((e, forward))
+        here = before
+    path.reverse()
+    return [(start, True), *path]
+
+
+def _name(mech, solid: int) -> str:
+    return mech.solids[solid].name
+
+
+def known_poses(mech, t: float) -> dict[int, tuple[np.ndarray, float]]:
+    """Solids whose pose (origin, fi) at time t follows from the fixed links and the angular
+    actuators alone: the held solids, then every solid an actuator turns relative to a
+    known one and a revolute pins to a known one."""
+    poses = {i: (np.array([float(s.x), float(s.y)]), float(s.fi))
+             for i, s in enumerate(mech.solids) if i in held(mech)}
+    angles = {i: fi for i, (_, fi) in poses.items()}
+    changed = True
+    while changed:
+        changed = False
+        for el in mech.drivers:
+            if el.type != "angular_actuator":
+                continue
+            f = float(el.time_law()(np.array([t]))[0][0])
+            s1, s2 = el.ref1.solid, el.ref2.solid
+            if s1 in angles and s2 not in angles:
+                angles[s2], changed = angles[s1] + f, True
+            elif s2 in angles and s1 not in angles:
+                angles[s1], changed = angles[s2] - f, True
+        for el in mech.constraints:
+            if el.type != "revolute":
+                continue
+            for mine, other in ((el.ref2, el.ref1), (el.ref1, el.ref2)):
+                if mine.solid in angles and mine.solid not in poses and other.solid in poses:
+                    fi = angles[mine.solid]
+                    at = place(poses[other.solid], other.local)
+                    poses[mine.solid] = (at - rotate(np.array([fi]), np.asarray(mine.local))[0],
+                                         fi)
+                    changed = True
+    return poses
+
+
+def place(pose, local) -> np.ndarray:
+    """r = R + A(fi) s: where a point of a solid of known pose is."""
+    origin, fi = pose
+    return origin + rotate(np.array([fi]), np.asarray(local, dtype=float))[0]
+
+
+@dataclass
+class _Node:
+    """A solid of the loop, entered at one point and left at another (the frame: two held
+    solids, maybe)."""
+
+    solid_in: int
+    p_in: tuple[float, float]
+    label_in: str
+    solid_out: int
+    p_out: tuple[float, float]
+    label_out: str
+
+    def link(self, poses) -> float:
+        """The distance between its two points [m]."""
+        if self.solid_in != self.solid_out:
+            return float(np.linalg.norm(place(poses[self.solid_out], self.p_out)
+                                        - place(poses[self.solid_in], self.p_in)))
+        return float(np.hypot(self.p_out[0] - self.p_in[0], self.p_out[1] - self.p_in[1]))
+
+
+def _walk(mech, cycle):
+    """The loop's edges (oriented) and its nodes: node k lies between edge k and edge k+1."""
+    steps = []
+    for e, forward in cycle:
+        ref_a, ref_b = (e.element.ref1, e.element.ref2)
+        if forward:
+            steps.append((e, e.a, e.b, e.pa, e.pb, ref_a.label, ref_b.label))
+        else:
+            steps.append((e, e.b, e.a, e.pb, e.pa, ref_b.label, ref_a.label))
+    nodes = []
+    for k, (e, a, b, pa, pb, la, lb) in enumerate(steps):
+        nxt = steps[(k + 1) % len(steps)]
+        nodes.append(_Node(b, pb, lb, nxt[1], nxt[3], nxt[5]))
+    return steps, nodes
+
+
+def _length(step, t: float) -> float | None:
+    """What an edge adds to the loop: 0 (a pin), f(t) (an actuator), None (it slides)."""
+    el = step[0].element
+    if el.type == "revolute":
+        return 0.0
+    if el.type == "linear_actuator":
+        return float(el.time_law()(np.array([t]))[0][0])
+    return None
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """Why a loop cannot close: the text, whether its lengths prove it (``definite``), and
+    the names of the loop's elements."""
+
+    text: str
+    definite: bool
+    elements: tuple[str, ...]
+
+
+def diagnose(mech, violated, t: float) -> Diagnosis | None:
+    """The loop that cannot close at time t, from the elements ``violated`` (worst first):
+    the first whose lengths prove it, else the loop of the worst; None if none is a loop."""
+    found = [d for d in (describe(mech, el, t) for el in violated) if d is not None]
+    return next((d for d in found if d.definite), found[0] if found else None)
+
+
+def describe(mech, element, t: float) -> Diagnosis | None:
+    """Why the loop through ``element`` cannot close at time t; None when the element
+    closes no loop."""
+    cycle = cycle_through(mech, element)
+    if cycle is None:
+        return None
+    members = tuple(e.element.name for e, _ in cycle)
+    steps, nodes = _walk(mech, cycle)
+    poses = known_poses(mech, t)
+    frame = held(mech)
+    names = [_name(mech, steps[0][1])]
+    for (e, *_), node in zip(steps, nodes):
+        names += [f"–{e.element.name}–", _name(mech, node.solid_in)]
+    loop = " ".join(names)
+    links = []           # (text, length or None) around the loop
+    for step, node in zip(steps, nodes):
+        extra = _length(step, t)
+        if extra is None:
+            links.append((f"'{step[0].element.name}' ({step[0].element.type}) slides", None))
+        elif extra:
+            links.append((f"actuator '{step[0].element.name}' {extra:.4g} m", extra))
+        if node.solid_in in frame or node.solid_in == node.solid_out:
+            links.append((f"{node.label_in}–{node.label_out} {node.link(poses):.4g} m",
+                          node.link(poses)))
+    listing = ", ".join(text for text, _ in links)
+    head = f"the loop {loop} cannot close at t = {t:g} s (its lengths: {listing})"
+    if any(length is None for _, length in links):
+        return Diagnosis(head + "; with sliding joints the lengths alone do not decide: check "
+                         "them, the lines' angles and the actuators' values at this time",
+                         False, members)
+    lengths = [length for _, length in links]
+    k = int(np.argmax(lengths))
+    rest = sum(lengths) - lengths[k]
+    if lengths[k] > rest * (1 + 1e-9):
+        return Diagnosis(head + f": the longest, {links[k][0]}, is longer than all the others "
+                         f"together ({rest:.4g} m). Change the lengths so that none is longer "
+                         "than the sum of the others", True, members)
+    reach = _reach(mech, steps, nodes, poses, t)
+    if reach:
+        return Diagnosis(head + ": " + reach, True, members)
+    return Diagnosis(head + ": its lengths would close it, but not in the position its "
+                     "actuators set at this time; check the actuators' values and the points "
+                     "they drive", False, members)
+
+
+def _reach(mech, steps, nodes, poses, t: float) -> str | None:
+    """Where the actuators place some solids, the free chain between two placed points
+    that cannot reach across their distance, in words (None if none is found)."""
+    known = [k for k, node in enumerate(nodes) if node.solid_in in poses
+             and node.solid_out in poses]
+    if not known or len(known) == len(nodes):
+        return None
+    count = len(nodes)
+    for i in known:
+        j = (i + 1) % count
+        chain_nodes = []
+        while j not in known:
+            chain_nodes.append(j)
+            j = (j + 1) % count
+        if not chain_nodes:
+            continue
+        start, end = nodes[i], nodes[j]
+        gap = float(np.linalg.norm(place(poses[end.solid_in], end.p_in)
+                                   - place(poses[start.solid_out], start.p_out)))
+        parts, lengths = [], []
+        for k in [*chain_nodes, j]:
+            extra = _length(steps[k], t)
+            if extra is None:
+                return None
+            if extra:
+                parts.append(f"actuator '{steps[k][0].element.name}' {extra:.4g} m")
+                lengths.append(extra)
+            if k != j:
+                node = nodes[k]
+                parts.append(f"{node.label_in}–{node.label_out} {node.link(poses):.4g} m")
+                lengths.append(node.link(poses))
+        total, longest = sum(lengths), max(lengths)
+        shortest = max(0.0, 2 * longest - total)
+        if gap > total * (1 + 1e-9) or gap < shortest * (1 - 1e-9):
+            drivers = ", ".join(f"'{el.name}'" for el in mech.drivers
+                                if el.type == "angular_actuator")
+            return (f"where the fixed links and the actuators ({drivers}) put them, "
+                    f"{start.label_out} and {end.label_in} are {gap:.4g} m apart, but the "
+                    f"chain between them ({', '.join(parts)}) spans only "
+                    f"{shortest:.4g} … {total:.4g} m. Change these lengths, or the "
+                    f"actuators' values at t = {t:g} s")
+    return None
