@@ -36,3 +36,9 @@ def moved_model(path, x0=0.3, y0=-0.2, fi0=0.7):
 def moved():
     """``moved_model``, for tests."""
     return moved_model
+
+
+def pytest_addoption(parser):
+    parser.addoption("--fuzz-long", action="store_true", default=False,
+                     help="tests/fuzz: run the long fuzz campaign (10,000 mutants) instead of "
+                          "the CI one")

@@ -1,0 +1,620 @@
+"""Run fuzz cases (``run_case``) and campaigns of them on worker processes (``campaign``).
+
+A case is the mutant of one seed (``mutants.mutant``), written as bytes into a fresh
+temporary directory that becomes the working directory, then run
+
+* in-process: ``pam2exu.run(path)`` (the file's own analysis) and ``pam2exu.run(path,
+  analysis=<another one, drawn from the seed>)``, warnings suppressed;
+* for a fraction of the seeds, through the command line, in-process: ``pam2exu.cli.main``
+  with ``run``, ``check``, ``run -o out.csv`` and, rarely, ``draw -o x.png``.
+
+The contract, for every call: a success whose Results hold only finite values and whose CSV
+(``Results.to_csv``) reads back bit for bit with ``pam2exu.read_csv``; or a ``Pam2ExuError``
+with a message (command line: exit code 1 or 2 and a message starting ``pam2exu: `` on stderr
+that does not say "unexpected error"); nothing else, no hang, and no file left in the working
+directory but the model and the files the command line was asked to write.
+
+Outcomes: ``success`` (the file's own analysis ran), ``clean error`` (it stopped on a
+Pam2ExuError), or a fault, whose class is one of
+
+* ``exception <Type> at <file>:<line>``: an exception other than a Pam2ExuError, located at
+  the innermost frame inside the pam2exu package (the same class whether it came from
+  ``pam2exu.run`` or the command line; a command line "unexpected error" is rerun with
+  ``--debug`` to locate it);
+* ``empty message <Type>``: a Pam2ExuError without a message;
+* ``cli output``: an exit code or stderr that breaks the command line's contract;
+* ``non-finite``: a Results table with NaN or infinite values;
+* ``csv``: the CSV does not read back identical (or cannot be written or read);
+* ``stray file``: a file left in the working directory;
+* ``hang``: the case did not finish within the time limit (interrupted by SIGALRM, or the
+  worker killed when it did not answer within the limit and a margin);
+* ``crash``: the worker process died (a segmentation fault, ``os._exit``, …).
+
+Command line (from the repository's root)::
+
+    python -m tests.fuzz.runner --count 10000 --workers 2 --seed 0 [--report out.md]
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import io
+import multiprocessing as mp
+import os
+import random
+import resource
+import shutil
+import signal
+import sys
+import tempfile
+import time
+import traceback
+import warnings
+from collections import Counter
+from dataclasses import dataclass, field
+from multiprocessing.connection import wait
+from pathlib import Path
+
+import numpy as np
+
+from .mutants import generate
+
+ANALYSES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
+#: fraction of the cases also run through the command line (run, check, run -o out.csv)
+CLI_FRACTION = 0.25
+#: fraction of the cases also drawn (draw -o x.png)
+DRAW_FRACTION = 0.03
+#: time limit of one case [s], and the margin after which a silent worker is killed
+TIMEOUT = 20.0
+MARGIN = 10.0
+#: address space a worker may use beyond what it has when it starts [bytes]
+MEMORY = 3 * 2**30
+
+
+class CaseTimeout(BaseException):
+    """Raised by SIGALRM in a worker when a case runs past its time limit (a BaseException,
+    so that no ``except Exception`` in the package swallows it)."""
+
+
+@dataclass
+class Outcome:
+    """The outcome of one case."""
+
+    seed: int
+    status: str = "success"        # "success", "clean error" or "fault"
+    fault: str = ""                # the fault class (see the module's docstring)
+    description: str = ""          # the mutant's description
+    kinds: list = field(default_factory=list)
+    via: str = ""                  # the call that faulted
+    message: str = ""
+    detail: str = ""               # the traceback's last frames, or what differs
+    sub: str = ""                  # a finer key within the class (non-finite, csv, hang)
+    seconds: float = 0.0
+    calls: int = 0                 # pam2exu calls made
+    successes: int = 0             # of which ran (the others stopped on a clean error)
+
+
+class _Fault(Exception):
+    def __init__(self, fault, via, message, detail="", sub=""):
+        super().__init__(fault)
+        self.fault, self.via, self.message, self.detail, self.sub = (fault, via, message,
+                                                                     detail, sub)
+
+
+def _pkg_dir() -> Path:
+    import pam2exu
+    return Path(pam2exu.__file__).resolve().parent
+
+
+def _frames(exc) -> list:
+    return traceback.extract_tb(exc.__traceback__) if exc.__traceback__ else []
+
+
+def location(exc) -> str:
+    """``<file>:<line>`` of the innermost frame of ``exc``'s traceback inside the pam2exu
+    package (the path relative to the repository), else of the innermost frame."""
+    pkg = _pkg_dir()
+    frames = _frames(exc)
+    inside = [f for f in frames if _under(f.filename, pkg)]
+    frame = inside[-1] if inside else (frames[-1] if frames else None)
+    if frame is None:
+        return "?"
+    path = Path(frame.filename)
+    if _under(frame.filename, pkg):
+        path = Path(frame.filename).resolve().relative_to(pkg.parent)
+    return f"{path}:{frame.lineno}"
+
+
+def _under(filename, pkg: Path) -> bool:
+    try:
+        Path(filename).resolve().relative_to(pkg)
+        return True
+    except ValueError:
+        return False
+
+
+def _detail(exc, n=6) -> str:
+    frames = _frames(exc)[-n:]
+    return "".join(traceback.format_list(frames)).rstrip()
+
+
+def _cut(text: str, n: int = 400) -> str:
+    text = str(text)
+    return text if len(text) <= n else f"{text[:n]}…({len(text)} chars)"
+
+
+def _exception_fault(exc, via) -> _Fault:
+    return _Fault(f"exception {type(exc).__name__} at {location(exc)}", via,
+                  f"{type(exc).__name__}: {_cut(exc)}", _detail(exc))
+
+
+def plan(seed: int) -> tuple[str, list[list[str]]]:
+    """The other analysis of a case, and its command lines (with ``MODEL`` for the file)."""
+    r = random.Random(f"case-{seed}")
+    other = r.choice(ANALYSES)
+    commands = []
+    if r.random() < CLI_FRACTION:
+        out = ["run", "MODEL", "-o", "out.csv"]
+        if r.random() < 0.5:
+            out += ["-a", r.choice(ANALYSES)]
+        commands += [["run", "MODEL"], ["check", "MODEL"], out]
+    if r.random() < DRAW_FRACTION:
+        commands.append(["draw", "MODEL", "-o", "x.png"])
+    return other, commands
+
+
+def _check_results(res, via, scratch) -> None:
+    """Finite values; the CSV reads back with the same columns, t and values (bit for bit)."""
+    import pam2exu
+    data = np.asarray(res.to_numpy())
+    if not np.isfinite(data).all():
+        names = ["t", *res.columns]
+        bad = [names[j] for j in range(data.shape[1]) if not np.isfinite(data[:, j]).all()]
+        rows = np.nonzero(~np.isfinite(data).all(axis=1))[0]
+        var = sorted({b.rsplit(".", 1)[-1] for b in bad})
+        raise _Fault("non-finite", via,
+                     f"{len(bad)} columns with NaN/inf, e.g. {_cut(bad[:6], 200)}, "
+                     f"from row {rows[0]} of {data.shape[0]}",
+                     sub=f"{res.analysis}: {', '.join(var[:6])}")
+    path = os.path.join(scratch, "res.csv")
+    try:
+        res.to_csv(path)
+        back = pam2exu.read_csv(path)
+    except CaseTimeout:
+        raise
+    except BaseException as exc:     # noqa: BLE001 - every exception is a finding
+        raise _Fault("csv", via, f"{type(exc).__name__}: {_cut(exc)}", _detail(exc),
+                     sub=f"{type(exc).__name__} at {location(exc)}") from None
+    finally:
+        for leftover in os.listdir(scratch):
+            os.remove(os.path.join(scratch, leftover))
+    if back.columns != res.columns:
+        raise _Fault("csv", via, f"columns differ: wrote {len(res.columns)} "
+                                 f"{_cut(res.columns[:5], 200)}, read {len(back.columns)} "
+                                 f"{_cut(back.columns[:5], 200)}", sub="columns differ")
+    a, b = np.ascontiguousarray(data), np.ascontiguousarray(back.to_numpy())
+    if a.shape != b.shape or a.dtype != b.dtype or not np.array_equal(a.view(np.uint64),
+                                                                     b.view(np.uint64)):
+        if a.shape != b.shape:
+            what = f"shapes {a.shape} and {b.shape}"
+        else:
+            i, j = np.argwhere(a.view(np.uint64) != b.view(np.uint64))[0]
+            what = (f"column {(['t'] + res.columns)[j]!r} row {i}: wrote {a[i, j]!r}, read "
+                    f"{b[i, j]!r}")
+        raise _Fault("csv", via, f"values differ: {what}", sub="values differ")
+
+
+def _api_call(name, analysis, scratch) -> bool:
+    """One in-process run: True when it ran, False for a clean error; _Fault otherwise."""
+    import pam2exu
+    via = f"pam2exu.run(path, analysis={analysis!r})"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = pam2exu.run(name, analysis=analysis)
+    except CaseTimeout:
+        raise
+    except pam2exu.Pam2ExuError as exc:
+        if not str(exc).strip():
+            raise _Fault(f"empty message {type(exc).__name__}", via,
+                         f"{type(exc).__name__} with message {str(exc)!r}", _detail(exc))
+        return False
+    except BaseException as exc:     # noqa: BLE001
+        raise _exception_fault(exc, via) from None
+    _check_results(res, via, scratch)
+    return True
+
+
+def _cli_call(argv) -> tuple[int | None, str, BaseException | None]:
+    from pam2exu.cli import main
+    out, err = io.StringIO(), io.StringIO()
+    code, escaped = None, None
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), \
+                warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            code = main(argv)
+    except CaseTimeout:
+        raise
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 2
+        err.write(f"\n[SystemExit({exc.code!r})]")
+    except BaseException as exc:     # noqa: BLE001
+        escaped = exc
+    return code, err.getvalue(), escaped
+
+
+def _cli(argv, scratch) -> bool:
+    """One command line run: True for exit 0, False for a clean error; _Fault otherwise."""
+    import pam2exu
+    via = "pam2exu " + " ".join(argv)
+    code, err, escaped = _cli_call(argv)
+    if escaped is not None:
+        raise _exception_fault(escaped, via)
+    if code == 0:
+        if "-o" in argv:
+            out = argv[argv.index("-o") + 1]
+            if not os.path.isfile(out):
+                raise _Fault("cli output", via, f"exit 0 but {out} was not written")
+            if argv[0] == "run":
+                try:
+                    back = pam2exu.read_csv(out)
+                except CaseTimeout:
+                    raise
+                except BaseException as exc:     # noqa: BLE001
+                    raise _Fault("csv", via, f"{type(exc).__name__}: {_cut(exc)}",
+                                 _detail(exc), sub=f"{type(exc).__name__} at {location(exc)}")
+                if not np.isfinite(back.to_numpy()).all():
+                    raise _Fault("non-finite", via, f"{out} holds NaN/inf values",
+                                 sub="cli csv")
+        return True
+    text = err.strip()
+    if code in (1, 2) and err.startswith("pam2exu: ") and "unexpected error" not in err:
+        return False
+    if "unexpected error" in err:
+        _, _, exc = _cli_call(["--debug", *argv])       # locate it
+        if exc is not None and not isinstance(exc, pam2exu.Pam2ExuError):
+            fault = _exception_fault(exc, via)
+            fault.message = f"{fault.message} [stderr: {_cut(text, 200)}]"
+            raise fault
+    raise _Fault("cli output", via, f"exit code {code!r}, stderr {_cut(text, 300)!r}",
+                 sub=f"exit {code}")
+
+
+def _on_alarm(signum, frame):
+    raise CaseTimeout()
+
+
+def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = None,
+             cli: bool | None = None) -> Outcome:
+    """Run the case of ``seed`` in this process and classify it (see the module docstring).
+
+    ``timeout``: seconds before SIGALRM interrupts the case (main thread only; None: no
+    limit). ``n_mutations``: passed to ``mutants.generate`` (0: the unchanged model).
+    ``cli``: True/False to force the command line runs on or off (None: as planned).
+    """
+    try:
+        m = generate(seed, n_mutations)
+    except Exception as exc:         # noqa: BLE001 - a fault of the generator itself
+        return Outcome(seed, "fault", f"generator {type(exc).__name__} at {location(exc)}",
+                       via="mutants.generate", message=f"{type(exc).__name__}: {_cut(exc)}",
+                       detail=_detail(exc))
+    other, commands = plan(seed)
+    if cli is True and not commands:
+        commands = [["run", "MODEL"], ["check", "MODEL"], ["run", "MODEL", "-o", "out.csv"]]
+    elif cli is False:
+        commands = []
+    outcome = Outcome(seed, description=m.description, kinds=list(m.kinds))
+    start = time.perf_counter()
+    base = tempfile.mkdtemp(prefix="pam2exu-fuzz-")
+    work, scratch = os.path.join(base, "work"), os.path.join(base, "scratch")
+    os.mkdir(work)
+    os.mkdir(scratch)
+    old_cwd = os.getcwd()
+    step = "writing the mutant"
+    armed = False
+    try:
+        os.chdir(work)
+        with open(m.name, "wb") as fh:
+            fh.write(m.data)
+        allowed = {m.name}
+        if timeout:
+            signal.signal(signal.SIGALRM, _on_alarm)
+            signal.setitimer(signal.ITIMER_REAL, timeout)
+            armed = True
+        try:
+            for k, analysis in enumerate((None, other)):
+                step = f"pam2exu.run(path, analysis={analysis!r})"
+                ran = _api_call(m.name, analysis, scratch)
+                outcome.calls += 1
+                outcome.successes += ran
+                if k == 0:
+                    outcome.status = "success" if ran else "clean error"
+            for command in commands:
+                argv = [m.name if a == "MODEL" else a for a in command]
+                if "-o" in argv:
+                    allowed.add(argv[argv.index("-o") + 1])
+                step = "pam2exu " + " ".join(argv)
+                outcome.successes += _cli(argv, scratch)
+                outcome.calls += 1
+        finally:
+            if armed:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+        stray = sorted(set(os.listdir(work)) - allowed)
+        if stray:
+            raise _Fault("stray file", step, f"left in the working directory: {_cut(stray, 300)}")
+    except _Fault as f:
+        outcome.status, outcome.fault, outcome.via = "fault", f.fault, f.via
+        outcome.message, outcome.detail, outcome.sub = f.message, f.detail, f.sub
+    except CaseTimeout as exc:
+        outcome.status, outcome.fault, outcome.via = "fault", "hang", step
+        outcome.message = f"interrupted after {timeout} s at {location(exc)}"
+        outcome.detail, outcome.sub = _detail(exc), "interrupted"
+    except BaseException as exc:     # noqa: BLE001 - a fault of the runner itself
+        outcome.status, outcome.fault, outcome.via = "fault", f"runner {type(exc).__name__}", step
+        outcome.message, outcome.detail = f"{type(exc).__name__}: {_cut(exc)}", _detail(exc)
+    finally:
+        os.chdir(old_cwd)
+        shutil.rmtree(base, ignore_errors=True)
+        outcome.seconds = time.perf_counter() - start
+    return outcome
+
+
+# --------------------------------------------------------------------------- workers
+
+def _vm_size() -> int:
+    try:
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except OSError:
+        return 0
+
+
+def _worker(conn, timeout: float, memory: int | None) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if memory:
+        _soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+        limit = _vm_size() + memory
+        if hard == resource.RLIM_INFINITY or limit < hard:
+            resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+    import pam2exu.analyses  # imported once per worker
+    import pam2exu.cli  # noqa: F401
+    while True:
+        try:
+            seed = conn.recv()
+        except (EOFError, OSError):
+            break
+        if seed is None:
+            break
+        outcome = run_case(seed, timeout)
+        conn.send(dataclasses.asdict(outcome))
+        if outcome.fault == "hang":        # interrupted anywhere: start afresh
+            break
+    conn.close()
+
+
+class _Worker:
+    def __init__(self, ctx, timeout, memory):
+        self.conn, child = ctx.Pipe()
+        self.proc = ctx.Process(target=_worker, args=(child, timeout, memory), daemon=True)
+        self.proc.start()
+        child.close()
+        self.seed = None
+        self.started = 0.0
+
+    def send(self, seed):
+        self.seed, self.started = seed, time.monotonic()
+        self.conn.send(seed)
+
+    def kill(self):
+        if self.proc.is_alive():
+            self.proc.kill()
+        self.proc.join(5)
+        self.conn.close()
+
+
+@dataclass
+class Campaign:
+    """What a campaign found: counts, and the faulty outcomes grouped by class."""
+
+    count: int
+    seed: int
+    workers: int
+    seconds: float = 0.0
+    counts: Counter = field(default_factory=Counter)
+    faults: dict = field(default_factory=dict)       # class -> list of Outcome, by seed
+    calls: int = 0
+    successes: int = 0
+    case_seconds: list = field(default_factory=list)
+    outcomes: list = field(default_factory=list)     # every Outcome, in order of completion
+
+    def add(self, outcome: Outcome) -> None:
+        self.outcomes.append(outcome)
+        self.counts[outcome.status] += 1
+        self.calls += outcome.calls
+        self.successes += outcome.successes
+        self.case_seconds.append(outcome.seconds)
+        if outcome.status == "fault":
+            self.faults.setdefault(outcome.fault, []).append(outcome)
+
+    @property
+    def n_faults(self) -> int:
+        return sum(len(v) for v in self.faults.values())
+
+    def classes(self) -> list[tuple[str, list[Outcome]]]:
+        """Fault classes, most frequent first, each with its outcomes sorted by seed."""
+        return sorted(((k, sorted(v, key=lambda o: o.seed)) for k, v in self.faults.items()),
+                      key=lambda kv: (-len(kv[1]), kv[0]))
+
+    def summary(self) -> str:
+        """The counts as a Markdown table."""
+        n = sum(self.counts.values())
+        rows = [("mutants", n), ("successes (own analysis ran)", self.counts["success"]),
+                ("clean errors (own analysis)", self.counts["clean error"]),
+                ("faulty mutants", self.counts["fault"])]
+        rows += [(f"fault: {k}", len(v)) for k, v in self.classes() if k != "hang"]
+        rows += [("hangs", len(self.faults.get("hang", [])))]
+        rows += [("pam2exu calls (in-process and command line)", self.calls),
+                 ("of which ran", self.successes)]
+        per = self.seconds / n if n else 0.0
+        slow = max(self.case_seconds, default=0.0)
+        wall = (f"{self.seconds:.1f} s ({per * 1000:.0f} ms per mutant on {self.workers} "
+                f"workers; slowest case {slow:.1f} s)")
+        rows += [("wall time", wall)]
+        width = max(len(r[0]) for r in rows)
+        lines = [f"| {'outcome':<{width}} | count |", f"|{'-' * (width + 2)}|-------|"]
+        lines += [f"| {a:<{width}} | {b} |" for a, b in rows]
+        return "\n".join(lines)
+
+    def report(self, examples: int = 1) -> str:
+        """Summary, then each fault class: count, representative seed(s) (``examples`` per
+        class; every hang and crash, up to 30), description, the call, the message and where
+        (traceback tail)."""
+        out = [f"# Fuzz campaign: seeds {self.seed} … {self.seed + self.count - 1}", "",
+               self.summary(), ""]
+        for k, group in self.classes():
+            kinds = Counter(kind for o in group for kind in set(o.kinds))
+            subs = Counter(o.sub for o in group if o.sub)
+            out += [f"## {k} ({len(group)})", ""]
+            out.append(f"- seeds: {', '.join(str(o.seed) for o in group[:20])}"
+                       + (" …" if len(group) > 20 else ""))
+            out.append(f"- mutation kinds involved: "
+                       f"{', '.join(f'{a} ({b})' for a, b in kinds.most_common(6))}")
+            if subs and len(subs) > 1 or (subs and k in ("non-finite", "csv")):
+                out.append(f"- breakdown: {'; '.join(f'{a} ({b})' for a, b in subs.most_common(10))}")
+            shown = group[:30] if k in ("hang", "crash") else group[:examples]
+            for o in shown:
+                out += [f"- representative seed {o.seed}: {o.description}",
+                        f"  - call: `{o.via}`",
+                        f"  - message: {o.message}"]
+                if o.detail:
+                    out += ["  - traceback (innermost frames):", "", "```",
+                            o.detail, "```"]
+            out.append("")
+        return "\n".join(out)
+
+
+def campaign(count: int, workers: int = 2, seed: int = 0, timeout: float = TIMEOUT,
+             margin: float = MARGIN, memory: int | None = MEMORY, progress=None) -> Campaign:
+    """Run the cases of seeds ``seed`` … ``seed + count - 1`` on ``workers`` processes.
+
+    Each worker (forked, with pam2exu imported) runs cases in-process with a SIGALRM limit of
+    ``timeout`` s; a worker that does not answer within ``timeout + margin`` s is killed and
+    the case recorded as a hang, one that dies as a crash; either is replaced and the campaign
+    goes on. ``memory``: bytes of address space a worker may add (RLIMIT_AS), so that absurd
+    allocations end in MemoryError. ``progress(done, campaign)`` is called after each case.
+    """
+    ctx = mp.get_context("fork")
+    result = Campaign(count, seed, workers)
+    start = time.monotonic()
+    seeds = list(range(seed, seed + count))
+    seeds.reverse()
+    pool = [_Worker(ctx, timeout, memory) for _ in range(max(1, min(workers, count)))]
+
+    def lost(w, fault, message, sub):
+        try:
+            m = generate(w.seed)
+            description, kinds = m.description, list(m.kinds)
+        except Exception as exc:     # noqa: BLE001 - reported by run_case's outcome
+            description, kinds = f"(no mutant: {type(exc).__name__})", []
+        result.add(Outcome(w.seed, "fault", fault, description, kinds, "worker", message,
+                           sub=sub, seconds=time.monotonic() - w.started))
+
+    try:
+        done = 0
+        while seeds or any(w.seed is not None for w in pool):
+            for w in pool:
+                if w.seed is None and seeds:
+                    w.send(seeds.pop())
+            busy = [w for w in pool if w.seed is not None]
+            ready = wait([w.conn for w in busy], timeout=0.5)
+            for i, w in enumerate(pool):
+                if w.seed is None:
+                    continue
+                replace = False
+                if w.conn in ready:
+                    try:
+                        outcome = Outcome(**w.conn.recv())
+                    except (EOFError, OSError):
+                        w.proc.join(5)
+                        lost(w, "crash", f"the worker died (exit code {w.proc.exitcode})",
+                             f"exit code {w.proc.exitcode}")
+                        replace = True
+                    else:
+                        result.add(outcome)
+                        replace = outcome.fault == "hang"
+                elif time.monotonic() - w.started > timeout + margin:
+                    lost(w, "hang", f"no answer within {timeout + margin:g} s: worker killed",
+                         "killed")
+                    replace = True
+                else:
+                    continue
+                done += 1
+                if progress:
+                    progress(done, result)
+                if replace:
+                    w.kill()
+                    pool[i] = _Worker(ctx, timeout, memory)
+                else:
+                    w.seed = None
+    finally:
+        for w in pool:
+            try:
+                w.conn.send(None)
+            except (OSError, ValueError):
+                pass
+        for w in pool:
+            w.proc.join(2)
+            w.kill()
+    result.seconds = time.monotonic() - start
+    return result
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m tests.fuzz.runner",
+                                description="Run a seeded mutation-fuzz campaign of pam2exu.")
+    p.add_argument("--count", type=int, default=1000, help="number of mutants (default 1000)")
+    p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    p.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
+    p.add_argument("--timeout", type=float, default=TIMEOUT,
+                   help=f"time limit per case, s (default {TIMEOUT:g})")
+    p.add_argument("--report", metavar="OUT.md", help="write the full report here")
+    p.add_argument("--examples", type=int, default=1,
+                   help="representative cases shown per fault class (default 1)")
+    p.add_argument("--jsonl", metavar="OUT.jsonl", help="write every outcome, one JSON a line")
+    p.add_argument("--case", type=int, metavar="SEED",
+                   help="run one case in this process and print its outcome")
+    args = p.parse_args(argv)
+    if args.case is not None:
+        outcome = run_case(args.case, args.timeout)
+        for k, v in dataclasses.asdict(outcome).items():
+            print(f"{k}: {v}")
+        return 0 if outcome.status != "fault" else 1
+    tty = sys.stderr.isatty()
+
+    def progress(done, result):
+        if done % 100 == 0 or done == args.count:
+            end = "\r" if tty and done != args.count else "\n"
+            print(f"{done}/{args.count} mutants, {result.n_faults} faults", end=end,
+                  file=sys.stderr, flush=True)
+    result = campaign(args.count, args.workers, args.seed, args.timeout, progress=progress)
+    print(result.summary())
+    if args.jsonl:
+        import json
+        with open(args.jsonl, "w", encoding="utf-8") as fh:
+            for o in sorted(result.outcomes, key=lambda o: o.seed):
+                fh.write(json.dumps(dataclasses.asdict(o), ensure_ascii=False) + "\n")
+    if args.report:
+        Path(args.report).write_text(result.report(args.examples) + "\n", encoding="utf-8")
+        print(f"report written to {args.report}")
+    else:
+        for k, group in result.classes():
+            o = group[0]
+            print(f"\n{k} ({len(group)}): seed {o.seed}: {o.description}\n  {o.via}: "
+                  f"{o.message}")
+    return 1 if result.n_faults else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
