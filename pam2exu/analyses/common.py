@@ -231,6 +231,8 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
         system = ExudynSystem(mech, forces=forces, velocity_forces=False, start=start)
         q, solved = system.solve_positions(job.times, job.solver or SolveSettings(),
                                            redundant=redundant, multipliers=forces)
+        if solved:               # step 0 is the assembly (Newton moved it by round-off)
+            q[0] = start
     job.info["exudyn_seconds"] = _time.perf_counter() - clock
 
     if solved < len(job.times) and not (partial and solved > 0):

@@ -154,3 +154,35 @@ def test_underdriven_names_only_the_free_solids():
     res = pam2exu.run(m, analysis="assembly")
     assert res["pendulum.fi"][0] == pytest.approx(-1.5, abs=1e-12)
     assert res["coupler.fi"][0] == pytest.approx(four_bar_pose(0.0)[0], abs=1e-10)
+
+
+def degrees_as_radians():
+    """The four-bar with its fi guesses given in degrees (47, 56, 123) where radians are
+    meant: Newton's iteration starts whole turns away from the mode the guess describes."""
+    m = pam2exu.load(EXAMPLES / "four_bar.toml")
+    m["crank"].fi, m["coupler"].fi, m["rocker"].fi = 47.0, 56.0, 123.0
+    return m
+
+
+def test_every_analysis_starts_from_what_assembly_returns():
+    """Issue 10, fault 4: the assembly analysis closed this model, but a kinematic run failed
+    at step 1 ("the Newton iteration diverged"), and with fewer steps ran from another
+    numbering of the same pose (coupler.fi = 189.3 rad). Now every analysis starts from the
+    assembly, bit for bit, and each angle keeps the whole turn nearest its guess."""
+    assembled = pam2exu.run(degrees_as_radians(), analysis="assembly")
+    phi, psi = four_bar_pose(0.0)
+    # the motor sets the crank at f(0) = 0; the joints leave coupler and rocker their turns
+    assert assembled["crank.fi"][0] == 0.0
+    assert assembled["coupler.fi"][0] == pytest.approx(phi + 2 * math.pi * 9, abs=1e-10)
+    assert assembled["rocker.fi"][0] == pytest.approx(psi + 2 * math.pi * 19, abs=1e-10)
+    assert abs(assembled["coupler.fi"][0] - 56.0) < math.pi
+    assert abs(assembled["rocker.fi"][0] - 123.0) < math.pi
+    for analysis in ("kinematic", "quasi_static", "kinetostatic"):
+        for steps in (200, 20, 3):
+            res = pam2exu.run(degrees_as_radians(), analysis=analysis, steps=steps)
+            for s in SOLIDS:
+                for v in ("x", "y", "fi"):
+                    assert res[f"{s}.{v}"][0] == assembled[f"{s}.{v}"][0], (analysis, steps, s, v)
+            # one turn of the crank later, the same pose and the same numbering
+            for s in ("coupler", "rocker"):
+                assert res[f"{s}.fi"][-1] == pytest.approx(assembled[f"{s}.fi"][0], abs=1e-9)

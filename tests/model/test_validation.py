@@ -904,3 +904,106 @@ def test_unknown_analysis_name_lists_both_spellings():
     with pytest.raises(ModelError, match=r"'cinematic' \(did you mean 'cinematica'\?\).*"
                                          r"\(Catalan: ensamblatge, quasi_estatica"):
         loads(SOLIDS + '\n[analysis]\ntype = "cinematic"\n')
+
+
+# ---- values of a wrong type or out of range, names, encodings (issue 10, faults 3, 9) ------
+
+def test_a_solid_name_that_is_not_a_string_is_a_model_error():
+    """Before: "unexpected error (TypeError: unhashable type: 'list')" from model/solid.py."""
+    message = only_problem(SOLIDS.replace('name = "crank"', "name = []"))
+    assert message.startswith("[[solid]] #2 '[]': name must be a non-empty string, got []")
+
+
+@pytest.mark.parametrize("entry, value", [
+    ("x = 0.1", "x = 1e300"), ("x = 0.1", "fi = -2e7"), ("x = 0.1", "mass = 1e13"),
+    ("x = 0.1", "cog = [0.0, 2e6]"), ("A = [0.1, 0.0]", "A = [1e200, 0.0]"),
+    ("angle = 0.0 } }\n\n[[solid]]\nname = \"crank\"",
+     "angle = 1e8 } }\n\n[[solid]]\nname = \"crank\""),
+])
+def test_numbers_out_of_range_are_model_errors(entry, value):
+    """A length beyond 1e6 m, an angle beyond 1e7 rad or another number beyond 1e12 is a
+    unit error, reported with the entry and the key (before: OverflowError, or Exudyn's
+    "inertia may not be negative, but received -nan" for a cog far away)."""
+    message = only_problem(SOLIDS.replace(entry, value, 1))
+    assert "out of range" in message and "are the units right?" in message
+    assert message.startswith("[[solid]] #")
+
+
+def test_law_constants_out_of_range_are_model_errors():
+    """C = 1e308 (before: "Residuals are not finite" from scipy)."""
+    message = only_problem(element('type = "angular_actuator"\nanc1 = "ground"\n'
+                                   'anc2 = "crank"\nC = [0.0, 1e308]'))
+    assert "'C' is out of range: C2 = 1e+308" in message
+
+
+def test_a_transmission_of_ratio_zero_is_a_model_error():
+    """T = 0 (before: "Singular matrix" from the multipliers' solve)."""
+    text = element('type = "transmission"\nanc1 = "ground"\nanc2 = "crank"\nT = 0.0\n'
+                   'arm = "ground"')
+    assert "T = 0 is not a gear ratio" in only_problem(text)
+
+
+def test_a_spring_between_a_point_and_itself_is_a_model_error():
+    """Length 0, no direction (before: NaN forces in a successful result)."""
+    text = element('type = "spring"\nname = "k"\nanc1 = "crank.A"\nanc2 = "crank.A"\n'
+                   'C = [1.0, 10.0]')
+    assert only_problem(text) == ("[[element]] #1 'k' (spring): anc1 and anc2 are the same "
+                                  "point 'crank.A': a spring of length 0 has no direction for "
+                                  "its force; attach it between two different points")
+
+
+@pytest.mark.parametrize("name, phrase", [
+    ("x" * 101, "name is 101 characters long: at most 100 are allowed"),
+    ("a\nb", "contains a control character"),
+    (" crank", "starts or ends with blanks"),
+    ("", "name must be a non-empty string"),
+])
+def test_names_must_be_usable_in_every_output(name, phrase):
+    """Names reach CSV headers, messages and pictures: short, printable, trimmed."""
+    m = Model("demo")
+    m.add_solid(name)
+    assert any(phrase in str(p) for p in m.problems())
+
+
+def test_a_long_name_is_shortened_in_messages():
+    m = Model("demo")
+    m.add_solid("y" * 1_000_000)
+    (problem,) = m.problems()
+    assert len(str(problem)) < 200 and "1000000 characters long" in str(problem)
+
+
+def test_outputs_that_are_not_a_list_are_a_model_error():
+    """outputs = 5 (before: TypeError 'int' object is not iterable)."""
+    with pytest.raises(ModelError, match=r"outputs must be a list of names or patterns"):
+        loads(SOLIDS + "\n[analysis]\noutputs = 5\n")
+
+
+def test_an_integer_too_large_for_a_float_is_not_a_number():
+    m = Model("demo")
+    m.add_solid("s", x=10**400)
+    assert any("x must be a number" in str(p) for p in m.problems())
+
+
+def test_a_windows_1252_file_is_read(tmp_path):
+    """PAM's exports and Windows editors save Windows-1252 (before: UnicodeDecodeError)."""
+    text = SOLIDS.replace('name = "crank"', 'name = "maneta_ç"') + "\n# Força\n"
+    path = tmp_path / "cp1252.toml"
+    path.write_bytes(text.encode("cp1252"))
+    model = pam2exu.load(path)
+    assert [s.name for s in model.solids] == ["ground", "maneta_ç"]
+    assert model.encoding == "cp1252"
+    assert pam2exu.load(ROOT / "examples" / "four_bar.toml").encoding == "utf-8"
+
+
+def test_bytes_that_are_no_text_say_to_save_as_utf8(tmp_path):
+    path = tmp_path / "binary.toml"
+    path.write_bytes(b"[model]\nname = \"\x81\x8d\"\n")
+    with pytest.raises(ModelError, match=r"not text in UTF-8 or Windows-1252 \(byte 0x81 at "
+                                         r"position 16\): save it as UTF-8 text"):
+        pam2exu.load(path)
+
+
+def test_arrays_nested_too_deeply_are_a_model_error():
+    """600 levels (before: RecursionError from tomllib)."""
+    with pytest.raises(ModelError, match=r"nested too deeply"):
+        loads("x = " + "[" * 600 + "]" * 600)

@@ -1,0 +1,152 @@
+"""The plan of a run (analyses/grid.py): laws over the grid, sub-steps, bounded work.
+
+Issue 10, faults 1, 5 and 9: a crank turning millions of radians per step ran for minutes;
+a motor at 360 rad/s (degrees given as radians) switched branch; ``--steps 1`` failed on
+every example; t_end = 5e-324, steps = 1e30 and law constants of 1e308 gave foreign
+exceptions. References: the four-bar's closed form (circle intersection,
+test_kinematic_closed_form.four_bar), and the motion per step computed here by hand.
+"""
+from __future__ import annotations
+
+import math
+import signal
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_kinematic_closed_form import FOUR_BAR, four_bar
+
+import pam2exu
+from pam2exu.analyses import grid
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@contextmanager
+def deadline(seconds: int):
+    """Fail (instead of hanging the suite) when the block runs longer than ``seconds``."""
+    def stop(*_):
+        raise TimeoutError(f"still running after {seconds} s")
+    previous = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def fast_four_bar(speed: float):
+    """examples/four_bar.toml with the crank at ``speed`` rad/s."""
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    model["motor"].C = [0.0, speed, 0.0, 0.0]
+    return model
+
+
+def test_motion_per_step_of_a_law():
+    """θ = 2π t on 0 … 1 s in 4 steps: Δθ = π/2 per step (= θ' Δt)."""
+    law = pam2exu.Law("polynomial", [0.0, 2 * math.pi])
+    assert grid.motion_per_step(law, np.linspace(0.0, 1.0, 5)) == pytest.approx(math.pi / 2)
+
+
+def test_a_crank_at_360_rad_per_second_is_solved_in_sub_steps_and_is_exact():
+    """360 rad/s over 1 s in 200 steps: 1.8 rad per step, so ⌈1.8 / 0.25⌉ = 8 sub-steps per
+    step; the results are reported on the 201 user times and match the closed form (before:
+    "the mechanism keeps switching branch near singular positions")."""
+    res = pam2exu.run(fast_four_bar(360.0), analysis="kinematic")
+    assert len(res) == 201 and res.info["substeps"] == 8
+    assert res.t[1] == pytest.approx(1.0 / 200)
+    th = 360.0 * res.t
+    (phi, dphi, _), (psi, dpsi, _) = four_bar(**FOUR_BAR, th=th, dth=360.0 + 0 * th,
+                                             ddth=0 * th)
+    assert np.max(np.abs(res["coupler.fi"] - phi)) < 1e-9
+    assert np.max(np.abs(res["rocker.fi"] - psi)) < 1e-9
+    assert np.max(np.abs(res["rocker.Dfi"] - dpsi)) < 1e-9 * 360.0
+    assert np.max(np.abs(res["coupler.Dfi"] - dphi)) < 1e-9 * 360.0
+
+
+def test_the_default_grid_has_no_sub_steps():
+    """2π/200 = 0.031 rad per step: the user's grid is solved as it is."""
+    res = pam2exu.run(EXAMPLES / "four_bar.toml", analysis="kinematic")
+    assert "substeps" not in res.info
+
+
+def test_a_run_that_would_take_too_long_is_refused_at_once_with_the_motion_per_step():
+    """t_end = 1e7 s in 40 steps at 2π rad/s: 2π·1e7/40 = 1.57e6 rad per step; in steps
+    of 0.25 rad that is 40·⌈1.57e6/0.25⌉ = 2.5e8 solves (before: minutes without end)."""
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    with deadline(20), pytest.raises(pam2exu.ModelError) as info:
+        pam2exu.run(model, t_end=1e7, steps=40)
+    text = str(info.value)
+    assert "'motor' turns 1.6e+06 rad per step" in text
+    assert "2.5e+08 position solves" in text and "2,000,000" in text
+    assert "degrees" in text
+
+
+@pytest.mark.parametrize("steps", [1, 2])
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.stem)
+def test_one_or_two_steps_give_the_fine_run_at_those_times(path, steps):
+    """``--steps 1`` and ``--steps 2`` work on every example (issue 10, fault 9): the rows
+    equal those of the model's own grid at the same times (the same branch)."""
+    model = pam2exu.load(path)
+    fine = pam2exu.run(model, analysis="kinematic")
+    coarse = pam2exu.run(model, analysis="kinematic", steps=steps)
+    assert len(coarse) == steps + 1
+    stride = model.analysis.steps // steps
+    assert model.analysis.steps % steps == 0
+    for name in coarse.columns:
+        scale = max(1.0, float(np.max(np.abs(fine[name]))))
+        assert np.max(np.abs(coarse[name] - fine[name][::stride])) < 1e-8 * scale, name
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.stem)
+def test_one_step_runs_every_analysis(path):
+    for analysis in ("quasi_static", "kinetostatic"):
+        res = pam2exu.run(path, analysis=analysis, steps=1)
+        assert len(res) == 2 and np.isfinite(res.to_numpy()).all()
+
+
+def test_a_linear_actuator_whose_distance_reaches_zero_is_a_model_error():
+    """examples/all_elements.toml's linear actuator with f(t) = 0.3 − 0.6 t: f(0.5) = 0,
+    a distance without direction."""
+    model = pam2exu.load(EXAMPLES / "all_elements.toml")
+    actuator = next(el for el in model.elements if el.type == "linear_actuator")
+    actuator.law, actuator.C = "polynomial", [0.3, -0.6]
+    with pytest.raises(pam2exu.ModelError, match=r"the distance PQ must stay positive.*"
+                                                 r"f\(t\) = 0 m at t = 0.5 s"):
+        pam2exu.run(model, analysis="kinematic", t_end=1.0, steps=10)
+
+
+def test_a_law_whose_rate_is_not_finite_is_a_model_error():
+    """A ramp over 5e-324 s has f' = rise / 5e-324 = ∞ (before: a hang of minutes)."""
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    model["motor"].law, model["motor"].C = "ramp", [0.0, 5e-324, 0.0, 1.0]
+    with deadline(20), pytest.raises(pam2exu.ModelError, match=r"f'\(t\) is not finite"):
+        pam2exu.run(model)
+
+
+def test_a_law_beyond_its_range_is_a_model_error():
+    """θ = 2e7 rad (a constant): more than the 1e7 rad an angle may reach."""
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    model["motor"].C = [2e7, 0.0, 0.0, 0.0]
+    with pytest.raises(pam2exu.ModelError, match=r"f\(t\) is .* \(at most 1e\+07 rad\)"):
+        pam2exu.run(model)
+
+
+@pytest.mark.parametrize("t_end, steps, message", [
+    (5e-324, 10, r"t_end = 4.94066e-324 s is out of range"),
+    (1e300, 10, r"t_end = 1e\+300 s is out of range"),
+    (1.0, 10**30, r"steps = 10{30} is more than pam2exu runs"),
+])
+def test_absurd_intervals_are_model_errors(t_end, steps, message):
+    """Before: "cannot convert float NaN to integer", "Maximum allowed size exceeded"."""
+    with pytest.raises(pam2exu.ModelError, match=message):
+        pam2exu.run(EXAMPLES / "four_bar.toml", t_end=t_end, steps=steps)
+
+
+def test_a_run_that_would_not_fit_in_memory_is_refused():
+    """all_elements, 9e6 steps: 9e6 rows × (4 × 36 coordinates + equations + columns) ×
+    8 bytes is over 4 GiB."""
+    with pytest.raises(pam2exu.ModelError, match=r"GiB of coordinates and results"):
+        pam2exu.run(EXAMPLES / "all_elements.toml", analysis="kinematic", steps=9_000_000)

@@ -1,0 +1,138 @@
+"""The guards of every analysis: no non-finite value in a result, no foreign exception.
+
+Issue 10, faults 2 and 9: a spring whose anchors coincide returned NaN forces in a
+"successful" result (its only sign a power balance "by up to nan W"); a linear actuator
+whose points coincide at the guess gave "SVD did not converge"; a solid fixed and jointed
+gave an IndexError; any other fault of pam2exu escaped as a bare NumPy exception.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pam2exu
+from pam2exu.analyses import common, native
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def four_bar_with(extra):
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    extra(model)
+    return model
+
+
+@pytest.mark.parametrize("analysis", ["kinematic", "kinetostatic"])
+def test_a_spring_whose_points_coincide_is_a_solver_error_naming_it_and_the_time(analysis):
+    """ground.O2 and crank.O are joined by the revolute O2: the spring between them has
+    ro = 0 at every time, so its direction (and Dro, and its force) is undefined."""
+    model = four_bar_with(lambda m: m.add("spring", name="k0", anc1="ground.O2",
+                                          anc2="crank.O", C=[1.0, 10.0]))
+    with pytest.raises(pam2exu.SolverError, match=r"at t = 0 s the points of spring 'k0' "
+                                                  r"coincide \(ro = 0 m\)") as info:
+        pam2exu.run(model, analysis=analysis)
+    assert info.value.time == 0.0 and info.value.elements == ("'k0' (spring)",)
+
+
+def test_a_non_finite_value_is_never_a_result(monkeypatch):
+    """The last guard (common.check_finite): whatever produced it, a NaN in a column is a
+    SolverError naming the column and the first time, not a result."""
+    from pam2exu.elements import Spring
+
+    def nan_after(self, st, names):
+        values = real(self, st, names)
+        values["ro"] = np.where(st.t >= 0.5, np.nan, values["ro"])
+        return values
+
+    real = Spring.compute
+    monkeypatch.setattr(Spring, "compute", nan_after)
+    model = four_bar_with(lambda m: m.add("spring", name="k", anc1="ground.O4",
+                                          anc2="coupler.P", C=[0.0, 10.0]))
+    with pytest.raises(pam2exu.SolverError, match=r"not numbers \(NaN or infinite\) first at "
+                                                  r"t = 0.5 s \(row 100\), in k.ro") as info:
+        pam2exu.run(model, analysis="kinematic")
+    assert info.value.time == 0.5 and info.value.step == 100
+
+
+def test_check_finite_names_every_column_of_the_first_bad_row():
+    job = common.prepare(EXAMPLES / "four_bar.toml", "kinematic", steps=4)
+    t = np.linspace(0.0, 1.0, 5)
+    values = {"a.x": np.array([0, 1, np.inf, 3, 4.0]), "b.y": np.array([0, 1, np.nan, 3, 4.0]),
+              "c.z": np.array([0, 1, 2, np.nan, 4.0]), "d.w": np.arange(5.0)}
+    with pytest.raises(pam2exu.SolverError, match=r"first at t = 0.5 s \(row 2\), in a.x, b.y; "
+                                                  r"3 columns in all"):
+        common.check_finite(job, t, values)
+    common.check_finite(job, t, {"d.w": np.arange(5.0)})        # nothing to say
+
+
+def test_a_foreign_exception_becomes_a_solver_error_saying_what_was_done(monkeypatch):
+    """Any exception that is not pam2exu's own, raised inside an analysis, reaches the
+    user as a SolverError naming the stage, with the exception as its cause."""
+    def broken(*args, **kwargs):
+        raise IndexError("index 3 is out of bounds")
+
+    monkeypatch.setattr(native, "rates", broken)
+    with pytest.raises(pam2exu.SolverError, match=r"the kinematic analysis of .*four_bar.toml "
+                                                  r"failed unexpectedly \(IndexError: index 3 is "
+                                                  r"out of bounds\) while computing velocities "
+                                                  r"and following the branch") as info:
+        pam2exu.run(EXAMPLES / "four_bar.toml", analysis="kinematic")
+    assert isinstance(info.value.__cause__, IndexError)
+    assert "please report it" in str(info.value)
+
+
+def test_a_linear_actuator_whose_points_coincide_at_the_guess_is_a_model_error(tmp_path):
+    """The slider's point B starts on the ground's O: |PQ| = 0 has no direction there
+    (before: "SVD did not converge")."""
+    text = """
+[[solid]]
+name = "ground"
+points = { O = [0.0, 0.0] }
+lines = { rail = { point = [0.0, 0.0], angle = 0.0 } }
+[[solid]]
+name = "slider"
+points = { B = [0.0, 0.0] }
+lines = { axis = { point = [0.0, 0.0], angle = 0.0 } }
+[[element]]
+type = "fixed"
+anc1 = "ground"
+[[element]]
+type = "prismatic"
+anc1 = "ground.rail"
+anc2 = "slider.axis"
+[[element]]
+type = "linear_actuator"
+name = "act"
+anc1 = "ground.O"
+anc2 = "slider.B"
+C = [0.1, 0.1]
+"""
+    with pytest.raises(pam2exu.ModelError, match=r"#3 'act' \(linear_actuator\): its equation "
+                                                 r"is not defined at the initial guess"):
+        pam2exu.run(pam2exu.loads(text), analysis="kinematic", steps=4)
+    moved = pam2exu.loads(text.replace('name = "slider"\n', 'name = "slider"\nx = 0.1\n'))
+    res = pam2exu.run(moved, analysis="kinematic", steps=4)
+    assert res["slider.x"][-1] == pytest.approx(0.2, abs=1e-14)      # f(1) = 0.1 + 0.1
+
+
+def test_a_solid_fixed_and_jointed_runs_with_minimum_norm_reactions():
+    """The crank held by a fixed link and hinged to the held ground: nothing moves, the
+    revolute is redundant (before: IndexError in native._solve)."""
+    m = pam2exu.Model("held", gravity=9.81)
+    m.add_solid("ground", points={"O": [0, 0]})
+    m.add_solid("crank", mass=2.0, points={"O": [0, 0]})
+    m.add("fixed", name="f0", anc1="ground")
+    m.add("fixed", name="f1", anc1="crank")
+    m.add("revolute", name="O", anc1="ground.O", anc2="crank.O")
+    with pytest.warns(pam2exu.RedundancyWarning):
+        res = pam2exu.run(m, analysis="kinetostatic", steps=4)
+    assert np.all(res["crank.Dfi"] == 0.0)
+    # the weight m g = 2 · 9.81 N is carried by f1 (a) and the pin O (b), a + b = m g; the
+    # pin's force on the ground, b, is carried by f0 (f0.Fy = b). Least squares of the
+    # reported components a² + b² + b²: a = 2 b, so a = 2 m g / 3, b = m g / 3
+    weight = 2.0 * 9.81
+    assert res["f1.Fy"] == pytest.approx(np.full(5, 2 * weight / 3), rel=1e-12)
+    assert res["O.Fy"] == pytest.approx(np.full(5, weight / 3), rel=1e-12)
+    assert res["f0.Fy"] == pytest.approx(np.full(5, weight / 3), rel=1e-12)
