@@ -87,7 +87,7 @@ def check_laws(mech, times: np.ndarray, ranges: bool = True) -> None:
                 break
         else:
             if ranges and unit == "m" and np.min(values[0]) <= 0:
-                k = int(np.argmin(values[0]))
+                k = int(np.argmax(values[0] <= 0))          # the first time
                 problems.append(Problem(el.where, (
                     f"the distance PQ must stay positive, but law '{law.name}' with "
                     f"C = {list(law.C)} gives f(t) = {values[0][k]:g} m at t = {times[k]:g} s: "
