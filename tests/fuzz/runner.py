@@ -21,6 +21,9 @@ Pam2ExuError), or a fault, whose class is one of
   the innermost frame inside the pam2exu package (the same class whether it came from
   ``pam2exu.run`` or the command line; a command line "unexpected error" is rerun with
   ``--debug`` to locate it);
+  A Pam2ExuError that says it is "a fault of pam2exu" (``analyses.run`` turns any foreign
+  exception into such a SolverError, its ``__cause__`` kept) counts as the exception it
+  wraps, in the same class;
 * ``empty message <Type>``: a Pam2ExuError without a message;
 * ``cli output``: an exit code or stderr that breaks the command line's contract;
 * ``non-finite``: a Results table with NaN or infinite values;
@@ -93,6 +96,7 @@ class Outcome:
     seconds: float = 0.0
     calls: int = 0                 # pam2exu calls made
     successes: int = 0             # of which ran (the others stopped on a clean error)
+    cause: str = ""                # a clean error's foreign __cause__: "<Type> at <file>:<line>"
 
 
 class _Fault(Exception):
@@ -147,6 +151,28 @@ def _cut(text: str, n: int = 400) -> str:
 def _exception_fault(exc, via) -> _Fault:
     return _Fault(f"exception {type(exc).__name__} at {location(exc)}", via,
                   f"{type(exc).__name__}: {_cut(exc)}", _detail(exc))
+
+
+#: what analyses.run says of a foreign exception it turns into a SolverError
+SELF_DECLARED = "fault of pam2exu"
+
+
+def _pam2exu_error(exc, via) -> str:
+    """Check a Pam2ExuError: '' when it is clean and its cause is pam2exu's own, else the
+    foreign cause ("<Type> at <file>:<line>"); _Fault when it is a fault."""
+    if not str(exc).strip():
+        raise _Fault(f"empty message {type(exc).__name__}", via,
+                     f"{type(exc).__name__} with message {str(exc)!r}", _detail(exc))
+    cause = exc.__cause__
+    if SELF_DECLARED in str(exc):
+        inner = cause if cause is not None else exc
+        fault = _exception_fault(inner, via)
+        fault.message += f" (raised as {type(exc).__name__}: {_cut(exc, 200)})"
+        raise fault
+    import pam2exu
+    if cause is not None and not isinstance(cause, pam2exu.Pam2ExuError):
+        return f"{type(cause).__name__} at {location(cause)}"
+    return ""
 
 
 def plan(seed: int) -> tuple[str, list[list[str]]]:
@@ -205,8 +231,9 @@ def _check_results(res, via, scratch) -> None:
         raise _Fault("csv", via, f"values differ: {what}", sub="values differ")
 
 
-def _api_call(name, analysis, scratch) -> bool:
-    """One in-process run: True when it ran, False for a clean error; _Fault otherwise."""
+def _api_call(name, analysis, scratch) -> tuple[bool, str]:
+    """One in-process run: (True, '') when it ran, (False, foreign cause or '') for a clean
+    error; _Fault otherwise."""
     import pam2exu
     via = f"pam2exu.run(path, analysis={analysis!r})"
     try:
@@ -216,14 +243,11 @@ def _api_call(name, analysis, scratch) -> bool:
     except CaseTimeout:
         raise
     except pam2exu.Pam2ExuError as exc:
-        if not str(exc).strip():
-            raise _Fault(f"empty message {type(exc).__name__}", via,
-                         f"{type(exc).__name__} with message {str(exc)!r}", _detail(exc))
-        return False
+        return False, _pam2exu_error(exc, via)
     except BaseException as exc:     # noqa: BLE001
         raise _exception_fault(exc, via) from None
     _check_results(res, via, scratch)
-    return True
+    return True, ""
 
 
 def _cli_call(argv) -> tuple[int | None, str, BaseException | None]:
@@ -270,11 +294,14 @@ def _cli(argv, scratch) -> bool:
                                  sub="cli csv")
         return True
     text = err.strip()
-    if code in (1, 2) and err.startswith("pam2exu: ") and "unexpected error" not in err:
+    if (code in (1, 2) and err.startswith("pam2exu: ") and "unexpected error" not in err
+            and SELF_DECLARED not in err):
         return False
-    if "unexpected error" in err:
+    if "unexpected error" in err or SELF_DECLARED in err:
         _, _, exc = _cli_call(["--debug", *argv])       # locate it
-        if exc is not None and not isinstance(exc, pam2exu.Pam2ExuError):
+        if isinstance(exc, pam2exu.Pam2ExuError):
+            _pam2exu_error(exc, via)
+        elif exc is not None:
             fault = _exception_fault(exc, via)
             fault.message = f"{fault.message} [stderr: {_cut(text, 200)}]"
             raise fault
@@ -326,7 +353,8 @@ def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = 
         try:
             for k, analysis in enumerate((None, other)):
                 step = f"pam2exu.run(path, analysis={analysis!r})"
-                ran = _api_call(m.name, analysis, scratch)
+                ran, cause = _api_call(m.name, analysis, scratch)
+                outcome.cause = outcome.cause or cause
                 outcome.calls += 1
                 outcome.successes += ran
                 if k == 0:
@@ -428,6 +456,7 @@ class Campaign:
     successes: int = 0
     case_seconds: list = field(default_factory=list)
     outcomes: list = field(default_factory=list)     # every Outcome, in order of completion
+    causes: dict = field(default_factory=dict)       # foreign cause -> seeds (clean errors)
 
     def add(self, outcome: Outcome) -> None:
         self.outcomes.append(outcome)
@@ -435,6 +464,8 @@ class Campaign:
         self.calls += outcome.calls
         self.successes += outcome.successes
         self.case_seconds.append(outcome.seconds)
+        if outcome.cause:
+            self.causes.setdefault(outcome.cause, []).append(outcome.seed)
         if outcome.status == "fault":
             self.faults.setdefault(outcome.fault, []).append(outcome)
 
@@ -491,6 +522,14 @@ class Campaign:
                 if o.detail:
                     out += ["  - traceback (innermost frames):", "", "```",
                             o.detail, "```"]
+            out.append("")
+        if self.causes:
+            out += ["## Not faults: clean errors caused by a foreign exception", "",
+                    ("A Pam2ExuError raised `from` an exception that is not pam2exu's (the "
+                     "contract is met; listed for review):"), ""]
+            for cause, seeds in sorted(self.causes.items(), key=lambda kv: -len(kv[1])):
+                seeds = sorted(seeds)
+                out.append(f"- {cause}: {len(seeds)} mutants, e.g. seed {seeds[0]}")
             out.append("")
         return "\n".join(out)
 

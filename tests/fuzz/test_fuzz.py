@@ -96,6 +96,28 @@ def test_runner_classifies_an_exception(monkeypatch):
     assert outcome.message == "ValueError: boom"
 
 
+def test_runner_classifies_a_self_declared_fault_as_its_cause(monkeypatch):
+    def fake(path, analysis=None):
+        try:
+            raise IndexError("list index out of range")
+        except IndexError as exc:
+            raise pam2exu.SolverError("the kinematic analysis of m.toml failed unexpectedly "
+                                      "(IndexError). This is a fault of pam2exu") from exc
+    outcome = _patched_case(monkeypatch, fake)
+    assert outcome.fault.startswith("exception IndexError at ")
+    assert "raised as SolverError" in outcome.message
+
+
+def test_runner_notes_a_foreign_cause_of_a_clean_error(monkeypatch):
+    def fake(path, analysis=None):
+        try:
+            float("x")
+        except ValueError as exc:
+            raise pam2exu.ModelError("'x' is not a number") from exc
+    outcome = _patched_case(monkeypatch, fake)
+    assert outcome.status == "clean error" and outcome.cause.startswith("ValueError at ")
+
+
 def test_runner_classifies_an_empty_message(monkeypatch):
     def fake(path, analysis=None):
         raise pam2exu.SolverError("")
