@@ -298,14 +298,26 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
         since = (f"at t = {t:.6g} s" if solved == 0 else
                  f"from t = {float(times[solved - 1]):.6g} s to t = {t:.6g} s")
         names = ", ".join(f"'{n}'" for n in among)
+        concerned = [e for e in mech.constraints if e.name in among]
+        extra = native.culprit(mech, t, start, among, disagreement)
+        bar = loops.bar_of(mech, extra) if extra is not None else None
+        if bar is not None:           # the extra bar: the last one the file adds
+            solid, concerned = bar
+            which = (f" Without '{extra.name}' the others agree: "
+                     f"{mech.solids[solid].name}, held by "
+                     f"{' and '.join(repr(e.name) for e in concerned)}, is an extra bar that "
+                     f"does not fit: remove it, or give it the length that fits.")
+        else:
+            which = (f" Without '{extra.name}' the others agree." if extra is not None
+                     else "") + (" Remove the extra constraint, or make the laws or the "
+                                 "geometry agree.")
         return SolverError(
             f"the constraints of {names} contradict each other {since} ({step}): they are "
             f"redundant (between them they fix a coordinate more than once) and their targets "
             f"disagree by {disagreement:.3g} (m or rad), so no configuration satisfies them "
-            f"all. Remove the extra constraint, or make the laws or the geometry agree. "
-            f"Exudyn said: {system.error}",
+            f"all.{which} Exudyn said: {system.error}",
             time=t, step=solved // job.every,
-            elements=tuple(f"'{e.name}' ({e.type})" for e in mech.constraints if e.name in among))
+            elements=tuple(f"'{e.name}' ({e.type})" for e in concerned))
     if worst and solved == 0:
         by_name = {f"'{el.name}' ({el.type})": el for el in mech.constraints}
         loop = loops.diagnose(mech, [by_name[name] for name in elements], t)

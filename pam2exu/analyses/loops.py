@@ -279,3 +279,17 @@ def _reach(mech, steps, nodes, poses, t: float) -> str | None:
                     f"{shortest:.4g} … {total:.4g} m. Change these lengths, or the "
                     f"actuators' values at t = {t:g} s")
     return None
+
+
+def bar_of(mech, element) -> tuple[int, list] | None:
+    """(solid, its two ties) when the tie ``element`` holds a binary bar: one of its two
+    solids, not held, that has exactly two ties (the fifth bar of a parallelogram)."""
+    if element.type not in TIES:
+        return None
+    graph = edges(mech)
+    frame = held(mech)
+    for solid in (element.ref2.solid, element.ref1.solid):
+        ties = [e.element for e in graph if solid in (e.a, e.b)]
+        if solid not in frame and len(ties) == 2:
+            return solid, ties
+    return None

@@ -305,10 +305,13 @@ class Mobility:
         return text
 
 
-def _rank(mech, t: float, q: np.ndarray, rtol: float):
+def _rank(mech, t: float, q: np.ndarray, rtol: float, rows=None):
     """(U, s, Vt, rank) of the SVD of Cq at (q, t), with the angle columns scaled by the
-    length scale so that all columns have units of length; None without equations."""
+    length scale so that all columns have units of length (only the equations ``rows``,
+    when given); None without equations."""
     J = equations(mech, State([t], q[None, :])).jacobian[0]
+    if rows is not None:
+        J = J[rows]
     J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
     if J.shape[0] == 0:
         return None
@@ -355,23 +358,43 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
     return Mobility(dof, redundant, free, dependent, condition)
 
 
-def contradiction(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> tuple[float, list[str]]:
+def contradiction(mech, t: float, q: np.ndarray, rtol: float = 1e-9,
+                  without=None) -> tuple[float, list[str]]:
     """How far redundant constraints contradict each other at time t, near configuration q.
 
     With N the left null space of Cq(q) (the combinations of equations that no change of q
     can alter, to first order), |Nᵀ C(q, t)| is a violation no configuration near q can
     remove: the constraints' targets disagree. Returns that size (in the equations' units,
     m or rad) and the elements whose equations make it up. Zero when Cq has full row rank.
+    ``without``: an element whose equations are left out.
     """
-    svd = _rank(mech, t, q, rtol)
+    keep = np.ones(mech.n_equations, dtype=bool)
+    if without is not None:
+        keep[mech.rows[mech.constraints.index(without)]] = False
+    svd = _rank(mech, t, q, rtol, keep)
     if svd is None or svd[3] == svd[0].shape[0]:
         return 0.0, []
-    left = svd[0][:, svd[3]:]                              # (m, redundant)
+    left = np.zeros((mech.n_equations, svd[0].shape[0] - svd[3]))
+    left[keep] = svd[0][:, svd[3]:]                        # (m, redundant)
     disagreement = left.T @ residuals(mech, np.array([t]), q[None, :])[0]
     share = np.abs(left @ disagreement)                    # each equation's part in it
     names = [el.name for el, rows in zip(mech.constraints, mech.rows)
              if np.max(share[rows]) > 1e-6 * max(float(np.max(share)), 1e-300)]
     return float(np.linalg.norm(disagreement)), names
+
+
+def culprit(mech, t: float, q: np.ndarray, among: list[str], size: float):
+    """The last element of ``among`` (in the file's order; joints before actuators and
+    fixed links) without whose equations the others no longer contradict each other (the
+    extra constraint a user added last), or None. ``size``: the contradiction with it, the
+    scale of "no longer"."""
+    concerned = [e for e in mech.constraints if e.name in among]
+    setters = [e for e in concerned if e.drives or e.grounds]
+    joints = [e for e in concerned if e not in setters]
+    for el in [*reversed(joints), *reversed(setters)]:
+        if contradiction(mech, t, q, without=el)[0] <= 1e-3 * size:
+            return el
+    return None
 
 
 def require_driven(mech, mob: Mobility, analysis: str) -> None:
