@@ -62,6 +62,7 @@ import numpy as np
 import pytest
 
 import pam2exu
+import test_kinematic_closed_form as kcf
 
 RTOL = 1e-9
 TWO_PI = 2.0 * math.pi
@@ -117,6 +118,12 @@ def law_polynomial(t, C):
             2 * c3 + 6 * c4 * t + 0 * t)
 
 
+#: the motor's laws: polynomial above, the transition laws written independently in
+#: test_kinematic_closed_form.py (nothing from pam2exu)
+MOTOR_LAWS = {"polynomial": law_polynomial, "ramp": kcf.law_ramp,
+              "bezier_c1": kcf.law_bezier_c1, "bezier_c2": kcf.law_bezier_c2}
+
+
 # ---- the mechanism -------------------------------------------------------------------------
 
 def slider_crank_params(**over):
@@ -149,7 +156,8 @@ def kinematics(p, t):
     g0 = np.array([gx, gy])
     r, l = p["crank"]["r"], p["rod"]["l"]
     sl = p["slider"]
-    th, dth, ddth = law_polynomial(t, p["motor"]["C"])
+    law = MOTOR_LAWS[p["motor"].get("law", "polynomial")]
+    th, dth, ddth = law(t, (tuple(p["motor"]["C"]) + (0.0,) * 4)[:4])
     thg = gam + th
     O = g0 + rot(gam, p["ground"]["O"])
     K = g0 + rot(gam, p["ground"]["rail_point"])
@@ -346,7 +354,7 @@ type = "angular_actuator"
 name = "motor"
 anc1 = "ground"
 anc2 = "crank"
-law = "polynomial"
+law = "{p['motor'].get('law', 'polynomial')}"
 C = {fmt(p['motor']['C'])}
 
 [[element]]
@@ -543,6 +551,24 @@ def test_kinetostatic_slider_crank(variant):
     and base.Fy = (m_ground + m_crank) g > 0 (the fixed link carries both weights).
     """
     run_and_compare(VARIANTS[variant], "kinetostatic")
+
+
+@pytest.mark.parametrize("analysis", ["quasi_static", "kinetostatic"])
+@pytest.mark.parametrize("law, C", [("ramp", (0.2, 0.8, 0.3, 4.0)),
+                                    ("bezier_c1", (0.1, 0.7, -0.5, 3.0)),
+                                    ("bezier_c2", (0.25, 0.9, 0.3, 6.0))])
+def test_force_analyses_with_transition_laws(law, C, analysis):
+    """The slider-crank (moved ground, reversed slider line, torsor in the rod's axes) whose
+    motor follows a transition law: at rest at C3 until C1, to C4 by C2, at rest after
+    (issue 10: these laws were covered only by pam2exu's own power balance). Every reaction
+    and the motor torque against the Newton–Euler solution, the law evaluated by the
+    independent implementation of test_kinematic_closed_form; the breakpoints lie on the
+    grid (200 steps over 1 s), where both sides take the right-hand limit (the ramp's θ'
+    jumps there, so its θ'' is zero on both sides and the torque jumps with the
+    centripetal terms)."""
+    p = dict(VARIANTS["moved_ground_reversed_line"])
+    p["motor"] = {"law": law, "C": C}
+    run_and_compare(p, analysis)
 
 
 @pytest.mark.parametrize("variant", VARIANTS)
