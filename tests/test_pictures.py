@@ -140,6 +140,20 @@ def test_draw_at_a_time_uses_the_kinematic_positions(examples):
     assert "t = 0.25 s" in fig.axes[0].get_title()
 
 
+@pytest.mark.parametrize("t", [0.0, 0.25])
+def test_draw_ignores_the_models_outputs(examples, t):
+    """A model whose [analysis] outputs keep only t (fuzz seed 2048: before, draw failed
+    with "no column 'ground.x'" from the assembly it ran with those outputs)."""
+    from matplotlib.patches import Circle
+    model = pam2exu.load(examples / "four_bar.toml")
+    model.analysis.outputs = ["t"]
+    fig = draw(model, t=t)
+    joint = [a for a in fig.axes[0].patches if a.get_gid() == "revolute:A"
+             and isinstance(a, Circle)]
+    np.testing.assert_allclose(joint[0].center, (0.1 * math.cos(2 * math.pi * t),
+                                                 0.1 * math.sin(2 * math.pi * t)), atol=1e-9)
+
+
 # --- animations -----------------------------------------------------------------------------
 
 def test_animate_writes_a_gif_with_one_frame_per_step(examples, tmp_path):

@@ -160,6 +160,7 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
         raise ModelError(exc.problems, model.source) from None
     if kind == "assembly":
         plan = grid.Plan(np.zeros(1), 1, None)
+        grid.check_laws(mech, plan.times)        # the actuators' values at t = 0
     else:
         plan = grid.plan(mech, settings.t_end, settings.steps, len(columns))
     levels = {available[c].level for c in columns} | {POSITION}

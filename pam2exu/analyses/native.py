@@ -423,12 +423,24 @@ def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
     return n - 1
 
 
+#: the most time the least-squares search of a failure's diagnosis may take [s]
+DIAGNOSIS_SECONDS = 2.0
+
+
+class _Enough(Exception):
+    """The diagnosis' search ran out of time (``closest_violation``)."""
+
+
 def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(C(q*, t), q*) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only).
 
     The elements still violated at q* are those that cannot close at time t. Where
-    C(q*) ≠ 0, Cqᵀ C = 0 there: the constraint Jacobian is singular at q*.
+    C(q*) ≠ 0, Cqᵀ C = 0 there: the constraint Jacobian is singular at q*. The search
+    stops after ``DIAGNOSIS_SECONDS`` with the best configuration found (a mechanism that
+    cannot close leaves a flat valley that it would otherwise crawl along for long).
     """
+    import time
+
     from scipy.optimize import least_squares
 
     # actuators and fixed links can always hold (they only set a coordinate): weight them
@@ -437,14 +449,29 @@ def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, 
     for el, rows in zip(mech.constraints, mech.rows):
         if el.drives or el.grounds:
             weight[rows] = 1e3
+    stop = time.perf_counter() + DIAGNOSIS_SECONDS
+    best = [np.inf, q_start, None]
 
     def fun(q):
-        return weight * equations(mech, State([t], q[None]), jacobian=False).residual[0]
+        with np.errstate(all="ignore"):
+            f = weight * equations(mech, State([t], q[None]), jacobian=False).residual[0]
+        size = float(np.dot(f, f))
+        if size < best[0]:
+            best[:] = size, q.copy(), f
+        if time.perf_counter() > stop:
+            raise _Enough
+        return f
 
     def jac(q):
-        return weight[:, None] * equations(mech, State([t], q[None])).jacobian[0]
+        with np.errstate(all="ignore"):
+            return weight[:, None] * equations(mech, State([t], q[None])).jacobian[0]
 
-    sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
-                        else "trf", max_nfev=200 * mech.nq, xtol=1e-15, ftol=1e-15,
-                        gtol=1e-15)
-    return sol.fun / weight, sol.x
+    try:
+        sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
+                            else "trf", max_nfev=200 * mech.nq, xtol=1e-15, ftol=1e-15,
+                            gtol=1e-15)
+        return sol.fun / weight, sol.x
+    except (_Enough, ValueError):       # out of time, or a residual that is not finite
+        if best[2] is None:
+            return np.full(mech.n_equations, np.inf), q_start
+        return best[2] / weight, best[1]

@@ -159,7 +159,7 @@ class Scope:
         try:
             x, y = value
             return PointRef(i, (float(x), float(y)), str(text))
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise LookupError(f"point '{item}' of solid '{solid.name}' is not [x, y]") from None
 
     def line(self, text: str) -> LineRef:
@@ -169,7 +169,7 @@ class Scope:
         try:
             px, py = value.get("point", (0.0, 0.0))
             return LineRef(i, (float(px), float(py)), float(value.get("angle", 0.0)), str(text))
-        except (AttributeError, TypeError, ValueError):
+        except (AttributeError, TypeError, ValueError, OverflowError):
             raise LookupError(f"line '{item}' of solid '{solid.name}' is not "
                               "{ point = [x, y], angle = a }") from None
 

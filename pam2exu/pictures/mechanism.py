@@ -76,7 +76,7 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
     model = _model(model)
     mech = model.mechanism()
     if analysis == "assembly":
-        res = run(model, analysis="assembly")
+        res = run(model, analysis="assembly", outputs=list(_POSE[:3]))
     else:
         res = run(model, analysis="kinematic", t_end=t_end, steps=steps, outputs=list(_POSE))
     q = np.column_stack([res[f"{s.name}.{k}"] for s in mech.solids for k in ("x", "y", "fi")])

@@ -150,3 +150,14 @@ def test_a_run_that_would_not_fit_in_memory_is_refused():
     8 bytes is over 4 GiB."""
     with pytest.raises(pam2exu.ModelError, match=r"GiB of coordinates and results"):
         pam2exu.run(EXAMPLES / "all_elements.toml", analysis="kinematic", steps=9_000_000)
+
+
+def test_the_assembly_checks_the_actuators_values_at_t0():
+    """A linear actuator of length 0 at t = 0, assembly analysis (fuzz seed 264: before,
+    Exudyn's "ObjectConnectorDistance.distance must be given")."""
+    model = pam2exu.load(EXAMPLES / "all_elements.toml")
+    actuator = next(el for el in model.elements if el.type == "linear_actuator")
+    actuator.law, actuator.C = "polynomial", [0.0]
+    with pytest.raises(pam2exu.ModelError, match=r"'cylinder' \(linear_actuator\): the "
+                                                 r"distance PQ must stay positive"):
+        pam2exu.run(model, analysis="assembly")

@@ -136,3 +136,26 @@ def test_a_solid_fixed_and_jointed_runs_with_minimum_norm_reactions():
     assert res["f1.Fy"] == pytest.approx(np.full(5, 2 * weight / 3), rel=1e-12)
     assert res["O.Fy"] == pytest.approx(np.full(5, weight / 3), rel=1e-12)
     assert res["f0.Fy"] == pytest.approx(np.full(5, weight / 3), rel=1e-12)
+
+
+def test_the_diagnosis_of_a_failure_stops_on_time(monkeypatch):
+    """The least-squares search behind "cannot be assembled" crawled for 24 s along the
+    flat valley of a mechanism that cannot close (fuzz seeds 740, 944). With no time left
+    it stops at once and still gives its best configuration: the diagnosis is bounded,
+    and says the same thing."""
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    model["coupler"].points["B"] = [0.1, 0.0]
+    model["rocker"].points["B"] = [0.1, 0.0]          # 0.1 + 0.1 + 0.1 < 0.4
+    calls = []
+    real = native.equations
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(native, "DIAGNOSIS_SECONDS", 0.0)
+    monkeypatch.setattr(native, "equations", counted)
+    with pytest.raises(pam2exu.SolverError, match=r"cannot be assembled .* the longest, "
+                                                  r"ground.O4–ground.O2 0.4 m, is longer"):
+        pam2exu.run(model, analysis="assembly")
+    assert len(calls) < 50                       # the search's first call ended it

@@ -1007,3 +1007,15 @@ def test_arrays_nested_too_deeply_are_a_model_error():
     """600 levels (before: RecursionError from tomllib)."""
     with pytest.raises(ModelError, match=r"nested too deeply"):
         loads("x = " + "[" * 600 + "]" * 600)
+
+
+def test_a_point_of_an_integer_too_large_for_a_float_is_reported_not_raised():
+    """An anchor on a point [0, 10**400] (fuzz seed 1871: before, OverflowError from
+    Scope.point while checking the element)."""
+    m = Model("demo")
+    m.add_solid("ground", points={"O": [0, 10**400]})
+    m.add_solid("crank", points={"O": [0, 0]})
+    m.add("revolute", name="O", anc1="ground.O", anc2="crank.O")
+    found = [str(p) for p in m.problems()]
+    assert "[[solid]] #1 'ground': point 'O' must be [x, y], got [0, " in found[0]
+    assert any("point 'O' of solid 'ground' is not [x, y]" in p for p in found)
