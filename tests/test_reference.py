@@ -183,3 +183,14 @@ def test_migration_page_maps_every_pam_element_and_law():
         assert f'`"{law}"`' in text, law
     for alias in LAW_ALIASES:
         assert f'`"{alias}"`' in text, alias
+
+
+def test_the_ranges_on_the_model_format_page_are_those_of_limits():
+    """docs/model-format.md, "Ranges, names and encodings", states pam2exu/limits.py."""
+    from pam2exu import limits
+    section = PAGES[0].read_text(encoding="utf-8").split("## Ranges, names and encodings")[1]
+    section = section.split("\n## ")[0]
+    for value in (limits.LENGTH, limits.ANGLE, limits.VALUE, *limits.T_END):
+        assert f"{value:.0e}" in section, value
+    assert f"{limits.STEPS:,}" in section and f"{limits.SOLVE_STEPS:,}" in section
+    assert f"{limits.MEMORY // 2**30} GiB" in section and f"at most {limits.NAME}" in section

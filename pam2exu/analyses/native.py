@@ -274,7 +274,7 @@ def condition_numbers(mech, t, q) -> np.ndarray:
     that units and the choice of length scale drop out; ∞ at a singular position.
 
     The one condition number of pam2exu (``pam2exu check``, ``Results.info``, the
-    ConditionWarning). The shipped examples: 1.4 to 8.6 over their motion; a four-bar
+    ConditionWarning). The shipped examples: 1.5 to 8.6 over their motion; a four-bar
     0.2° from a change point: about 190.
     """
     J = equations(mech, State(t, q)).jacobian
