@@ -34,6 +34,8 @@ SPIKE, SPIKE_FLOOR = 10.0, 1e-4
 SUBSTEPS = 16
 #: the most re-solves of a run before giving up
 MAX_RESOLVES = 64
+#: ... and the most position solves they may take: this many times the run, plus a floor
+RESOLVE_WORK, RESOLVE_FLOOR = 8, 20_000
 #: the condition number of the constraint Jacobian (rows and columns equilibrated) above
 #: which a run warns; ordinary mechanisms: 3 to 10, a four-bar 0.2° from a change point: 190
 CONDITION_WARNING = 100.0
@@ -80,7 +82,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
     q, solved, system = positions(job, redundant, check=False, partial=True)
     breakpoints = _breakpoints(mech)
     verified: set[int] = set()
-    resolves = 0
+    resolves = spent = 0              # re-solves, and the position solves they took
     while True:
         job.stage = "computing velocities and following the branch"
         tk, qk = t[:solved], q[:solved]
@@ -110,11 +112,9 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
         j = k - 1
         while singular[j]:
             j -= 1
-        if resolves == MAX_RESOLVES:
-            raise SolverError(
-                f"at t = {t[k]:.6g} s (step {k}) the mechanism keeps switching branch near "
-                f"singular positions ({MAX_RESOLVES} steps solved again already). Use more "
-                "steps, so the actuators move less per step.", time=float(t[k]), step=k)
+        spent += len(t) - k
+        if resolves == MAX_RESOLVES or spent > RESOLVE_WORK * len(t) + RESOLVE_FLOOR:
+            raise _keeps_switching(job, k, resolves, spent)
         h = t[k] - t[j]
         start = q[j] + h * qd[j] + 0.5 * h * h * qdd[j]
         part, part_solved, part_system = _resolve(job, k, start, redundant)
@@ -128,12 +128,14 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
         if verdict != "better" and not singular[j0:k1 + 1].any():
             # the predictor found no other branch: track the branch closely instead (not
             # through a singular step, where small steps cannot choose the branch)
+            spent += (k1 - j0) * SUBSTEPS
             tracked = _track(job, j0, k1, q[j0], redundant)
             if tracked is not None:
                 differs = np.nonzero(np.max(np.abs(tracked - q[j0:j0 + len(tracked)]),
                                             axis=1) > 1e-8 * mech.scale())[0]
                 if differs.size:     # the switch happened at step f: go on from there
                     k = j0 + int(differs[0])
+                    spent += len(t) - k
                     part, part_solved, part_system = _resolve(
                         job, k, tracked[differs[0]], redundant)
                     verdict = "better" if part_solved else "worse"
@@ -154,6 +156,26 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
     near = np.nonzero(_spikes(defect) | _with_neighbours(singular))[0]
     _warn_ill_conditioned(job, q, singular, near)
     return q, qd, (qdd if accelerations else None)
+
+
+def _keeps_switching(job: Job, k: int, resolves: int, spent: int) -> SolverError:
+    """The error when following the branch takes more re-solves, or more position solves,
+    than a run allows (the work of a run stays bounded)."""
+    t = job.times
+    if resolves == MAX_RESOLVES:
+        much = f"{resolves} steps solved again already"
+    else:
+        much = (f"solving it again would take {spent:,} position solves, more than "
+                f"{RESOLVE_WORK} times the run")
+    motion = ""
+    if job.motion:
+        name, moved, unit = job.motion
+        motion = (f" '{name}' moves {moved:.3g} {unit} per step (solved in {job.every} "
+                  "sub-steps).")
+    return SolverError(
+        f"at t = {t[k]:.6g} s the mechanism keeps switching branch near singular positions "
+        f"({much}).{motion} Use more steps, so the actuators move less per step, or end the "
+        "interval before this time.", time=float(t[k]), step=k // job.every)
 
 
 def _unwrap(mech, t, q, qd, solved):

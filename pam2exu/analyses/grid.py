@@ -36,7 +36,7 @@ class Plan:
     times:  the solve grid, t_k = k t_end / (steps · every) [s]
     every:  sub-steps per user step (1: the user's grid itself)
     motion: (actuator name, its motion per user step, unit) of the actuator that moves
-            most per step relative to its limit; None without actuators
+            most per step relative to its limit; None without sub-steps
     """
 
     times: np.ndarray
@@ -138,4 +138,4 @@ def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
             f"({len(times):,} solve steps, {columns} columns), more than pam2exu allows "
             f"({limits.MEMORY / 2**30:g} GiB): use fewer steps, or fewer outputs "
             f"(--outputs)"), mech.model.source)
-    return Plan(times, every, (worst[0].name, *worst[1:]) if worst else None)
+    return Plan(times, every, (worst[0].name, *worst[1:]) if every > 1 else None)

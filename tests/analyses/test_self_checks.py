@@ -7,6 +7,7 @@ mutations.
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from pathlib import Path
 
@@ -70,3 +71,23 @@ def test_a_spike_above_its_neighbours_is_a_jump():
     defect = np.full(40, 1e-3)
     defect[20] = 0.02
     assert branch._first_jump(defect, np.zeros(40, dtype=bool), set()) == 20
+
+
+@pytest.mark.filterwarnings("ignore::pam2exu.ConditionWarning")
+def test_following_the_branch_has_bounded_work(monkeypatch):
+    """Re-solving to follow the branch may take at most RESOLVE_WORK times the run's
+    position solves (plus a floor): with no allowance, the first re-solve the parallelogram
+    needs at a change point is refused with a SolverError that says so, instead of
+    re-solving the rest of the run (issue 10: the work of a run, re-solves included, is
+    bounded)."""
+    from test_hard_cases import parallelogram_model
+    model = parallelogram_model(math.pi / 4)
+    res = pam2exu.run(model, analysis="kinematic", t_end=1.0, steps=600)
+    assert res.info["branch_resolves"] >= 1                 # it needs re-solves
+    monkeypatch.setattr(branch, "RESOLVE_WORK", 0)
+    monkeypatch.setattr(branch, "RESOLVE_FLOOR", 0)
+    with pytest.raises(pam2exu.SolverError, match=r"keeps switching branch near singular "
+                                                  r"positions \(solving it again would take "
+                                                  r"[0-9,]+ position solves, more than 0 "
+                                                  r"times the run\)"):
+        pam2exu.run(model, analysis="kinematic", t_end=1.0, steps=600)
