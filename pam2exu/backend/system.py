@@ -12,6 +12,7 @@ the items of each solid and element start.
 """
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +23,7 @@ from exudyn import itemInterface as items
 from ..kinematics import State
 from .symbolic import offset_function
 
+log = logging.getLogger("pam2exu")
 
 #: Exudyn's dense linear solver up to this many coordinates, the sparse one above (measured:
 #: sparse is faster from 27–51 coordinates on, 14× faster at 300; docs/performance.md)
@@ -46,12 +48,50 @@ class SolveSettings:
         Dense linear solver (None: dense up to DENSE_UP_TO coordinates, sparse above).
     verbose : int
         Exudyn's solver output (0: quiet).
+    predictor : bool
+        Start each step's Newton iteration from the quadratic extrapolation of the last
+        three solved steps (``extrapolate``) instead of the previous step's solution: one
+        Newton iteration per step instead of two on smooth motions (docs/performance.md).
+        Not used with redundant constraints, which Exudyn solves with a singular Jacobian:
+        there one iteration from the prediction can stop on the tolerance with a position
+        error of ~5e-12 rad after a change point (the redundant parallelogram), where two
+        from the previous step reach round-off.
     """
 
     tolerance: float = 1e-13
     max_iterations: int = 25
     dense: bool | None = None
     verbose: int = 0
+    predictor: bool = True
+
+
+def extrapolate(q1: np.ndarray, q2: np.ndarray, q3: np.ndarray) -> np.ndarray:
+    """q_k ≈ 3 q_{k−1} − 3 q_{k−2} + q_{k−3}: the parabola through three equally spaced steps, one step on."""
+    return 3.0 * (q1 - q2) + q3
+
+
+class Predictor:
+    """Sets Exudyn's coordinates, before each load step, to ``extrapolate`` of the last three
+    steps solved on the grid.
+
+    Called once per load step with the step's grid index, or None for a step Exudyn made
+    smaller after a failure; the coordinates at a call are the previous step's solution, so
+    only an unbroken run of grid steps k−3, k−2, k−1 feeds the extrapolation.
+    """
+
+    def __init__(self, system_data):
+        self.get, self.set = system_data.GetODE2Coordinates, system_data.SetODE2Coordinates
+        self.last, self.solved = None, []
+
+    def __call__(self, k: int | None) -> None:
+        if k is None or self.last is None or k != self.last + 1:
+            self.solved = []
+        else:
+            self.solved = [*self.solved[-2:], self.get()]
+            if len(self.solved) == 3:
+                q3, q2, q1 = self.solved
+                self.set(extrapolate(q1, q2, q3))
+        self.last = k
 
 
 def solver_options(mech, settings: SolveSettings, redundant: bool,
@@ -136,7 +176,8 @@ class ExudynSystem:
                 centerOfMass=[gx, gy] if forces else [0.0, 0.0])))
         self._markers: dict = {}
         self._ground = None
-        self.drivers: list = []          # (object, parameter, law)
+        self.drivers: list = []          # (object, parameter, law, shift)
+        self.stepped: list = []          # the drivers set by a Python pre-step function
         self.objects: dict[str, list] = {el.name: [] for el in mech.elements}
         for el in mech.elements:
             self.begin(el)
@@ -294,7 +335,7 @@ class ExudynSystem:
         step each, from the start configuration.
 
         Returns (q, n_solved): q has a row per time; when Exudyn stops early, the rows
-        after n_solved are NaN. With ``multipliers``, Exudyn's Lagrange multipliers of
+        after n_solved are NaN. ``self.newton_iterations``: Newton iterations in all. With ``multipliers``, Exudyn's Lagrange multipliers of
         every step are kept in ``self.multipliers`` (n, AE size); in the static solver
         they satisfy f + Cqᵀ λ = 0, f the applied generalized forces.
 
@@ -304,7 +345,7 @@ class ExudynSystem:
         settings = settings or SolveSettings()
         times = np.asarray(times, dtype=float)
         n = len(times)
-        self.error, self.multipliers = None, None
+        self.error, self.multipliers, self.newton_iterations = None, None, 0
         if not self.sensors:                     # every solid is fixed: nothing to solve
             return np.tile(self.mech.initial_q(), (n, 1)), n
         # one time alone (an assembly, a restart at the last step) is step k0 = 1 of a grid
@@ -314,33 +355,44 @@ class ExudynSystem:
         tables = [(obj, par, law, shift, law(times)[0] + shift)
                   for obj, par, law, shift in self.drivers]
         mbs = self.mbs
-        # connector offsets follow their law as compiled symbolic functions; the rest
-        # (a distance, or an Exudyn without symbolic functions) by a Python pre-step function
-        self._symbolic, stepped = [], []
+        # connector offsets follow their law as compiled symbolic functions; a distance
+        # (ObjectConnectorDistance has no user function) by a Python pre-step function, and
+        # so does an offset whose symbolic function Exudyn cannot build (logged: slower)
+        self._symbolic, self.stepped = [], []
         for table in tables:
             obj, par, law, shift, _ = table
+            if par != "offset":
+                self.stepped.append(table)
+                continue
             try:
-                if par != "offset":
-                    raise NotImplementedError(par)
                 function = offset_function(mbs, obj, law, shift, dt)
-            except Exception:
-                stepped.append(table)
+            except Exception as exc:       # Exudyn's symbolic module raises several kinds
+                log.warning("the law %s of Exudyn object %s could not be compiled as a "
+                            "symbolic user function (%s: %s): it is set by a Python "
+                            "pre-step function instead, which is slower",
+                            law.name, obj, type(exc).__name__, exc)
+                self.stepped.append(table)
                 continue
             mbs.SetObjectParameter(obj, "offsetUserFunction", function)
             self._symbolic.append(function)
         if self._symbolic:
             mbs.Assemble()
 
+        predict = (Predictor(mbs.systemData) if settings.predictor and n > 3 and not redundant
+                   else None)
+
         def pre_step(mbs, t):
             tau = t - dt
             k = int(round(tau / dt)) - k0
             on_grid = 0 <= k < n and abs(tau - (k + k0) * dt) <= 1e-6 * dt
-            for obj, par, law, shift, values in stepped:
+            for obj, par, law, shift, values in self.stepped:
                 mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid
                                        else law.value(tau) + shift)
+            if predict is not None:
+                predict(k if on_grid else None)
             return True
 
-        if stepped:
+        if self.stepped or predict is not None:
             mbs.SetPreStepUserFunction(pre_step)
         self.multipliers = None
         if multipliers:
@@ -369,6 +421,8 @@ class ExudynSystem:
             error = exc
         finally:
             exu.config.printToConsole = False
+        solver = mbs.sys.get("staticSolver")      # SolveStatic keeps it (storeSolver=True)
+        self.newton_iterations = int(solver.it.newtonStepsCount) if solver else None
         data = {i: np.asarray(mbs.GetSensorStoredData(s)) for i, s in self.sensors.items()}
         q = np.full((n, self.mech.nq), np.nan)
         first = next(iter(data.values()), None)
