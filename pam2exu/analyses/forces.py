@@ -191,6 +191,42 @@ def multipliers(mech, st: State, rhs: np.ndarray, redundant: bool,
     return np.linalg.solve(B, R[..., None])[..., 0]
 
 
+@dataclass
+class Energies:
+    """Per step: kinetic + potential energy [J], damper dissipation [W], torsor power [W]."""
+
+    energy: np.ndarray
+    dissipation: np.ndarray
+    external: np.ndarray
+
+
+def over_time(mech, t, q, redundant: bool, qd=None, qdd=None):
+    """Every reaction, spring and actuator force at every step: (outputs, Energies or None).
+
+    Cqᵀ λ = Q_inertia − Q_applied per step (kinetostatic, with qd and qdd: inertia and
+    damper terms, and the energies of the power balance); with qdd None, Cqᵀ λ = −Q_applied
+    without damper terms (quasi-static equilibrium, no energies).
+    """
+    n = len(t)
+    dynamic = qdd is not None
+    out: dict[str, np.ndarray] = {}
+    energies = Energies(np.zeros(n), np.zeros(n), np.zeros(n)) if dynamic else None
+    for s in native.chunks(mech, n, sparse=mech.n_equations >= native.SPARSE_FROM):
+        st = State(t[s], q[s], qd[s] if dynamic else None)
+        applied = applied_forces(mech, st, damping=dynamic)
+        rhs = -applied.force
+        if dynamic:
+            inertia, kinetic = inertia_forces(mech, st, qdd[s])
+            rhs += inertia
+            energies.energy[s] = kinetic + applied.potential
+            energies.dissipation[s] = applied.dissipation
+            energies.external[s] = np.sum(applied.external * qd[s], axis=1)
+        lam = multipliers(mech, st, rhs, redundant)
+        for name, v in {**reactions(mech, st, lam), **applied.outputs}.items():
+            out.setdefault(name, np.empty(n))[s] = v
+    return out, energies
+
+
 def _sparse_multipliers(mech, st: State, rhs: np.ndarray):
     """λ with Cqᵀ λ = rhs for all states by one sparse LU (large mechanisms); None if singular."""
     from scipy.sparse.linalg import splu

@@ -5,7 +5,7 @@ import numpy as np
 
 from ..elements import FORCE
 from ..kinematics import State
-from . import forces, native
+from . import forces
 from .branch import motion
 from .common import ConsistencyWarning, Job, check_mobility, collect, warn
 
@@ -27,23 +27,10 @@ def kinetostatic(job: Job):
 
 def inverse_dynamics(job: Job, q, qd, qdd, redundant: bool) -> dict[str, np.ndarray]:
     """Reactions, spring and actuator forces at every step, then the power balance check."""
-    mech, t = job.mech, job.times
-    n = len(t)
     job.stage = "computing the reactions and actuator forces (inverse dynamics)"
-    out: dict[str, np.ndarray] = {}
-    energy, dissipation, external = np.zeros(n), np.zeros(n), np.zeros(n)
-    for s in native.chunks(mech, n, sparse=mech.n_equations >= native.SPARSE_FROM):
-        st = State(t[s], q[s], qd[s])
-        applied = forces.applied_forces(mech, st, damping=True)
-        inertia, kinetic = forces.inertia_forces(mech, st, qdd[s])
-        lam = forces.multipliers(mech, st, inertia - applied.force, redundant)
-        for name, v in {**forces.reactions(mech, st, lam), **applied.outputs}.items():
-            out.setdefault(name, np.empty(n))[s] = v
-        energy[s] = kinetic + applied.potential
-        dissipation[s] = applied.dissipation
-        external[s] = np.sum(applied.external * qd[s], axis=1)
-    power = forces.actuator_power(mech, State(t, q), out)
-    check_power_balance(job, power, energy, dissipation, external)
+    out, e = forces.over_time(job.mech, job.times, q, redundant, qd, qdd)
+    power = forces.actuator_power(job.mech, State(job.times, q), out)
+    check_power_balance(job, power, e.energy, e.dissipation, e.external)
     return out
 
 

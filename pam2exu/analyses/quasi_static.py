@@ -1,4 +1,5 @@
-"""Quasi-static analysis: positions and static equilibrium, by Exudyn's static solver."""
+"""Quasi-static analysis: positions by Exudyn, static equilibrium natively, cross-checked
+against Exudyn's static solver with the forces."""
 from __future__ import annotations
 
 import numpy as np
@@ -11,43 +12,39 @@ from .common import Job, check_mobility, collect, positions, velocities
 
 #: Exudyn's multipliers must satisfy the native equilibrium to this, relative to the forces
 EQUILIBRIUM_TOLERANCE = 1e-9
+#: the steps at which Exudyn's static solver, with the forces, checks the native reactions
+CHECKED_STEPS = 3
 
 
 def quasi_static(job: Job):
     """x, y, fi, f(t), ro, fi_rel, every reaction, spring and actuator force; no rates.
 
-    Contract: Exudyn's static solver, with the masses, gravity, torsors and springs (no
-    damper terms) in the model, gives at each time the configuration and the Lagrange
-    multipliers λ (f + Cqᵀ λ = 0); the reactions are read from λ (``forces.reactions``).
-    The native equilibrium Cqᵀ λ = −Q_applied is checked at every step. With redundant
-    constraints λ is not unique: the reactions are the native minimum-norm solution. A
-    singular (dead-point) position, where the reactions are not defined, is an error.
+    Contract: every degree of freedom is driven, so the configurations do not depend on the
+    forces: they come from Exudyn's static solver on the constraints (as kinematic), and
+    the reactions from the native equilibrium Cqᵀ λ = −Q_applied at every step (gravity,
+    torsors and springs, no damper terms; ``forces.over_time``). Exudyn's static solver
+    with the masses and force elements in the model checks them at ``CHECKED_STEPS`` steps
+    (its multipliers λ, f + Cqᵀ λ = 0, must satisfy the native equilibrium). With
+    redundant constraints λ is not unique: the reactions are the minimum-norm solution and
+    are not checked against Exudyn's. A singular (dead-point) position, where the reactions
+    are not defined, is an error.
     """
     mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
     redundant = mob.redundant > 0
     if FORCE not in job.levels:
         return collect(job, positions(job, redundant))
-    q, system = positions(job, redundant, forces=True, check=False)
+    q = positions(job, redundant, check=False)
     velocities(job, q, redundant)      # raises at a singular position: reactions undefined
-    mech, t = job.mech, job.times
-    order = [i for el in mech.constraints for i in system.ae_rows(el)]
-    lam_exudyn = system.multipliers[:, order]
-    out: dict[str, np.ndarray] = {}
-    worst = 0.0
-    for s in native.chunks(mech, len(t)):
-        st = State(t[s], q[s])
-        applied = forces.applied_forces(mech, st, damping=False)
-        jacobian = native.equations(mech, st).jacobian
-        if redundant:
-            lam = forces.multipliers(mech, st, -applied.force, True, jacobian)
-        else:
-            lam = lam_exudyn[s]
-            worst = max(worst, _equilibrium_error(mech, st, lam, applied.force, jacobian))
-        for name, v in {**forces.reactions(mech, st, lam), **applied.outputs}.items():
-            out.setdefault(name, np.empty(len(t)))[s] = v
-    job.info["reactions_from"] = ("native minimum-norm solve" if redundant
-                                  else "Exudyn's multipliers")
-    if not redundant:
+    job.stage = "computing the reactions (static equilibrium)"
+    out, _ = forces.over_time(job.mech, job.times, q, redundant)
+    if redundant:
+        job.info["reactions_from"] = "native minimum-norm solve"
+    else:
+        rows = checked_steps(len(job.times))
+        job.stage = "checking the reactions with Exudyn's static solver"
+        worst = exudyn_equilibrium_error(job, q, rows)
+        job.info["reactions_from"] = (f"native solve, Exudyn's multipliers agree at "
+                                      f"{len(rows)} steps")
         job.info["equilibrium_error"] = worst
         if worst > EQUILIBRIUM_TOLERANCE:
             raise TranslationError(
@@ -58,7 +55,39 @@ def quasi_static(job: Job):
     return collect(job, q, extra=out)
 
 
-def _equilibrium_error(mech, st, lam, applied, jacobian) -> float:
+def checked_steps(n: int) -> list[int]:
+    """The steps Exudyn's multipliers are checked at: the first, the last and evenly between."""
+    return sorted({int(k) for k in np.linspace(0, n - 1, min(n, CHECKED_STEPS)).round()})
+
+
+def exudyn_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float:
+    """Largest ``equilibrium_error`` of Exudyn's multipliers at the given steps.
+
+    At each step, Exudyn's static solver with the masses and force elements (no dampers)
+    starts from the configuration found and keeps its multipliers.
+    """
+    from ..backend import ExudynSystem, SolveSettings
+    mech, settings = job.mech, job.solver or SolveSettings()
+    worst = 0.0
+    for k in rows:
+        system = ExudynSystem(mech, forces=True, velocity_forces=False, start=q[k])
+        qk, solved = system.solve_positions(job.times[k:k + 1], settings, multipliers=True)
+        if not solved:
+            raise TranslationError(
+                f"internal error: Exudyn's static solver with the forces did not converge at "
+                f"t = {job.times[k]:.6g} s from the configuration found without them: the "
+                f"Exudyn translation is wrong. Please report it with the model file. Exudyn "
+                f"said: {system.error}")
+        order = [i for el in mech.constraints for i in system.ae_rows(el)]
+        st = State(job.times[k:k + 1], qk)
+        applied = forces.applied_forces(mech, st, damping=False)
+        jacobian = native.equations(mech, st).jacobian
+        lam = system.multipliers[:, order]
+        worst = max(worst, equilibrium_error(mech, st, lam, applied.force, jacobian))
+    return worst
+
+
+def equilibrium_error(mech, st, lam, applied, jacobian) -> float:
     """max |Cqᵀ λ + Q_applied| relative to the largest force (moments divided by the length scale)."""
     per_length = np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
     residual = forces.equilibrium_residual(mech, st, lam, -applied, jacobian) * per_length
