@@ -731,33 +731,65 @@ def chain(plan):
 
 
 class AgainstPlain:
-    """Section 2: pam2exu (kinematic, kinetostatic) against the two plain Exudyn variants,
-    four-bar, default tolerance. ``round()`` times every configuration once, in
-    alternation; the rounds are spread over the whole benchmark (between its sections), so
-    that a slow spell of the machine spoils one round, not the comparison. ``rows()``: the
-    best of all rounds, with Newton iterations per step and the plain script's error."""
+    """Section 2: pam2exu against the two plain Exudyn variants, four-bar, default
+    tolerance. pam2exu runs: kinematic with only the solids' x, y, fi (*positions*, with
+    and without the predictor), kinematic and kinetostatic with every output, kinematic
+    with every output written to CSV, and quasi-static with every output. ``round()``
+    times every configuration once, in alternation; the rounds are spread over the whole
+    benchmark (between its sections), so that a slow spell of the machine spoils one
+    round, not the comparison. ``rows()``: the best of all rounds, with Newton iterations
+    per step (plain script, pam2exu with and without predictor) and the plain script's
+    error."""
 
-    KEYS = ("kinematic", "kinetostatic", "prestep", "symbolic")
+    PAM = {"positions": ("kinematic", ["x", "y", "fi"], True, False),
+           "positions_no_predictor": ("kinematic", ["x", "y", "fi"], False, False),
+           "kinematic": ("kinematic", None, True, False),
+           "kinematic_csv": ("kinematic", None, True, True),
+           "quasi_static": ("quasi_static", None, True, False),
+           "kinetostatic": ("kinetostatic", None, True, False)}
+    KEYS = (*PAM, "prestep", "symbolic")
 
     def __init__(self, plan):
         self.plan = plan
         self.model, self.reference, _, _ = four_bar_case()
         self.best = {n: {k: (math.inf, None) for k in self.KEYS} for n in plan.compare_steps}
         self.rounds = 0
+        self.scratch = Path(tempfile.mkdtemp(prefix="pam2exu-bench-csv-"))
+
+    def pam(self, key, steps):
+        """(wall seconds, Exudyn seconds) of one pam2exu run of configuration ``key``."""
+        analysis, outputs, predictor, csv = self.PAM[key]
+        start = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = pam2exu.run(self.model, analysis=analysis, steps=steps, outputs=outputs,
+                              solver=SolveSettings(predictor=predictor))
+        if csv:
+            res.to_csv(self.scratch / "four_bar.csv")
+        return time.perf_counter() - start, res.info["exudyn_seconds"]
 
     def round(self):
         self.rounds += 1
         for steps, best in self.best.items():
             if steps >= 100000 and self.rounds > self.plan.big_repeats:
                 continue
-            for analysis in ("kinematic", "kinetostatic"):
-                seconds, res, _ = run_pam(self.model, analysis, steps, 1.0, DEFAULT_TOLERANCE, 1)
-                if seconds < best[analysis][0]:
-                    best[analysis] = (seconds, res.info["exudyn_seconds"])
+            for key in self.PAM:
+                seconds, exudyn_seconds = self.pam(key, steps)
+                if seconds < best[key][0]:
+                    best[key] = (seconds, exudyn_seconds)
             for driver in ("prestep", "symbolic"):
                 _, total, solve, _ = plain_exudyn_four_bar(steps, DEFAULT_TOLERANCE, driver)
                 if total < best[driver][0]:
                     best[driver] = (total, solve)
+
+    def pam_iterations(self, steps, predictor):
+        """Newton iterations per step of pam2exu's position solve (Exudyn's counter)."""
+        from pam2exu.analyses.common import prepare
+        from pam2exu.backend import ExudynSystem
+        job = prepare(self.model, analysis="kinematic", steps=steps)
+        system = ExudynSystem(job.mech)
+        system.solve_positions(job.times, SolveSettings(predictor=predictor))
+        return system.newton_iterations / len(job.times)
 
     def rows(self):
         rows = []
@@ -770,13 +802,18 @@ class AgainstPlain:
             plain_err = max(float(np.max(np.abs(q[:, 3 * i + 2] - kin[f"{s}.fi"])))
                             for i, s in enumerate(("crank", "coupler", "rocker")))
             rows.append({"steps": steps, "iterations": iterations, "jacobians": jacobians,
+                         "pam_iterations": self.pam_iterations(steps, True),
+                         "pam_iterations_no_predictor": self.pam_iterations(steps, False),
                          "plain_angle_error": plain_err, **best})
             us = {k: 1e6 * v[0] / steps for k, v in best.items()}
-            log(f"  {steps:6d} steps: pam2exu kinematic {us['kinematic']:.1f} µs/step (Exudyn "
-                f"{1e6 * best['kinematic'][1] / steps:.1f}), kinetostatic "
-                f"{us['kinetostatic']:.1f}; plain pre-step {us['prestep']:.1f} (solve "
-                f"{1e6 * best['prestep'][1] / steps:.1f}), symbolic {us['symbolic']:.1f} "
-                f"(solve {1e6 * best['symbolic'][1] / steps:.1f}); Newton {iterations:.2f} it/step")
+            log(f"  {steps:6d} steps: pam2exu positions {us['positions']:.1f} µs/step "
+                f"(no predictor {us['positions_no_predictor']:.1f}), kinematic "
+                f"{us['kinematic']:.1f} (Exudyn {1e6 * best['kinematic'][1] / steps:.1f}; "
+                f"with CSV {us['kinematic_csv']:.1f}), quasi-static {us['quasi_static']:.1f}, "
+                f"kinetostatic {us['kinetostatic']:.1f}; plain pre-step {us['prestep']:.1f} "
+                f"(solve {1e6 * best['prestep'][1] / steps:.1f}), symbolic "
+                f"{us['symbolic']:.1f} (solve {1e6 * best['symbolic'][1] / steps:.1f}); Newton "
+                f"{iterations:.2f} it/step plain, {rows[-1]['pam_iterations']:.2f} pam2exu")
         return rows
 
 
@@ -1032,6 +1069,21 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         e, where = worst.get(kind, (float("nan"), "–"))
         trows.append([f"{kind}, worst relative error at default settings", f"≤ {target:.0e}",
                       f"{e:.1e} ({where})", verdict(e, target)])
+    pos_us = 1e6 * cmp10["positions"][0] / s
+    csv_us = 1e6 * cmp10["kinematic_csv"][0] / s
+    qs_us = 1e6 * cmp10["quasi_static"][0] / s
+    for label, value, goal in (
+            ("kinematic four-bar, positions only (x, y, fi) / plain Exudyn (symbolic driver)",
+             pos_us, 1.0),
+            ("kinematic four-bar, every output / plain Exudyn (symbolic driver)", kin_us, 1.5),
+            ("kinematic four-bar, every output written to CSV / plain Exudyn (symbolic "
+             "driver)", csv_us, 1.7)):
+        ratio = value / sym_us
+        trows.append([label, f"≤ {goal:.1f}×", f"{ratio:.2f}× ({value:.1f} / {sym_us:.1f} µs)",
+                      verdict(ratio, goal)])
+    trows.append(["quasi-static four-bar (every output) / kinematic (every output)", "≤ 1.2×",
+                  f"{qs_us / kin_us:.2f}× ({qs_us:.1f} / {kin_us:.1f} µs)",
+                  verdict(qs_us / kin_us, 1.2)])
     add(table(["target", "goal", "measured", "verdict"], trows))
     add("")
 
@@ -1050,16 +1102,27 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         f"Jacobian: {cmp10['jacobians']:.2f} Jacobians per step "
         "(`solver.it.newtonJacobiCount`; full Newton, `useModifiedNewton = False`).")
     add(f"- A least-squares fit over the grid below splits the plain solve into "
-        f"{per_step:.1f} µs per step plus {per_it:.1f} µs per Newton iteration. So the "
-        f"{s:,}-step solve cannot go below about {per_step + per_it:.0f} µs/step with one "
-        "iteration per step. Exudyn's static solver starts each load step from the previous "
-        "step's solution (its settings offer no predictor), so one iteration suffices only "
+        f"{per_step:.1f} µs per step plus {per_it:.1f} µs per Newton iteration. Exudyn's "
+        "static solver starts each load step from the previous step's solution (its "
+        "settings offer no predictor), so in the plain script one iteration suffices only "
         "when the motion per step is small enough for a single Newton update to reach the "
         "tolerance"
         + (": in this grid " + ", ".join(f"{r['steps']:,} steps at {r['tolerance']:.0e}"
                                          for r in ns_rows if r["iterations"] < 1.05)
            if any(r["iterations"] < 1.05 for r in ns_rows) else "")
         + ".")
+    pos_off_us = 1e6 * cmp10["positions_no_predictor"][0] / s
+    add(f"- **The predictor.** pam2exu sets Exudyn's coordinates before each load step to "
+        "the parabola through the last three steps (`SolveSettings.predictor`, a Python "
+        "pre-step function): Newton then takes "
+        + ", ".join(f"{r['pam_iterations']:.2f} iterations per step at {r['steps']:,} steps "
+                    f"(without it {r['pam_iterations_no_predictor']:.2f})" for r in plain_rows)
+        + f". At {s:,} steps the positions-only run takes {pos_us:.1f} µs/step with it and "
+        f"{pos_off_us:.1f} without: it pays "
+        + ("wherever the plain solve needs more than one iteration per step (the pre-step "
+           "call costs less than an iteration)" if pos_us < pos_off_us else
+           "nothing here")
+        + "; it is off for redundant mechanisms (docs/analyses.md).")
     add(f"- pam2exu's own Exudyn part ({kin_exu:.1f} µs/step) is within "
         f"{kin_exu / sym_us:.2f}× of the whole plain script; the rest is pam2exu's native "
         f"pass ({kin_us - kin_exu:.1f} µs/step kinematic, {dyn_us - dyn_exu:.1f} µs/step "
@@ -1143,17 +1206,27 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
 
         def us(v, st=st):
             return f"{1e6 * v / st:.1f}"
-        rows.append([f"{st:,}", us(r["kinematic"][0]), us(r["kinematic"][1]),
-                     us(r["kinetostatic"][0]), f"{us(r['prestep'][0])} / {us(r['prestep'][1])}",
+        rows.append([f"{st:,}", us(r["positions"][0]), us(r["positions_no_predictor"][0]),
+                     us(r["kinematic"][0]), us(r["kinematic"][1]), us(r["kinematic_csv"][0]),
+                     us(r["quasi_static"][0]), us(r["kinetostatic"][0]),
+                     f"{us(r['prestep'][0])} / {us(r['prestep'][1])}",
                      f"{us(r['symbolic'][0])} / {us(r['symbolic'][1])}",
+                     f"{r['positions'][0] / r['symbolic'][0]:.2f}×",
                      f"{r['kinematic'][0] / r['symbolic'][0]:.2f}×",
-                     f"{r['kinematic'][0] / r['prestep'][0]:.2f}×",
+                     f"{r['kinematic_csv'][0] / r['symbolic'][0]:.2f}×",
+                     f"{r['pam_iterations']:.2f} / {r['pam_iterations_no_predictor']:.2f} / "
                      f"{r['iterations']:.2f}", f"{r['plain_angle_error']:.0e}"])
-    add(table(["steps", "pam2exu kinematic µs/step", "of which Exudyn",
-               "pam2exu kinetostatic", "plain, pre-step: total / solve",
-               "plain, symbolic: total / solve", "kinematic / plain symbolic",
-               "kinematic / plain pre-step", "Newton it./step", "plain: max angle error, rad"],
-              rows))
+    add(table(["steps", "pam2exu positions µs/step", "positions, no predictor",
+               "kinematic, every output", "of which Exudyn", "kinematic + CSV",
+               "quasi-static", "kinetostatic", "plain, pre-step: total / solve",
+               "plain, symbolic: total / solve", "positions / plain symbolic",
+               "kinematic / plain symbolic", "kinematic + CSV / plain symbolic",
+               "Newton it./step: pam2exu / no predictor / plain",
+               "plain: max angle error, rad"], rows))
+    add("")
+    add("*Positions*: kinematic with `outputs=[\"x\", \"y\", \"fi\"]` (no rates are computed); "
+        "*kinematic + CSV*: every output, then `Results.to_csv`; *quasi-static* and "
+        "*kinetostatic*: every output.")
     add("")
     largest = plain_rows[-1]
     pam_err = next((r.errors["positions"][0] for r in grid
