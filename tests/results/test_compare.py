@@ -63,6 +63,17 @@ def test_known_difference_max_error_where_and_rule(tmp_path):
     assert not compare(res, ref, rtol=0.999e-6, atol=0.0, columns=["a.x"]).passed
 
 
+def test_identical_tables_pass_at_zero_tolerance(tmp_path):
+    """The rule is max error ≤ tolerance, equality included: a table against itself passes
+    at rtol = atol = 0 (kills the mutant ``worst < tol``)."""
+    t = np.linspace(0.0, 1.0, 11)
+    res = Results(t, {"a.x": np.sin(W * t), "a.y": 0 * t})
+    c = compare(res, res, rtol=0, atol=0)
+    assert c.passed and [(r.max_abs_error, r.tolerance) for r in c.rows] == [(0, 0), (0, 0)]
+    path = write(tmp_path / "a.csv", t, {"a.x": np.sin(W * t)})
+    assert main(["compare", str(path), str(path), "--rtol", "0", "--atol", "0"]) == 0
+
+
 def test_abs_error_of_non_finite_values():
     """Both nan or the same infinity: equal; nan or inf on one side only: infinite error."""
     r = np.array([1.0, np.nan, np.inf, np.nan, 2.0, np.inf])
