@@ -84,6 +84,9 @@ def _parser() -> argparse.ArgumentParser:
                       help="md: Markdown table (default); csv: CSV on stdout, notes on stderr")
     comp.add_argument("--interp", choices=["cubic", "linear"], default="cubic",
                       help="interpolation of the result when the times differ (default cubic)")
+    comp.add_argument("--wrap-angles", action="store_true",
+                      help="compare angles (rad) modulo 2π, for exports whose angles wrap at "
+                           "±π (PAM's)")
 
     exp = sub.add_parser(
         "export", help="write a standalone Exudyn script of the model (positions to CSV)",
@@ -251,7 +254,8 @@ def _compare(args) -> int:
     from .results.compare import CompareInputError, compare
     try:
         table = compare(args.result, args.reference, rtol=args.rtol, atol=args.atol,
-                        columns=args.columns, names=args.names, method=args.interp)
+                        columns=args.columns, names=args.names, method=args.interp,
+                        wrap_angles=args.wrap_angles)
     except CompareInputError as exc:
         if args.debug:
             raise

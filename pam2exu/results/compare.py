@@ -6,9 +6,11 @@ For every variable in both tables, over the reference rows compared:
     scale      = max_k |reference(t_k)|
     passes when  max_k error(t_k) <= atol + rtol * scale
 
-Rows are matched by ``t``. When the two tables have different times, the result is
+Rows are matched by ``t``, to the precision each file's time column carries (a time written
+0.00277778 matches 1/360). When the two tables have different times, the result is
 interpolated onto the reference times (cubic spline by default) inside the result's time
-interval; reference rows outside it are counted and left out. Column names are brought to
+interval; reference rows outside it are counted and left out. With ``wrap_angles``, angles
+[rad] are compared modulo 2π (exports that wrap them at ±π). Column names are brought to
 pam2exu's spelling first: the reference's by a names map (PAM name -> pam2exu name), then
 both tables' by ``SPELLINGS``.
 The user guide is docs/compare.md.
@@ -18,6 +20,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import re
 import unicodedata
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -63,13 +66,15 @@ class VariableComparison:
         The variable (pam2exu's spelling).
     max_abs_error : float
         max_k |result(t_k) − reference(t_k)| [unit]; inf when one table only has a
-        non-finite value at some t_k.
+        non-finite value at some t_k. For an angle compared modulo 2π, the difference is
+        first reduced to (−π, π].
     max_rel_error : float
         max_abs_error / scale [–]; nan when scale == 0.
     t_at_max : float
         First reference time of the maximum [s]; nan when there is no error.
     scale : float
-        max_k |reference(t_k)| over its finite values [unit].
+        max_k |reference(t_k)| over its finite values [unit]; π for an angle compared
+        modulo 2π (the largest difference on the circle).
     tolerance : float
         atol + rtol · scale [unit].
     passed : bool
@@ -124,7 +129,15 @@ class Comparison:
         The time interval compared [s].
     notes : list of str
         What was done to read the tables: renamed columns, separators, encodings, unused
-        names-map entries.
+        names-map entries, angles not wrapped.
+    time_digits : str
+        When the rows were matched to the precision a file's times carry (not to float
+        round-off): what they carry, e.g. ``'6 significant digits the reference carries'``;
+        else ''.
+    time_difference : float
+        max |t_result − t_reference| over the rows matched [s]; 0 when interpolated.
+    wrapped : list of str
+        The angles [rad] compared modulo 2π (``wrap_angles=True``).
 
     Examples
     --------
@@ -151,6 +164,9 @@ class Comparison:
     method: str | None                  # interpolation method, None when the times are equal
     overlap: tuple[float, float]        # [s]
     notes: list[str] = field(default_factory=list)
+    time_digits: str = ""               # what the times carry when matched to it
+    time_difference: float = 0.0        # max |t_result - t_reference| of the rows matched [s]
+    wrapped: list[str] = field(default_factory=list)    # angles compared modulo 2π
 
     @property
     def passed(self) -> bool:
@@ -181,10 +197,15 @@ class Comparison:
         -------
         list of str
             One line each: the result, the reference, how the times were matched, the
-            pass rule with rtol and atol, then the ``notes``.
+            pass rule with rtol and atol, the angles compared modulo 2π, then the ``notes``.
         """
         lo, hi = self.overlap
-        if self.method is None:
+        if self.method is None and self.time_digits:
+            times = (f"times matched row by row to the {self.time_digits}: the same "
+                     f"{self.reference_rows} times to within half a unit of the last digit "
+                     f"(largest difference {self.time_difference:.3g} s; "
+                     f"t = {lo:g} … {hi:g} s)")
+        elif self.method is None:
             times = (f"times: the same {self.reference_rows} times in both, "
                      f"compared row by row (t = {lo:g} … {hi:g} s)")
         else:
@@ -199,6 +220,8 @@ class Comparison:
                 times,
                 (f"rule: a variable passes when max |result − reference| ≤ atol + rtol·scale, "
                  f"scale = max |reference| (rtol = {self.rtol:g}, atol = {self.atol:g})"),
+                *([f"angles compared modulo 2π (the difference reduced to (−π, π], scale π): "
+                   f"{_listing(self.wrapped)}"] if self.wrapped else []),
                 *self.notes]
 
     def verdict(self) -> str:
@@ -398,6 +421,121 @@ def interpolation_error(t: np.ndarray, values: np.ndarray, t_new: np.ndarray,
     return diff.max(axis=1) / (2 ** order - 1)
 
 
+_NUMBER = re.compile(r"[+-]?(\d*)(?:\.(\d*))?(?:[eE]([+-]?\d+))?")
+
+
+def written_precision(cells) -> tuple[np.ndarray, str]:
+    """Half a unit of the last digit each time of a column carries, from its text.
+
+    A writer that drops trailing zeros (``%g``, PAM's 6 significant digits) writes 0.01 for
+    0.0100000: every time then carries the most significant digits any time of the column
+    shows, d, and its precision is half a unit of its d-th significant digit (0 for a time
+    written 0). A writer that keeps them (every time with the same number of decimals, some
+    ending in 0: ``%.4f``) gives each time half a unit of its own last digit.
+
+    Parameters
+    ----------
+    cells : list of str
+        The time column as written ('.' as decimal mark), one cell per row.
+
+    Returns
+    -------
+    precision : numpy.ndarray
+        Half a unit of the last digit each time carries [s]; 0 for a cell that is not a
+        plain number (``nan``, empty).
+    digits : str
+        What the column carries: ``'6 significant digits'`` or ``'4 decimals'``; '' when no
+        cell is a number.
+
+    Examples
+    --------
+    >>> p, digits = written_precision(["0", "0.00277778", "0.5", "1", "100"])
+    >>> digits, [float(f"{x:.3g}") for x in p]
+    ('6 significant digits', [0.0, 5e-09, 5e-07, 5e-06, 0.0005])
+    >>> written_precision(["0.000", "0.250", "1.125"])[1]
+    '3 decimals'
+    """
+    parsed = []                    # (digits after the point, place of the first and last digit)
+    for cell in cells:
+        m = _NUMBER.fullmatch(cell.strip())
+        whole, frac = (m.group(1), m.group(2) or "") if m else ("", "")
+        if not whole + frac:
+            parsed.append(None)
+            continue
+        exponent, digits = int(m.group(3) or 0), whole + frac
+        lead = len(digits) - len(digits.lstrip("0"))           # leading zeros
+        first = exponent + len(whole) - 1 - lead if lead < len(digits) else None  # None: 0
+        parsed.append((frac, first, exponent - len(frac)))
+    numbers = [q for q in parsed if q is not None]
+    if not numbers:
+        return np.zeros(len(parsed)), ""
+    decimals = {len(frac) for frac, _, _ in numbers}
+    zeros_kept = len(decimals) == 1 and decimals != {0} \
+        and any(frac.endswith("0") for frac, _, _ in numbers)
+    if zeros_kept:                                   # each time its own last digit
+        places = [q[2] if q else None for q in parsed]
+        n = decimals.pop()
+        digits = f"{n + 1} significant digits" if any("e" in c.lower() for c in cells) \
+            else f"{n} decimal{'s' * (n > 1)}"
+    else:                                            # every time d significant digits
+        d = max((first - last + 1 for _, first, last in numbers if first is not None),
+                default=1)
+        places = [q[1] - d + 1 if q and q[1] is not None else None for q in parsed]
+        digits = f"{d} significant digit{'s' * (d > 1)}"
+    precision = np.array([0.0 if k is None else 0.5 * 10.0 ** k for k in places])
+    return precision, digits
+
+
+def times_match(t: np.ndarray, precision: np.ndarray, t_ref: np.ndarray,
+                precision_ref: np.ndarray) -> bool:
+    """Whether two time grids are the same to the precision each carries (rows matched 1:1).
+
+    Row k matches when |t_k − t_ref,k| ≤ precision_k + precision_ref,k + 4 ε max |t_ref|
+    (the two intervals the written times stand for overlap, ε the float's epsilon), and the
+    pairing is unambiguous: the intervals of neighbouring rows do not overlap.
+
+    Parameters
+    ----------
+    t, t_ref : numpy.ndarray
+        The times of the result and of the reference [s].
+    precision, precision_ref : numpy.ndarray
+        Half a unit of the last digit each time carries [s] (``written_precision``); 0 for
+        times held as floats.
+
+    Returns
+    -------
+    bool
+        True when the grids have the same number of rows and every row matches.
+
+    Examples
+    --------
+    >>> t = np.arange(4) / 360                    # 0, 0.00277778, 0.00555556, 0.00833333
+    >>> six = np.array([float(f"{x:.6g}") for x in t])
+    >>> p = written_precision([f"{x:.6g}" for x in t])[0]
+    >>> times_match(t, 0 * t, six, p), times_match(t, 0 * t, six, 0 * p)
+    (True, False)
+    """
+    if t.shape != t_ref.shape:
+        return False
+    floor = 4 * np.finfo(float).eps * max(float(np.max(np.abs(t_ref), initial=0.0)), 1e-300)
+    tol = precision + precision_ref + floor
+    if not np.all(np.abs(t - t_ref) <= tol):
+        return False
+    reach = tol[:-1] + tol[1:]                   # neighbouring intervals must stay apart
+    return bool(np.all(reach < np.abs(np.diff(t))) and np.all(reach < np.abs(np.diff(t_ref))))
+
+
+def angle_error(result: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """|result − reference| of angles modulo 2π: the difference reduced to (−π, π], then its
+    magnitude [rad], in [0, π]; non-finite values as in ``abs_error``."""
+    err = abs_error(result, reference)
+    finite = np.isfinite(err) & (err > 0)
+    with np.errstate(invalid="ignore"):
+        diff = result[finite] - reference[finite]
+    err[finite] = np.abs(np.pi - np.mod(np.pi - diff, 2 * np.pi))
+    return err
+
+
 # --- reading -------------------------------------------------------------------------------
 
 @dataclass
@@ -411,6 +549,16 @@ class _Table:
     units: dict[str, str]
     notes: list[str]
     used_keys: set[str]
+    t_text: tuple[str, list[str], int] | None = None   # (separator, lines, column of t)
+
+
+def _time_precision(table: _Table) -> tuple[np.ndarray, str]:
+    """Half a unit of the last digit each time carries [s], and what the times carry, from
+    the text of the time column (``written_precision``); zeros for a Results table."""
+    if table.t_text is None:
+        return np.zeros(len(table.t)), ""
+    delimiter, lines, j = table.t_text
+    return written_precision(_cells((delimiter, lines), j))
 
 
 def read_names(path: str | Path) -> dict[str, str]:
@@ -489,8 +637,10 @@ def _lines(text: str) -> list[tuple[int, str]]:
             if line.strip() and not line.lstrip().startswith("#")]
 
 
-def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str]]:
-    """Column names, values (columns × rows) and notes of a result CSV file.
+def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str],
+                                              tuple[str, list[str]]]:
+    """Column names, values (columns × rows), notes, and (separator, lines of values) of a
+    result CSV file, the lines for ``_cells``.
 
     Separator ';' or tab when the header line has one, else ','; with ';' or tab a ',' inside
     a number is a decimal comma. Empty cells are nan.
@@ -516,7 +666,7 @@ def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str]]:
         values = np.loadtxt(io.StringIO(body if delimiter == "," else body.replace(",", ".")),
                             delimiter=delimiter, ndmin=2, dtype=float, comments=None)
         if values.shape[1] == len(header):
-            return header, values.T, notes
+            return header, values.T, notes, (delimiter, [line for _, line in lines[1:]])
     except ValueError:
         pass
     rows = list(csv.reader([line for _, line in lines[1:]], delimiter=delimiter))
@@ -545,7 +695,15 @@ def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str]]:
                         f"{path}, line {number}, column '{header[j]}': '{rows[k][j].strip()}'"
                         f" is not a number; fix the value (an empty cell is read as missing)"
                     ) from None
-    return header, values.T, notes
+    return header, values.T, notes, (delimiter, [line for _, line in lines[1:]])
+
+
+def _cells(body: tuple[str, list[str]], j: int) -> list[str]:
+    """The text of column j on each line of values ('.' as decimal mark)."""
+    delimiter, lines = body
+    cells = [row[j].strip() if j < len(row) else "" for row in csv.reader(lines,
+                                                                         delimiter=delimiter)]
+    return cells if delimiter == "," else [c.replace(",", ".") for c in cells]
 
 
 def _load(source, role: str, names: dict[str, str]) -> _Table:
@@ -554,10 +712,10 @@ def _load(source, role: str, names: dict[str, str]) -> _Table:
         label = f"'{source.model}' {source.analysis} results" if source.model \
             else "Results table"
         raw = ["t", *source.columns]
-        data, units, notes = source.to_numpy().T, dict(source.units), []
+        data, units, notes, body = source.to_numpy().T, dict(source.units), [], None
     elif isinstance(source, (str, Path)):
         label = str(source)
-        raw, data, notes = _read_csv(Path(source), role)
+        raw, data, notes, body = _read_csv(Path(source), role)
         units = {}
     else:
         raise CompareInputError(f"the {role} must be a CSV file path or a Results table, "
@@ -588,7 +746,7 @@ def _load(source, role: str, names: dict[str, str]) -> _Table:
     if renamed:
         notes.append(f"{role}: {len(renamed)} columns renamed: {_listing(renamed)}")
     return _Table(label, np.asarray(data[it], dtype=float), [new_names[j] for j in keep],
-                  data[keep], units, notes, used)
+                  data[keep], units, notes, used, None if body is None else (*body, it))
 
 
 def _spellings() -> str:
@@ -622,6 +780,43 @@ def _same_times(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.all(np.abs(a - b) <= tol))
 
 
+def _angles(names: list[str], res: _Table, ref: _Table) -> tuple[list[str], list[str]]:
+    """The columns among ``names`` that are angles [rad], and those that may be one but whose
+    unit neither table tells (``f(t)`` of an actuator of unknown type, in two CSV files)."""
+    from .units import declared_units, unit_of
+    columns = res.names + ref.names
+    angles, unknown = [], []
+    for name in names:
+        unit = (res.units.get(name) or ref.units.get(name) or unit_of(name)
+                or _unit_among(name, columns))
+        if unit == "rad":
+            angles.append(name)
+        elif not unit and "rad" in declared_units().get(name.rpartition(".")[2], ()):
+            unknown.append(name)
+    return angles, unknown
+
+
+def _unit_among(column: str, columns: list[str]) -> str:
+    """The unit of ``column`` declared by every element type whose outputs include all the
+    variables its owner has in ``columns`` ('' when none or several): ``motor.f(t)`` next to
+    ``motor.Mz`` is an angular actuator's, in rad."""
+    from ..elements import ELEMENTS
+    owner, _, variable = column.rpartition(".")
+    present = {c.rpartition(".")[2] for c in columns if c.rpartition(".")[0] == owner}
+    units = {v.unit for cls in ELEMENTS.values()
+             if present <= {o.name for o in cls.outputs}
+             for v in cls.outputs if v.name == variable}
+    return units.pop() if len(units) == 1 else ""
+
+
+def _carried(res: tuple[np.ndarray, str], ref: tuple[np.ndarray, str], floor: float) -> str:
+    """'6 significant digits the reference carries': what the times coarser than ``floor``
+    [s] carry, from the (precision, digits) of each table, for the header."""
+    sides = [f"{digits} the {role} carries" for role, (precision, digits) in
+             (("result", res), ("reference", ref)) if digits and np.any(precision > floor)]
+    return " and the ".join(sides) or "digits the files carry"
+
+
 def _choose(res: _Table, ref: _Table, columns) -> tuple[list[str], list[str], list[str]]:
     """Common columns (result order), and those of one table only, restricted to ``columns``."""
     union = res.names + [c for c in ref.names if c not in set(res.names)]
@@ -652,13 +847,15 @@ def _choose(res: _Table, ref: _Table, columns) -> tuple[list[str], list[str], li
 
 
 def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=None,
-            names=None, method: str = "cubic") -> Comparison:
+            names=None, method: str = "cubic", wrap_angles: bool = False) -> Comparison:
     """Compare ``result`` with ``reference`` variable by variable.
 
-    Rows are matched by ``t``. When the times differ, the result is interpolated onto the
-    reference times inside the result's interval (reference rows outside it are not
-    compared) and the interpolation's own error is estimated. ``pam2exu compare`` calls
-    this function; the user guide is docs/compare.md.
+    Rows are matched by ``t``, to the precision each file's times carry: a time written with
+    d significant digits matches one within half a unit of its last digit
+    (``written_precision``, ``times_match``). When the times differ, the result is
+    interpolated onto the reference times inside the result's interval (reference rows
+    outside it are not compared) and the interpolation's own error is estimated.
+    ``pam2exu compare`` calls this function; the user guide is docs/compare.md.
 
     Parameters
     ----------
@@ -679,6 +876,11 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
     method : str
         ``cubic`` (not-a-knot spline) or ``linear``: how the result is interpolated onto the
         reference times when the times differ.
+    wrap_angles : bool
+        Compare angles (unit rad: ``fi``, ``fi_rel``, an angular actuator's ``f(t)``)
+        modulo 2π, for exports that wrap them at ±π: the difference is reduced to (−π, π]
+        before its magnitude is taken, and the scale is π. An interpolated result is
+        unwrapped first.
 
     Returns
     -------
@@ -691,7 +893,8 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
     CompareInputError
         A file is missing or unreadable, has no ``t``, the tables have nothing in common or
         their times do not overlap, a ``columns`` pattern matches nothing, ``rtol`` or
-        ``atol`` is not a number ≥ 0, or ``method`` is unknown.
+        ``atol`` is not a number ≥ 0, ``method`` is unknown, or ``wrap_angles`` is not a
+        bool.
 
     Examples
     --------
@@ -713,6 +916,8 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
     if method not in METHODS:
         raise CompareInputError(f"`method` must be one of {', '.join(METHODS)}, not "
                                 f"{method!r}{closest(method, METHODS)}")
+    if not isinstance(wrap_angles, bool):
+        raise CompareInputError(f"`wrap_angles` must be True or False, not {wrap_angles!r}")
     names_map = _names_map(names)
     res = _load(result, "result", {})              # the map is for the reference's names
     ref = _load(reference, "reference", names_map)
@@ -723,15 +928,27 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
     unused = sorted(set(names_map) - ref.used_keys)
     if unused:
         notes.append(f"names map: no column matched {_listing(unused)}")
+    wrapped, unknown = _angles(common, res, ref) if wrap_angles else ([], [])
+    if unknown:
+        notes.append(f"not compared modulo 2π (angle or length: neither file tells which "
+                     f"actuator it is): {_listing(unknown)}")
+    angle = np.array([name in wrapped for name in common], dtype=bool)
 
     same = _same_times(res.t, ref.t)
+    written = None if same else (_time_precision(res), _time_precision(ref))
+    matched = same or times_match(res.t, written[0][0], ref.t, written[1][0])
     _check_times(ref, need_increasing=False)
-    _check_times(res, need_increasing=not same)
-    if same:
+    _check_times(res, need_increasing=not matched)
+    digits, dt = "", 0.0
+    if matched:
         inside = np.ones(len(ref.t), dtype=bool)
         values = res.values[ir]
         interp_err = np.full(len(common), np.nan)
         overlap = (float(ref.t.min(initial=0)), float(ref.t.max(initial=0)))
+        if not same:
+            floor = 4 * np.finfo(float).eps * float(np.max(np.abs(ref.t), initial=0.0))
+            digits = _carried(*written, floor)
+            dt = float(np.max(np.abs(res.t - ref.t)))
     else:
         lo, hi = float(res.t[0]), float(res.t[-1])
         slack = 1e-9 * max(hi - lo, abs(lo), abs(hi))
@@ -741,16 +958,21 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
                 f"the times do not overlap: result {res.label} has t = {lo:g} … {hi:g} s, "
                 f"reference {ref.label} t = {ref.t.min():g} … {ref.t.max():g} s; compare "
                 f"files of the same interval (pam2exu run --t-end)")
-        values = interpolate(res.t, res.values[ir], ref.t[inside], method)
-        interp_err = interpolation_error(res.t, res.values[ir], ref.t[inside], method)
+        source = res.values[ir]
+        smooth = angle & np.all(np.isfinite(source), axis=1)
+        if smooth.any():                   # an angle that wraps at ±π is not smooth
+            source = source.copy()
+            source[smooth] = np.unwrap(source[smooth], axis=1)
+        values = interpolate(res.t, source, ref.t[inside], method)
+        interp_err = interpolation_error(res.t, source, ref.t[inside], method)
         overlap = (lo, hi)
     t_ref = ref.t[inside]
     rows = []
     for k, (name, j) in enumerate(zip(common, jr)):
         target = ref.values[j][inside]
-        err = abs_error(values[k], target)
+        err = (angle_error if angle[k] else abs_error)(values[k], target)
         at = int(np.argmax(err))
-        worst, scale = float(err[at]), scale_of(target)
+        worst, scale = float(err[at]), math.pi if angle[k] else scale_of(target)
         tol = tolerance(scale, rtol, atol)
         rows.append(VariableComparison(
             name=name, max_abs_error=worst,
@@ -760,5 +982,5 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
             interpolation_error=float(interp_err[k]),
             unit=res.units.get(name) or ref.units.get(name) or ""))
     return Comparison(rows, only_res, only_ref, res.label, ref.label, float(rtol), float(atol),
-                      len(res.t), len(ref.t), int(inside.sum()), None if same else method,
-                      overlap, notes)
+                      len(res.t), len(ref.t), int(inside.sum()), None if matched else method,
+                      overlap, notes, digits, dt, wrapped)

@@ -1,8 +1,10 @@
 """``pam2exu compare``: errors and where they occur against known differences, the pass rule,
-interpolation between different time grids against textbook bounds, PAM-style names, input
-errors, CLI exit codes, and the acceptance cases on the shipped examples."""
+interpolation between different time grids against textbook bounds, times matched to the
+digits a file carries, angles modulo 2π, PAM-style names, input errors, CLI exit codes, and
+the acceptance cases on the shipped examples."""
 import csv
 import io
+import math
 import subprocess
 import sys
 import unicodedata
@@ -14,18 +16,20 @@ import pytest
 import pam2exu
 from pam2exu.cli import main
 from pam2exu.results import CompareInputError, Results, compare, read_names
-from pam2exu.results.compare import abs_error, canonical_name
+from pam2exu.results.compare import (abs_error, angle_error, canonical_name, times_match,
+                                     written_precision)
 
 ROOT = Path(__file__).resolve().parents[2]
 W = 2 * np.pi                               # rad/s: one period per second
 
 
 def write(path, t, columns: dict, sep=",", decimal=".", fmt="%.17g", encoding="utf-8",
-          newline="\n"):
-    """A CSV written independently of Results.to_csv (PAM-style options)."""
+          newline="\n", t_fmt=None):
+    """A CSV written independently of Results.to_csv (PAM-style options; ``t_fmt`` for the
+    time column, else ``fmt``)."""
     lines = [sep.join(["t", *columns])]
     for k in range(len(t)):
-        cells = [fmt % v for v in [t[k], *(c[k] for c in columns.values())]]
+        cells = [(t_fmt or fmt) % t[k]] + [fmt % c[k] for c in columns.values()]
         lines.append(sep.join(c.replace(".", decimal) for c in cells))
     Path(path).write_bytes((newline.join(lines) + newline).encode(encoding))
     return path
@@ -128,6 +132,82 @@ def test_times_equal_up_to_rounding_are_matched_row_by_row(tmp_path):
     assert c.method is None and c.passed and "the same 101 times" in c.header()[2]
 
 
+# --- times matched to the digits a file carries ----------------------------------------------
+
+@pytest.mark.parametrize("cells, precision, digits", [
+    (["0", "0.00277778", "0.5", "1", "100"], [0, 5e-9, 5e-7, 5e-6, 5e-4],
+     "6 significant digits"),                               # %.6g drops trailing zeros
+    (["2.77778e-03", "-1e+00", "0"], [5e-9, 5e-6, 0], "6 significant digits"),
+    (["0.000", "0.250", "1.125"], [5e-4, 5e-4, 5e-4], "3 decimals"),   # %.3f keeps them
+    (["2.50000E-01", "1.00000E+00"], [5e-7, 5e-6], "6 significant digits"),
+    (["0", "0.0027777777777777779"], [0, 5e-20], "17 significant digits"),
+    (["nan", ""], [0, 0], ""),
+])
+def test_written_precision(cells, precision, digits):
+    """Half a unit of the last digit each time carries, from the text of the column."""
+    p, d = written_precision(cells)
+    assert d == digits
+    np.testing.assert_allclose(p, precision, rtol=1e-12, atol=0)
+
+
+def test_six_digit_times_are_matched_row_by_row_both_ways(tmp_path):
+    """sin(2πt) at t = k/360 written with 6 significant digits (t = 0.00277778, …) against
+    full precision: rows are matched one to one (not interpolated) whichever file carries 6
+    digits, and the max error is exactly the rounding of the values."""
+    t = np.arange(361) / 360
+    x = np.sin(W * t)
+    six_t = np.array([float(f"{v:.6g}") for v in t])
+    six_x = np.array([float(f"{v:.6g}") for v in x])
+    assert not times_match(t, 0 * t, six_t, 0 * t)           # float rounding alone: no
+    rounding = np.abs(x - six_x)
+    full = Results(t, {"a.x": x})
+    six = write(tmp_path / "six.csv", t, {"a.x": x}, fmt="%.6g")
+    exact = write(tmp_path / "full.csv", t, {"a.x": x})
+    for res, ref, side in ((full, six, "reference"), (six, exact, "result")):
+        c = compare(res, ref, rtol=5e-6)
+        assert c.method is None and c.rows_compared == 361 and c.passed
+        row = c["a.x"]
+        assert row.max_abs_error == rounding.max()
+        assert row.t_at_max == (six_t if side == "reference" else t)[np.argmax(rounding)]
+        assert c.time_digits == f"6 significant digits the {side} carries"
+        assert c.time_difference == np.abs(t - six_t).max()
+        assert c.header()[2].startswith(f"times matched row by row to the 6 significant "
+                                        f"digits the {side} carries: the same 361 times")
+    both = compare(six, write(tmp_path / "five.csv", t, {"a.x": x}, fmt="%.5g"), rtol=5e-5)
+    assert both.method is None and both.time_digits == (
+        "6 significant digits the result carries and the 5 significant digits the reference "
+        "carries")
+
+
+@pytest.mark.parametrize("shift, matched", [(0.9, True), (1.1, False)])
+def test_time_matching_stops_at_half_a_unit_of_the_last_digit(tmp_path, shift, matched):
+    """'0.00277778' stands for 0.002777775 … 0.002777785: a result time 0.9 half-units from
+    it matches, one 1.1 half-units away does not (the result is then interpolated)."""
+    t = np.arange(361) / 360
+    ref = write(tmp_path / "ref.csv", t, {"a.x": t}, t_fmt="%.6g")
+    moved = t.copy()
+    moved[1] = 0.00277778 + shift * 5e-9
+    c = compare(Results(moved, {"a.x": moved}), ref)
+    assert (c.method is None) is matched
+    six = np.array([float(f"{v:.6g}") for v in t])
+    assert c.time_difference == (np.abs(moved - six).max() if matched else 0.0)
+
+
+def test_times_off_by_1e_4_relative_are_interpolated(tmp_path):
+    """A reference on times 1e-4 (relative) later than the result's, written with 6 digits:
+    20 times the 5e-6 they carry, so the result is interpolated, not matched row by row
+    (kills the mutant that loosens the matching to 1e-3·|t|). The values are a cubic, which
+    the spline reproduces: the errors are round-off; matched row by row they would be ~1e-4."""
+    cubic = lambda x: 1 - 2 * x + 0.5 * x ** 2 + 0.25 * x ** 3      # noqa: E731
+    t = np.linspace(0.0, 1.0, 101)
+    t_ref = np.array([float(f"{v:.6g}") for v in t * (1 + 1e-4)])
+    ref = write(tmp_path / "ref.csv", t * (1 + 1e-4), {"a.x": cubic(t_ref)}, t_fmt="%.6g")
+    c = compare(Results(t, {"a.x": cubic(t)}), ref)
+    assert c.method == "cubic" and (c.rows_compared, c.rows_outside) == (100, 1)
+    assert c.time_digits == "" and c.time_difference == 0.0
+    assert c.passed and c["a.x"].max_abs_error < 1e-14
+
+
 def test_reading_variants(tmp_path):
     """Trailing separators, an empty cell (missing: infinite error), a BOM and tabs, '#' lines,
     and t in any column."""
@@ -141,6 +221,95 @@ def test_reading_variants(tmp_path):
     c = compare(res, tabs)
     assert c.passed and c.method is None and c["a.x"].max_abs_error == 0
     assert any("tab as separator" in n for n in c.notes)
+
+
+# --- angles modulo 2π ------------------------------------------------------------------------
+
+def wrap(angle):
+    """An angle in (−π, π], as PAM exports it (independent of compare's reduction)."""
+    return np.array([a - 2 * np.pi * math.ceil((a - np.pi) / (2 * np.pi)) for a in angle])
+
+
+def test_angle_error():
+    """The difference reduced to (−π, π], then its magnitude; non-finite as abs_error."""
+    r = np.array([np.pi, -np.pi, 2 * np.pi + 1e-3, 0.5, 7.0, np.nan, np.nan, 1.0])
+    f = np.array([0.0, 0.0, 0.0, -0.5, 0.0, np.nan, 1.0, np.inf])
+    np.testing.assert_allclose(angle_error(r, f),
+                               [np.pi, np.pi, 1e-3, 1.0, 7.0 - 2 * np.pi, 0, np.inf, np.inf],
+                               rtol=1e-12)
+    assert wrap(np.array([np.pi, -np.pi, 3.5]))[:2].tolist() == [np.pi, np.pi]
+
+
+def test_wrap_angles(tmp_path):
+    """An unwrapped result (3t rad, t = 0 … 2 s) against an export wrapped at ±π with a bump
+    of 1e-6 at t = 0.37: modulo 2π only the bump remains, with scale π; lengths, a linear
+    actuator's f(t) and an f(t) whose actuator neither file names are not wrapped."""
+    t = np.linspace(0.0, 2.0, 201)
+    fi = 3 * t
+    bump = np.where(np.isclose(t, 0.37), 1e-6, 0.0)
+    names = ["a.fi", "ts.fi_rel", "m.f(t)", "l.f(t)", "u.f(t)", "a.x"]
+    res = write(tmp_path / "res.csv", t, {**{n: fi for n in names}, "m.Mz": t, "l.Força": t})
+    ref = write(tmp_path / "ref.csv", t, {**{n: wrap(fi) + bump for n in names}, "m.Mz": t,
+                                          "l.Força": t})
+    c = compare(res, ref, wrap_angles=True)
+    assert c.wrapped == ["a.fi", "ts.fi_rel", "m.f(t)"] and c.failed == names
+    for name in c.wrapped:
+        row = c[name]
+        assert row.max_abs_error == pytest.approx(1e-6, rel=1e-8) and row.t_at_max == 0.37
+        assert row.scale == math.pi and row.tolerance == pytest.approx(1e-12 + 1e-9 * math.pi)
+        assert row.max_rel_error == pytest.approx(1e-6 / math.pi, rel=1e-8)
+    assert c["a.x"].max_abs_error == pytest.approx(2 * np.pi, rel=1e-12)
+    assert c["a.x"].scale == np.abs(wrap(fi) + bump).max()      # max |wrapped reference|
+    assert ("angles compared modulo 2π (the difference reduced to (−π, π], scale π): a.fi, "
+            "ts.fi_rel, m.f(t)") in c.header()
+    assert "not compared modulo 2π (angle or length: neither file tells which actuator it " \
+           "is): u.f(t)" in c.notes
+    plain = compare(res, ref)
+    assert plain.wrapped == [] and plain["a.fi"].max_abs_error == pytest.approx(2 * np.pi)
+    loose = compare(res, ref, wrap_angles=True, rtol=1e-6)        # tolerance 3.14e-6
+    assert loose.failed == ["l.f(t)", "u.f(t)", "a.x"]
+    assert compare(res, ref, wrap_angles=True, rtol=0.3e-6).failed == names    # 0.94e-6
+    with pytest.raises(CompareInputError, match=r"`wrap_angles` must be True or False"):
+        compare(res, ref, wrap_angles="yes")
+
+
+def test_wrapped_result_is_unwrapped_before_interpolation():
+    """A wrapped result on a coarse grid against the unwrapped angle on a fine one: the
+    result is unwrapped, then interpolated (a line, reproduced to round-off); the units of
+    Results tables say which columns are angles (here f(t), which a CSV would not tell)."""
+    t, t_ref = np.linspace(0.0, 2.0, 41), np.linspace(0.0, 2.0, 401)
+    res = Results(t, {"m.f(t)": wrap(3 * t)}, {"m.f(t)": "rad"})
+    ref = Results(t_ref, {"m.f(t)": 3 * t_ref}, {"m.f(t)": "rad"})
+    c = compare(res, ref, wrap_angles=True)
+    assert c.method == "cubic" and c.wrapped == ["m.f(t)"]
+    assert c["m.f(t)"].max_abs_error < 1e-13 and c["m.f(t)"].interpolation_error < 1e-13
+    assert compare(res, ref, wrap_angles=True, method="linear").passed
+    assert not compare(res, ref).passed
+
+
+def test_pam_export_with_6_digit_times_and_wrapped_angles(data, tmp_path):
+    """crank_pam_wrapped.csv: the closed form over 3 s every 1/120 s (t = 0.00833333, …),
+    angles wrapped at ±π, 6 digits. Rows match one to one; modulo 2π the angles' errors are
+    exactly the rounding of the wrapped closed form; without it they fail by 2π."""
+    folder = data / "compare"
+    res = pam2exu.run(folder / "crank.toml", t_end=3.0, steps=360)
+    ref, names = folder / "crank_pam_wrapped.csv", folder / "crank_names.csv"
+    c = compare(res, ref, names=names, rtol=1e-5, wrap_angles=True)
+    assert c.passed and c.method is None and len(c.rows) == 11
+    assert c.time_digits == "6 significant digits the reference carries"
+    assert c.wrapped == ["crank.fi", "motor.f(t)"]
+    t = np.arange(361) / 120
+    fi = wrap(2 * t)
+    rounding = np.abs(np.array([float(f"{x:.6g}") for x in fi]) - fi)
+    for name in c.wrapped:
+        assert c[name].max_abs_error == pytest.approx(rounding.max(), rel=1e-6, abs=1e-13)
+        assert c[name].t_at_max == pytest.approx(t[np.argmax(rounding)], abs=5e-6)
+    assert compare(res, ref, names=names, rtol=1e-5).failed == ["crank.fi", "motor.f(t)"]
+    csv_res = res.to_csv(tmp_path / "crank_3s.csv")
+    assert main(["compare", str(csv_res), str(ref), "--names", str(names), "--rtol", "1e-5",
+                 "--wrap-angles"]) == 0
+    assert main(["compare", str(csv_res), str(ref), "--names", str(names), "--rtol",
+                 "1e-5"]) == 1
 
 
 # --- names ---------------------------------------------------------------------------------
