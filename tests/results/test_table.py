@@ -1,12 +1,14 @@
 """The Results table: named columns, CSV of the contract, NumPy without copies, selection."""
 import csv
+import sys
 
 import numpy as np
 import pytest
 
 import pam2exu
 from pam2exu.errors import ModelError
-from pam2exu.results import Results, select_columns
+from pam2exu.results import Results, select_columns, table as table_module
+from pam2exu.results.compare import _load
 
 COLUMNS = ["crank.x", "crank.fi", "guide.Fx", "motor.f(t)", "spring.Força", "rod.Fx"]
 
@@ -38,6 +40,162 @@ def test_csv_round_trip_full_precision_utf8(tmp_path):
     values = np.array(rows[1:], dtype=float)
     np.testing.assert_array_equal(values, res.to_numpy())  # bit for bit
     assert not (tmp_path / "r.csv.part").exists()
+
+
+# --- CSV: every float64 back bit for bit -------------------------------------------------
+
+def bits(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float).view(np.uint64)
+
+
+def hard_values() -> np.ndarray:
+    """Floats that shortest-digit printers and parsers get wrong when they are wrong."""
+    rng = np.random.default_rng(20240610)
+    random = rng.integers(0, 2**64, 3000, dtype=np.uint64, endpoint=False).view(float)
+    subnormal = (rng.integers(1, 2**52, 300, dtype=np.uint64)
+                 | (rng.integers(0, 2, 300, dtype=np.uint64) << np.uint64(63))).view(float)
+    powers = np.concatenate([10.0 ** np.arange(-323, 309), 2.0 ** np.arange(-1074, 1024)])
+    special = [0.0, -0.0, 5e-324, -5e-324, 2.2250738585072009e-308, 2.2250738585072014e-308,
+               1e308, -1e308, sys.float_info.max, -sys.float_info.max, 0.1 + 0.2, 0.3, 1 / 3,
+               2 / 3, np.pi, -np.e, 1.0, -2.0, 2.0**53, 2.0**53 + 2, 2.0**63, 2.0**64, 1e15,
+               1e16, 1e21, 1e22, 1e23, 123456789.0, 9007199254740993.0, 4.294967294e9,
+               1.8531501765868567e21, -3.347727380279489e33, 2.98023223876953125e-8,
+               9.5e-5, 1e-5, 0.001, 100000.0, 1234567890123456789.0]
+    with np.errstate(over="ignore"):
+        near = np.nextafter(np.repeat(special, 2), np.tile([-np.inf, np.inf], len(special)))
+    values = np.concatenate([random, subnormal, powers, special, near])
+    return values[np.isfinite(values)]
+
+
+def square(values: np.ndarray, columns: int = 7) -> Results:
+    """A table of the values, row after row (t is a column like the others)."""
+    values = np.resize(values, (-(-len(values) // columns), columns))
+    return Results(values[:, 0], {f"c{j}.x": values[:, j] for j in range(1, columns)})
+
+
+def read_by_hand(path) -> np.ndarray:
+    """Python's float() on each cell: a reader that shares no code with pam2exu's."""
+    with open(path, encoding="utf-8", newline="") as fh:
+        return np.array([[float(cell) for cell in row] for row in list(csv.reader(fh))[1:]])
+
+
+def test_csv_hard_values_read_back_bit_for_bit(tmp_path):
+    """Random bit patterns, subnormals, ±0, the extremes, every power of 10 and of 2."""
+    res = square(hard_values())
+    path = res.to_csv(tmp_path / "hard.csv")
+    back = pam2exu.read_csv(path)
+    assert back.columns == res.columns
+    np.testing.assert_array_equal(bits(back.to_numpy()), bits(res.to_numpy()))
+    np.testing.assert_array_equal(bits(read_by_hand(path)), bits(res.to_numpy()))
+    general = _load(path, "results", {})           # compare's reader, not read_csv's own
+    np.testing.assert_array_equal(bits(general.values), bits(res.to_numpy().T[1:]))
+
+
+def test_csv_keeps_the_sign_of_zero(tmp_path):
+    """-0.0 is written -0 and read back -0.0."""
+    res = Results([-0.0, 0.0, 1.0], {"a.x": [0.0, -0.0, -0.0], "b.y": [-0.0, 1.0, 0.0]})
+    path = res.to_csv(tmp_path / "zeros.csv")
+    assert path.read_text(encoding="utf-8").splitlines()[1:] == ["-0,0,-0", "0,-0,1",
+                                                                 "1,-0,0"]
+    np.testing.assert_array_equal(np.signbit(pam2exu.read_csv(path).to_numpy()),
+                                  np.signbit(res.to_numpy()))
+
+
+def test_csv_writes_the_shortest_digits(tmp_path):
+    res = Results([0.0, 1.0], {"a.x": [0.1 + 0.2, -0.0], "a.y": [1e-5, 2.0**53]})
+    text = res.to_csv(tmp_path / "r.csv").read_text(encoding="utf-8")
+    assert text == "t,a.x,a.y\n0,3.0000000000000004e-1,1e-5\n1,-0,9.007199254740992e15\n"
+
+
+def test_csv_non_finite_values_read_back(tmp_path):
+    values = np.array([[0.0, np.nan, np.inf], [1.0, -np.inf, -np.nan]])
+    res = Results(values[:, 0], {"a.x": values[:, 1], "a.y": values[:, 2]})
+    path = res.to_csv(tmp_path / "r.csv")
+    for back in (pam2exu.read_csv(path).to_numpy(), read_by_hand(path)):
+        np.testing.assert_array_equal(back, values)          # nan where nan, ±inf exactly
+
+
+@pytest.mark.parametrize("rows, columns", [(1, 1), (1, 4), (2, 2), (3, 3), (40, 5)])
+def test_csv_small_and_square_tables(tmp_path, rows, columns):
+    """A square symmetric array is no special case (Matrix Market would write half of it)."""
+    values = np.add.outer(np.arange(rows), np.arange(columns)) / 7.0
+    res = square(values.ravel(), columns)
+    back = pam2exu.read_csv(res.to_csv(tmp_path / "r.csv"))
+    np.testing.assert_array_equal(bits(back.to_numpy()), bits(values))
+
+
+def test_csv_in_blocks_is_the_same_file(tmp_path, monkeypatch):
+    """Rows are formatted a block at a time (bounded memory): the blocks join seamlessly."""
+    res = square(hard_values()[:500])
+    whole = res.to_csv(tmp_path / "whole.csv").read_bytes()
+    monkeypatch.setattr(table_module, "_BLOCK", 20)          # 2 rows of 7 values a block
+    assert res.to_csv(tmp_path / "blocks.csv").read_bytes() == whole
+    back = pam2exu.read_csv(tmp_path / "blocks.csv")
+    np.testing.assert_array_equal(bits(back.to_numpy()), bits(res.to_numpy()))
+
+
+def test_csv_of_a_run_reads_back_bit_for_bit(examples, tmp_path):
+    res = pam2exu.run(examples / "four_bar.toml", analysis="kinetostatic", steps=60)
+    path = res.to_csv(tmp_path / "four_bar.csv")
+    back = pam2exu.read_csv(path)
+    assert back.columns == res.columns
+    np.testing.assert_array_equal(bits(back.to_numpy()), bits(res.to_numpy()))
+    np.testing.assert_array_equal(bits(read_by_hand(path)), bits(res.to_numpy()))
+    table = pam2exu.compare(res, path, rtol=0.0, atol=0.0)
+    assert table.passed and all(row.max_abs_error == 0.0 for row in table.rows)
+
+
+NAMES = ["a,b.x", 'q"uo.y', '"lead.x', "Força.Fx", "émbolo.f(t)", "ü ñ.Dfi"]
+
+
+def test_csv_names_with_commas_quotes_and_accents_read_back(tmp_path):
+    res = Results([0.0, 0.5], {name: [k, -k / 3] for k, name in enumerate(NAMES)})
+    path = res.to_csv(tmp_path / "names.csv")
+    with open(path, encoding="utf-8", newline="") as fh:
+        assert next(csv.reader(fh)) == ["t", *NAMES]       # quoted as CSV readers expect
+    back = pam2exu.read_csv(path)
+    assert back.columns == NAMES
+    np.testing.assert_array_equal(bits(back.to_numpy()), bits(res.to_numpy()))
+
+
+def test_csv_written_with_17_digits_still_reads_back(tmp_path):
+    """Files of earlier versions (np.savetxt, %.17g)."""
+    res = square(hard_values()[:700])
+    path = tmp_path / "old.csv"
+    with open(path, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(",".join(["t", *res.columns]) + "\n")
+        np.savetxt(fh, res.to_numpy(), delimiter=",", fmt="%.17g")
+    np.testing.assert_array_equal(bits(pam2exu.read_csv(path).to_numpy()), bits(res.to_numpy()))
+
+
+def test_csv_failure_leaves_the_old_file_and_no_part_file(tmp_path, monkeypatch):
+    path = tmp_path / "r.csv"
+    path.write_text("the old file\n", encoding="utf-8")
+    res = square(np.arange(70.0))
+    blocks = []
+
+    def fail_on_the_second(values):
+        if blocks:
+            raise OSError("disk full")
+        blocks.append(values)
+        return b"1,2,3,4,5,6,7\n" * len(values)
+
+    monkeypatch.setattr(table_module, "_BLOCK", 14)
+    monkeypatch.setattr(table_module, "_csv_block", fail_on_the_second)
+    with pytest.raises(OSError, match="disk full"):
+        res.to_csv(path)
+    assert blocks                                          # it failed half way
+    assert path.read_text(encoding="utf-8") == "the old file\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv"]
+
+
+def test_csv_replaces_an_existing_file(tmp_path):
+    path = tmp_path / "r.csv"
+    path.write_text("x" * 10_000, encoding="utf-8")
+    res = Results([0.0], {"a.x": [2.5]})
+    assert res.to_csv(str(path)) == path
+    assert path.read_text(encoding="utf-8") == "t,a.x\n0,2.5\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv"]
 
 
 @pytest.mark.parametrize("patterns, expected", [
