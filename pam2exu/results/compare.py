@@ -642,8 +642,8 @@ def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str],
     """Column names, values (columns × rows), notes, and (separator, lines of values) of a
     result CSV file, the lines for ``_cells``.
 
-    Separator ';' or tab when the header line has one, else ','; with ';' or tab a ',' inside
-    a number is a decimal comma. Empty cells are nan.
+    Separator ';' or tab when the header line has one outside quoted names, else ','; with
+    ';' or tab a ',' inside a number is a decimal comma. Empty cells are nan.
     """
     text, notes = _text(path, role)
     lines = _lines(text)
@@ -651,7 +651,9 @@ def _read_csv(path: Path, role: str) -> tuple[list[str], np.ndarray, list[str],
         raise CompareInputError(f"{role} file '{path}' has no rows of values; it needs a "
                                 f"header line 't,<name>.<variable>,…' and one line per time")
     header_line = lines[0][1]
-    delimiter = ";" if ";" in header_line else "\t" if "\t" in header_line else ","
+    unquoted = header_line.replace('""', "").split('"')[::2]   # outside quoted names
+    delimiter = (";" if any(";" in u for u in unquoted) else
+                 "\t" if any("\t" in u for u in unquoted) else ",")
     if delimiter != ",":
         notes.append(f"{role} read with {'tab' if delimiter == chr(9) else repr(delimiter)} "
                      f"as separator and ',' as decimal mark")

@@ -139,7 +139,7 @@ def test_runner_classifies_non_finite_values(monkeypatch):
 
 def test_runner_classifies_a_csv_that_does_not_read_back(monkeypatch):
     def fake(path, analysis=None):
-        return pam2exu.Results([0.0, 1.0], {"a,b.fi": [0.0, 1.0]})
+        return pam2exu.Results([0.0, 1.0], {"a\nb.fi": [0.0, 1.0]})     # a line break
     assert _patched_case(monkeypatch, fake).fault == "csv"
 
 

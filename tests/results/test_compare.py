@@ -555,3 +555,14 @@ def test_a_bool_is_not_a_tolerance(tmp_path):
     good = write(tmp_path / "good.csv", t, {"a.x": t})
     with pytest.raises(CompareInputError, match=r"`rtol` must be a number ≥ 0, not True"):
         compare(good, good, rtol=True)
+
+
+def test_a_name_holding_a_semicolon_is_read_from_its_quotes(tmp_path):
+    """to_csv quotes a name with ';': the separator is still ',' (the ';' is inside quotes),
+    so the file compares equal to the table it was written from."""
+    res = Results([0.0, 0.5, 1.0], {"a;b.x": [0.1, 0.2, 0.3], "c.y": [1.0, 2.0, 3.0]})
+    path = res.to_csv(tmp_path / "semicolon.csv")
+    assert path.read_text(encoding="utf-8").splitlines()[0] == 't,"a;b.x",c.y'
+    comparison = compare(res, path, rtol=0.0, atol=0.0)
+    assert comparison.passed and sorted(v.name for v in comparison.rows) == ["a;b.x", "c.y"]
+    assert not comparison.notes                       # not read with ";" as separator
