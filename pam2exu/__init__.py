@@ -14,7 +14,7 @@ from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
 from .errors import (MobilityError, ModelError, Pam2ExuError, SolverError, TranslationError)
 from .export import export
-from .analyses.common import ConditionWarning, ConsistencyWarning, RedundancyWarning
+from .errors import ConditionWarning, ConsistencyWarning, RedundancyWarning
 from .model import Law, Model, Solid, load, loads
 from .pictures import animate, draw
 from .results import CompareInputError, Comparison, Results, plot, read_csv

@@ -1,4 +1,5 @@
-"""Every error pam2exu raises on purpose, one class each, with what it means."""
+"""Every error pam2exu raises on purpose and every warning it issues, one class each, with
+what it means."""
 from __future__ import annotations
 
 import difflib
@@ -181,3 +182,64 @@ def closest(name: str, candidates) -> str:
     """' (did you mean 'x'?)' for the nearest candidate, or ''."""
     match = difflib.get_close_matches(str(name), [str(c) for c in candidates], n=1, cutoff=0.5)
     return f" (did you mean '{match[0]}'?)" if match else ""
+
+
+# ---- warnings: the run goes on, the text is kept in Results.warnings too --------------
+
+class RedundancyWarning(UserWarning):
+    """Redundant (consistent) constraints: positions are unique, reactions are not.
+
+    Issued once per run, naming the elements among which the redundant equations are
+    (e.g. a parallelogram with a fifth bar). Positions, velocities and accelerations are
+    exact; the reactions of these elements are the minimum-norm solution, one of infinitely
+    many. The text is also kept in ``Results.warnings``.
+
+    Parameters
+    ----------
+    message : str
+        The number of redundant equations and the elements concerned.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import pam2exu
+    >>> from pam2exu.analyses import RedundancyWarning
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore", RedundancyWarning)
+    ...     res = pam2exu.run("tests/data/parallelogram5.toml")   # doctest: +SKIP
+    """
+
+
+class ConsistencyWarning(UserWarning):
+    """A physics check after an analysis (the power balance) did not hold.
+
+    kinetostatic: Σ actuator power must equal d(kinetic + potential energy)/dt + damper
+    dissipation − torsor power [W], to within the error of the finite difference (checked
+    when the run has at least 9 rows, i.e. steps ≥ 8, away from the laws' breakpoints).
+    When it does not, the forces may be wrong: please report it with the model file. The
+    text is also kept in ``Results.warnings``; the numbers are in ``Results.info``
+    (``power_balance_error``, ``power_balance_tolerance`` [W]).
+
+    Parameters
+    ----------
+    message : str
+        The largest difference [W] and the tolerance [W].
+    """
+
+
+class ConditionWarning(UserWarning):
+    """The mechanism passes at or near a singular position: results there are less exact.
+
+    Issued by the kinematic and kinetostatic analyses when the constraint Jacobian is
+    ill-conditioned somewhere in the interval (with the time [s], the condition number and
+    the relative error to expect), or when a step is exactly at a singular position (a
+    change point), where velocities and accelerations are interpolated from the
+    neighbouring steps. The run follows the branch it starts on. The text is also kept in
+    ``Results.warnings``; ``Results.info["max_condition_number"]`` is the worst condition
+    number sampled.
+
+    Parameters
+    ----------
+    message : str
+        Where [s], how ill-conditioned, and the error to expect.
+    """

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from ..errors import Pam2ExuError, SolverError
 from .assembly import assembly
-from .common import ConditionWarning, ConsistencyWarning, RedundancyWarning, prepare
+from ..errors import ConditionWarning, ConsistencyWarning, RedundancyWarning
+from .common import prepare
 from .kinematic import kinematic
 from .kinetostatic import kinetostatic
 from .quasi_static import quasi_static

@@ -20,10 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SolverError
+from ..errors import ConditionWarning, SolverError
 from . import native
-from .common import (ConditionWarning, Job, _position_failure, check_residual, singular_error,
-                     warn)
+from .common import Job, _position_failure, check_residual, singular_error, warn
 
 #: a velocity jump between two steps above this fraction of the velocities' scale is
 #: taken as a possible branch switch (smooth motion: O((ω dt)³) of it)

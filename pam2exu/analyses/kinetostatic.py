@@ -7,7 +7,8 @@ from ..elements import FORCE
 from ..kinematics import State
 from . import forces
 from .branch import motion
-from .common import ConsistencyWarning, Job, check_mobility, collect, warn
+from ..errors import ConsistencyWarning
+from .common import Job, check_mobility, collect, warn
 
 
 def kinetostatic(job: Job):
