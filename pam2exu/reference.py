@@ -21,6 +21,7 @@ from pathlib import Path
 from .elements import ACCELERATION, ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY, Element
 from .errors import closest
 from .laws import LAW_ALIASES, LAWS
+from .model.solid import SOLID_OUTPUTS
 
 #: which analyses give a variable of each level (PAM's analyses; assembly gives x, y, fi)
 ANALYSES_OF_LEVEL = {
@@ -152,7 +153,6 @@ def laws_markdown() -> str:
 
 def outputs_markdown() -> str:
     """Every output variable: owner, PAM name, unit, which analyses give it, meaning."""
-    from .analyses.common import SOLID_OUTPUTS
     rows = [("solid", f"`{v.name}`", v.unit, _analyses(v.level), v.meaning)
             for v in SOLID_OUTPUTS]
     for cls in ELEMENTS.values():

@@ -14,21 +14,9 @@ from ..errors import (ConditionWarning, ConsistencyWarning, ModelError, Problem,
                       RedundancyWarning, SolverError, TranslationError)
 from ..kinematics import State
 from ..model import Model, load
+from ..model.solid import SOLID_OUTPUTS
 from ..results import Results, select_columns
 from . import grid, loops, native
-
-#: the outputs of every solid
-SOLID_OUTPUTS = (
-    Var("x", "m", POSITION, "x of the local frame's origin"),
-    Var("y", "m", POSITION, "y of the local frame's origin"),
-    Var("fi", "rad", POSITION, "angle of the local x axis, counter-clockwise, never wrapped"),
-    Var("Dx", "m/s", VELOCITY, "dx/dt"),
-    Var("Dy", "m/s", VELOCITY, "dy/dt"),
-    Var("Dfi", "rad/s", VELOCITY, "dfi/dt"),
-    Var("DDx", "m/s²", ACCELERATION, "d²x/dt²"),
-    Var("DDy", "m/s²", ACCELERATION, "d²y/dt²"),
-    Var("DDfi", "rad/s²", ACCELERATION, "d²fi/dt²"),
-)
 
 #: what each analysis provides (as in PAM)
 LEVELS = {

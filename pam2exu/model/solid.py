@@ -5,6 +5,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..elements.base import ACCELERATION, POSITION, VELOCITY, Var
 from ..errors import closest
 from ..limits import shown
 
@@ -67,6 +68,20 @@ class Solid:
         """Where the solid is in the model, for messages: ``"[[solid]] #2 'crank'"``."""
         at = f" #{self.position}" if self.position else ""
         return f"[[solid]]{at} '{shown(self.name)}'"
+
+
+#: the outputs of every solid: columns ``<solid>.<variable>`` (``Results``, ``units.unit_of``)
+SOLID_OUTPUTS = (
+    Var("x", "m", POSITION, "x of the local frame's origin"),
+    Var("y", "m", POSITION, "y of the local frame's origin"),
+    Var("fi", "rad", POSITION, "angle of the local x axis, counter-clockwise, never wrapped"),
+    Var("Dx", "m/s", VELOCITY, "dx/dt"),
+    Var("Dy", "m/s", VELOCITY, "dy/dt"),
+    Var("Dfi", "rad/s", VELOCITY, "dfi/dt"),
+    Var("DDx", "m/s²", ACCELERATION, "d²x/dt²"),
+    Var("DDy", "m/s²", ACCELERATION, "d²y/dt²"),
+    Var("DDfi", "rad/s²", ACCELERATION, "d²fi/dt²"),
+)
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import functools
 
+from ..model.solid import SOLID_OUTPUTS
+
 
 @functools.cache
 def declared_units() -> dict[str, tuple[str, ...]]:
@@ -27,7 +29,6 @@ def declared_units() -> dict[str, tuple[str, ...]]:
     >>> declared_units()["Mz"], declared_units()["f(t)"]
     (('N·m',), ('rad', 'm'))
     """
-    from ..analyses.common import SOLID_OUTPUTS
     from ..elements import ELEMENTS
     out: dict[str, list[str]] = {}
     for var in (*SOLID_OUTPUTS, *(v for cls in ELEMENTS.values() for v in cls.outputs)):
@@ -73,7 +74,6 @@ def unit_of(column: str, model=None) -> str:
 
 def _unit_in_model(model, owner: str, variable: str) -> str | None:
     """The unit the model's solid or element ``owner`` declares for ``variable``, if any."""
-    from ..analyses.common import SOLID_OUTPUTS
     declared = None
     if any(s.name == owner for s in model.solids):
         declared = SOLID_OUTPUTS
