@@ -10,8 +10,8 @@ class Pam2ExuError(Exception):
     """Base class of pam2exu's errors: the message is meant for the user, as is.
 
     Catch this class to handle every error pam2exu raises on purpose (``ModelError``,
-    ``MobilityError``, ``SolverError``, ``TranslationError``, and
-    ``pam2exu.results.CompareInputError``, ``pam2exu.results.plot.PictureError``).
+    ``MobilityError``, ``SolverError``, ``TranslationError``, ``CompareInputError``,
+    ``PictureError``).
 
     Parameters
     ----------
@@ -175,6 +175,34 @@ class TranslationError(Pam2ExuError):
     ----------
     message : str
         The element, the time and the size of the violation.
+    """
+
+
+class CompareInputError(Pam2ExuError):
+    """The tables cannot be compared (missing file, no ``t`` column, nothing in common, …).
+
+    The message names the file (and the line and column, for a bad value) and what to
+    change. Raised by ``compare``, ``read_names``, ``read_csv`` and ``plot`` (for a CSV
+    file). CLI exit code 2.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong with which file, and what to change.
+    """
+
+
+class PictureError(Pam2ExuError):
+    """A picture cannot be made as asked: an image format that is not supported, ffmpeg
+    missing for an MP4 file, nothing to plot. CLI exit code 2.
+
+    Raised by ``plot``, ``pictures.draw`` and ``pictures.animate``; the message says what to
+    change.
+
+    Parameters
+    ----------
+    message : str
+        What cannot be done, and what to do instead.
     """
 
 

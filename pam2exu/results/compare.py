@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, Pam2ExuError, closest
+from ..errors import CompareInputError, ModelError, closest
 from .table import Results, select_columns
 
 RTOL = 1e-9
@@ -37,20 +37,6 @@ METHODS = ("cubic", "linear")
 SPELLINGS = {"Forca": "Força", "f": "f(t)", "Df": "Df(t)"}
 MAP_HEADER = ("pam_name", "pam2exu_name")
 _SHOWN = 8                  # names listed in a note before "… and n more"
-
-
-class CompareInputError(Pam2ExuError):
-    """The tables cannot be compared (missing file, no ``t`` column, nothing in common, …).
-
-    The message names the file (and the line and column, for a bad value) and what to
-    change. Raised by ``compare``, ``read_names``, ``read_csv`` and ``plot`` (for a CSV
-    file). CLI exit code 2.
-
-    Parameters
-    ----------
-    message : str
-        What is wrong with which file, and what to change.
-    """
 
 
 @dataclass(frozen=True)

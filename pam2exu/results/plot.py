@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import Pam2ExuError
+from ..errors import PictureError
 
 #: default resolution [dots per inch]; with ``WIDTH`` inches a plot is 880 px wide
 DPI = 100
@@ -18,20 +18,6 @@ WIDTH = 8.8
 PANEL, MARGIN = 2.4, 0.9
 #: legends with more entries than this go to the right of their panel
 LEGEND_INSIDE = 4
-
-
-class PictureError(Pam2ExuError):
-    """A picture cannot be made as asked: an image format that is not supported, ffmpeg
-    missing for an MP4 file, nothing to plot. CLI exit code 2.
-
-    Raised by ``plot``, ``pictures.draw`` and ``pictures.animate``; the message says what to
-    change.
-
-    Parameters
-    ----------
-    message : str
-        What cannot be done, and what to do instead.
-    """
 
 
 def figure(width: float, height: float, dpi: float = DPI):
