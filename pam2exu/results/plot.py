@@ -9,7 +9,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import PictureError
+from ..errors import ModelError, PictureError
+from ..model import Model, load
+from .names import SPELLINGS, canonical_name
+from .reading import read_csv
+from .table import Results, select_columns
+from .units import unit_of
 
 #: default resolution [dots per inch]; with ``WIDTH`` inches a plot is 880 px wide
 DPI = 100
@@ -147,9 +152,6 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
     >>> plot("results.csv", "motor.Mz", "torque.png")        # doctest: +SKIP
     <Figure size 880x330 with 1 Axes>
     """
-    from ..model import Model, load
-    from .table import Results, read_csv, select_columns
-    from .units import unit_of
     if model is not None and not isinstance(model, Model):
         model = load(model)
     if isinstance(source, Results):
@@ -159,7 +161,7 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
         if title is None:
             title = f"{Path(source).name}" + (f" ('{model.name}')" if model else "")
     where = f"'{source}'" if not isinstance(source, Results) else "the results"
-    columns = _in_order(res.columns, names, select_columns, where)
+    columns = _in_order(res.columns, names, where)
     if not columns:
         raise PictureError("nothing to plot: choose variables besides t")
     panels: dict[str, list[str]] = {}
@@ -194,13 +196,11 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
     return fig
 
 
-def _in_order(columns: list[str], names, select_columns, where: str) -> list[str]:
+def _in_order(columns: list[str], names, where: str) -> list[str]:
     """The columns matching ``names``, in the order of the patterns (then of the table);
     PictureError naming every pattern that matches nothing."""
-    from ..errors import ModelError
     if names is None:
         return [c for c in columns if c != "t"]
-    from .compare import SPELLINGS, canonical_name
     names = [names] if isinstance(names, str) else list(names)
     # PAM spellings as in the files: motor.Forca, f, Df
     names = [canonical_name(n) if "." in n else SPELLINGS.get(n, n) for n in names]

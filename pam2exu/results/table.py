@@ -1,4 +1,8 @@
-"""The result of an analysis: one table of named columns, PAM's variable names."""
+"""The result of an analysis: one table of named columns, PAM's variable names.
+
+``Results`` and its CSV writer (``Results.to_csv``), with the fast reader of exactly what the
+writer writes (``_read_own``); any result CSV file is read by ``reading.read_csv``.
+"""
 from __future__ import annotations
 
 import csv
@@ -408,69 +412,15 @@ def select_columns(columns: list[str], patterns) -> list[str]:
     return [c for c in columns if c in chosen]
 
 
-def read_csv(path: str | Path, model=None) -> Results:
-    """A result CSV file as a Results table, with units from the output declarations.
-
-    Reads what ``pam2exu compare`` reads: ``Results.to_csv`` files and PAM-style exports
-    (',' or ';' separated, decimal comma with ';', PAM spellings such as ``Forca``, which
-    become pam2exu's: ``Força``). ``model`` (a Model or a model file) gives the units of
-    ``f(t)`` and ``Df(t)``, which depend on the actuator type (see ``units.unit_of``).
-    A file exactly as ``to_csv`` writes it is read by scipy's Matrix Market reader (C++),
-    its values taken only when they write back as the file's bytes; any other file as
-    ``compare`` reads it.
-
-    Parameters
-    ----------
-    path : str or Path
-        The CSV file: a header line ``t,<name>.<variable>,…``, then one line per time.
-    model : Model, str or Path, optional
-        The model the file was computed from, for the units of ``f(t)`` and ``Df(t)``
-        (rad or m); also gives the table's ``model`` name (else the file's stem).
-
-    Returns
-    -------
-    Results
-        The columns of the file (``t`` first), ``analysis`` ''.
-
-    Raises
-    ------
-    CompareInputError
-        The file is missing or unreadable: no ``t`` column, a line with the wrong number of
-        values, a value that is not a number, two columns with one name.
-    ModelError
-        ``model`` is a model file with problems.
-
-    Examples
-    --------
-    >>> res = read_csv("slider.csv", model="examples/slider_crank.toml")  # doctest: +SKIP
-    >>> res.units["motor.f(t)"]                                          # doctest: +SKIP
-    'rad'
-    """
-    from ..model import Model, load
-    from .compare import CompareInputError, _load
-    from .units import unit_of
-    if model is not None and not isinstance(model, Model):
-        model = load(model)
-    own = _read_own(Path(path))
-    try:
-        table = _load(path if own is None else own, "results", {})
-    except CompareInputError:
-        if own is None:
-            raise
-        table = _load(path, "results", {})          # the message names the file
-    units = {name: unit_of(name, model) for name in table.names}
-    return Results(table.t, dict(zip(table.names, table.values)), units,
-                   model=Path(path).stem if model is None else model.name)
-
-
 def _read_own(path: Path) -> Results | None:
     """A file exactly as ``to_csv`` writes it, read fast; None for any other file.
 
     scipy's Matrix Market reader (fast_matrix_market: fast_float, correctly rounded, C++)
     reads the numbers; they are taken only when ``_csv_lines`` writes them back as the
-    file's own bytes, so they are what the general reader (``compare``) reads, bit for bit,
-    whatever the file holds. Anything else (another writer's digits, comments, ';', a
-    byte-order mark, CRLF) is None, and ``read_csv`` reads it the general way.
+    file's own bytes, so they are what the general reader (``reading.load_table``, which
+    ``compare`` uses) reads, bit for bit, whatever the file holds. Anything else (another
+    writer's digits, comments, ';', a byte-order mark, CRLF) is None, and ``read_csv`` reads
+    it the general way.
 
     Parameters
     ----------

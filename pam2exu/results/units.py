@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import functools
 
+from ..elements import ELEMENTS
 from ..model.solid import SOLID_OUTPUTS
+from .names import canonical_name
 
 
 @functools.cache
@@ -29,7 +31,6 @@ def declared_units() -> dict[str, tuple[str, ...]]:
     >>> declared_units()["Mz"], declared_units()["f(t)"]
     (('N·m',), ('rad', 'm'))
     """
-    from ..elements import ELEMENTS
     out: dict[str, list[str]] = {}
     for var in (*SOLID_OUTPUTS, *(v for cls in ELEMENTS.values() for v in cls.outputs)):
         units = out.setdefault(var.name, [])
@@ -60,7 +61,6 @@ def unit_of(column: str, model=None) -> str:
     >>> unit_of("crank.fi"), unit_of("B.Fx"), unit_of("motor.Forca"), unit_of("motor.f(t)")
     ('rad', 'N', 'N', '')
     """
-    from .compare import canonical_name
     if column == "t":
         return "s"
     owner, _, variable = canonical_name(column).rpartition(".")

@@ -16,8 +16,9 @@ import pytest
 import pam2exu
 from pam2exu.cli import main
 from pam2exu.results import CompareInputError, Results, compare, read_names
-from pam2exu.results.compare import (abs_error, angle_error, canonical_name, times_match,
-                                     written_precision)
+from pam2exu.results.compare import abs_error, angle_error, times_match
+from pam2exu.results.names import canonical_name
+from pam2exu.results.reading import written_precision
 
 ROOT = Path(__file__).resolve().parents[2]
 W = 2 * np.pi                               # rad/s: one period per second

@@ -8,7 +8,7 @@ import pytest
 import pam2exu
 from pam2exu.errors import ModelError
 from pam2exu.results import Results, select_columns, table as table_module
-from pam2exu.results.compare import _load
+from pam2exu.results.reading import load_table
 
 COLUMNS = ["crank.x", "crank.fi", "guide.Fx", "motor.f(t)", "spring.Força", "rod.Fx"]
 
@@ -90,7 +90,7 @@ def test_csv_hard_values_read_back_bit_for_bit(tmp_path):
     assert back.columns == res.columns
     np.testing.assert_array_equal(bits(back.to_numpy()), bits(res.to_numpy()))
     np.testing.assert_array_equal(bits(read_by_hand(path)), bits(res.to_numpy()))
-    general = _load(path, "results", {})           # compare's reader, not read_csv's own
+    general = load_table(path, "results", {})      # compare's reader, not read_csv's own
     np.testing.assert_array_equal(bits(general.values), bits(res.to_numpy().T[1:]))
 
 
@@ -179,7 +179,7 @@ def test_csv_edited_by_hand_is_read_the_general_way(tmp_path, edit):
     assert other.read_bytes() != own.read_bytes()
     assert table_module._read_own(own) is not None
     assert table_module._read_own(other) is None
-    expected = _load(other, "results", {})
+    expected = load_table(other, "results", {})
     back = pam2exu.read_csv(other)
     np.testing.assert_array_equal(bits(back.t), bits(expected.t))
     np.testing.assert_array_equal(bits(back.to_numpy()[:, 1:].T), bits(expected.values))
@@ -210,9 +210,9 @@ def test_csv_fast_reader_agrees_with_the_general_one_on_damaged_files(tmp_path):
         if fast is None:
             continue
         taken += 1
-        fast_table = _load(fast, "results", {})
+        fast_table = load_table(fast, "results", {})
         try:
-            general = _load(path, "results", {})
+            general = load_table(path, "results", {})
         except pam2exu.CompareInputError:      # compare takes a ';' or tab in a name
             header = text.split(b"\n")[0]     # for the separator; read_csv does not
             assert b";" in header or b"\t" in header

@@ -1,0 +1,59 @@
+"""Column names in pam2exu's spelling: PAM's own spellings, names maps, lists of names.
+
+A column is ``<name>.<variable>``. Files exported from PAM spell some variables otherwise
+(``Forca``, ``f``, ``Df``); ``SPELLINGS`` brings them to pam2exu's (``Força``, ``f(t)``,
+``Df(t)``). A names map (PAM name → pam2exu name, ``reading.read_names``) renames whole
+columns or the solid or element before the dot. ``compare``, ``read_csv``, ``plot`` and
+``units.unit_of`` all spell names this way.
+"""
+from __future__ import annotations
+
+import unicodedata
+
+# PAM spellings of variable names -> pam2exu's (applied to the part after the last dot)
+SPELLINGS = {"Forca": "Força", "f": "f(t)", "Df": "Df(t)"}
+_SHOWN = 8                  # names listed in a note before "… and n more"
+
+
+def canonical_name(column: str, names: dict[str, str] | None = None) -> str:
+    """pam2exu's name of a column: the names map (whole column, else the part before the dot),
+    then ``SPELLINGS`` on the part after the dot (Forca → Força, f → f(t), Df → Df(t)).
+
+    Examples
+    --------
+    >>> canonical_name("motor.Forca"), canonical_name("Solid1.fi", {"Solid1": "crank"})
+    ('motor.Força', 'crank.fi')
+    """
+    return canonical(column, names or {})[0]
+
+
+def canonical(column: str, names: dict[str, str]) -> tuple[str, tuple[str, ...]]:
+    """``canonical_name`` and the map keys it used."""
+    col = clean(column)
+    if col in names:
+        return names[col], (col,)
+    owner, dot, variable = col.rpartition(".")
+    if not dot:
+        return col, ()
+    used = (owner,) if owner in names else ()
+    full = f"{names.get(owner, owner)}.{SPELLINGS.get(variable, variable)}"
+    if full in names:
+        return names[full], used + (full,)
+    return full, used
+
+
+def clean(name: str) -> str:
+    """Strip blanks and use one Unicode form (NFC), so 'Força' typed either way matches."""
+    return unicodedata.normalize("NFC", name.strip())
+
+
+def spellings() -> str:
+    """'Forca → Força, f → f(t), Df → Df(t)'."""
+    return ", ".join(f"{k} → {v}" for k, v in SPELLINGS.items())
+
+
+def listing(names, n: int = _SHOWN) -> str:
+    """'a, b, c' with at most n names, then '… and k more'."""
+    names = list(names)
+    more = f", … and {len(names) - n} more" if len(names) > n else ""
+    return ", ".join(names[:n]) + more
