@@ -19,11 +19,10 @@ What it measures (each section of docs/performance.md is one of these):
    link, one motor drives them all), N = 1 … 64; time per step against N and the fitted
    exponent; errors against the chained closed form and a Newton–Euler solution.
 
-References. Kinematics: the closed forms of tests/analyses/test_kinematic_closed_form.py
-(``four_bar``, chained loop by loop for the chain) and tests/analyses/test_newton_euler.py
-(``kinematics``: offset slider-crank with the slider's pin off its line), imported from
-the tests. Forces:
-``newton_euler`` of test_newton_euler.py for the slider-crank; for the four-bar and the
+References (the top-level ``references`` package, shared with the tests). Kinematics: the
+closed forms of references/closed_form.py (``four_bar``, chained loop by loop for the chain)
+and references/slider_crank.py (``kinematics``: offset slider-crank with the slider's pin
+off its line). Forces: ``newton_euler`` of references/slider_crank.py for the slider-crank; for the four-bar and the
 chain, ``revolute_newton_euler`` below (Σ F = m a_G, Σ M_G = J α per body, solved at every
 step), which checks itself by the power balance before it is used. No reference comes
 from pam2exu.
@@ -45,13 +44,14 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests" / "analyses"))
+sys.path.insert(0, str(ROOT))          # the references/ package at the repository root
 
 import exudyn as exu
-import test_kinematic_closed_form as kcf
-import test_newton_euler as ne
 from exudyn import itemInterface as items
+
+import references.closed_form as kcf  # noqa: E402
+import references.slider_crank as ne  # noqa: E402
+from references.laws import actuator_law  # noqa: E402
 
 from pam2exu.analyses.native import SPARSE_FROM  # noqa: E402
 from pam2exu.backend.system import DENSE_UP_TO  # noqa: E402
@@ -345,7 +345,7 @@ def four_bar_case(t_end=1.0, C=None):
 
     def reference(t):
         a, b, c, d = (kcf.FOUR_BAR[key] for key in "abcd")
-        th, dth, ddth = kcf.actuator_law(model, "motor", t)
+        th, dth, ddth = actuator_law(model, "motor", t)
         (phi, dphi, ddphi), (psi, dpsi, ddpsi) = kcf.four_bar(a, b, c, d, th, dth, ddth)
         k = len(t)
         z = np.zeros(k)
@@ -373,7 +373,7 @@ def four_bar_case(t_end=1.0, C=None):
                  ("motor", "motor", "ground", "crank")]
         forces = revolute_newton_euler(bodies, links, float(model.gravity))
         return kin, forces
-    w = float(np.max(np.abs(kcf.actuator_law(model, "motor", np.linspace(0, t_end, 101))[1])))
+    w = float(np.max(np.abs(actuator_law(model, "motor", np.linspace(0, t_end, 101))[1])))
     return model, reference, 0.4, w
 
 
@@ -395,7 +395,7 @@ def parallelogram_case():
     model = pam2exu.load(ROOT / "tests" / "data" / "parallelogram5.toml")
 
     def reference(t):
-        th, dth, ddth = kcf.actuator_law(model, "motor", t)
+        th, dth, ddth = actuator_law(model, "motor", t)
         k = len(t)
         z = np.zeros(k)
         Z = np.zeros((2, k))

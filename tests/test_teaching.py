@@ -26,6 +26,8 @@ import matplotlib.image as mpimg
 import numpy as np
 import pytest
 
+from references import slider_crank
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 SCRIPTS = sorted(EXAMPLES.glob("*.py"))
@@ -172,8 +174,9 @@ def test_coupler_curve_rocker_swing_against_the_limit_positions(results):
 # ---- 2b. motor torque: Newton–Euler and the closed-form energies --------------------------
 
 def newton_euler_module():
-    """The hand Newton–Euler slider-crank of tests/analyses/test_newton_euler.py."""
-    return load_script(ROOT / "tests" / "analyses" / "test_newton_euler.py")
+    """The hand Newton–Euler slider-crank of references/slider_crank.py (which
+    tests/analyses/test_newton_euler.py checks by itself and against pam2exu)."""
+    return slider_crank
 
 
 def slider_crank_parameters(ne, gravity=None):
@@ -199,7 +202,7 @@ def slider_crank_parameters(ne, gravity=None):
 
 def test_motor_torque_against_newton_euler(results):
     """motor.Mz, and its inertia part, against the hand Newton–Euler solution of
-    tests/analyses/test_newton_euler.py (12 equations ΣF = m a_G, ΣM_G = J_G α for ground,
+    references/slider_crank.py (12 equations ΣF = m a_G, ΣM_G = J_G α for ground,
     crank, rod and slider, closed-form slider-crank kinematics sin φ = −r sin θ / l),
     solved at the script's times: with gravity for Mz, without it for the inertia part
     (dT/dt)/ω. The gravity part (dV/dt)/ω in closed form: y_G of the crank is c_c sin θ, of

@@ -4,7 +4,7 @@ Issue 10, faults 1, 5 and 9: a crank turning millions of radians per step ran fo
 a motor at 360 rad/s (degrees given as radians) switched branch; ``--steps 1`` failed on
 every example; t_end = 5e-324, steps = 1e30 and law constants of 1e308 gave foreign
 exceptions. References: the four-bar's closed form (circle intersection,
-test_kinematic_closed_form.four_bar), and the motion per step computed here by hand.
+references/closed_form.py ``four_bar``), and the motion per step computed here by hand.
 """
 from __future__ import annotations
 
@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_kinematic_closed_form import FOUR_BAR, four_bar
 
 import pam2exu
 from pam2exu.analyses import grid
+from references.closed_form import FOUR_BAR, four_bar
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 

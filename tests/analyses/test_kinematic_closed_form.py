@@ -3,7 +3,10 @@
 Every reference below is an analytic expression of time: the actuator's law, then the
 loop-closure equations of the mechanism solved for its position, differentiated once for
 the velocities and twice for the accelerations. The derivation is in each docstring.
-Nothing is taken from pam2exu except the results under test.
+Nothing is taken from pam2exu except the results under test. The time laws
+(``references/laws.py``), the column helpers, the error measure ``errors`` and the
+four-bar's ``four_bar`` (``references/closed_form.py``) are shared with
+benchmarks/speed_vs_error.py and live in the top-level ``references`` package.
 
 Notation: e(a) = (cos a, sin a), n(a) = e(a + π/2) = (−sin a, cos a), so that
 d/dt e(a) = a' n(a), d/dt n(a) = −a' e(a), and e(a)·e(b) = cos(a − b),
@@ -23,109 +26,15 @@ import numpy as np
 import pytest
 
 import pam2exu
+from references.closed_form import FOUR_BAR, e, errors, four_bar, n, solid, still
+from references.laws import LAWS, actuator_law
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 RTOL = 1e-9
 TWO_PI = 2.0 * math.pi
 
 
-# ---- independent time laws (model-format.md, "Time laws") ------------------------------
-
-def law_polynomial(t, C):
-    """f = C1 + C2 t + C3 t² + C4 t³, f' = C2 + 2 C3 t + 3 C4 t², f'' = 2 C3 + 6 C4 t."""
-    c1, c2, c3, c4 = C
-    return (c1 + c2 * t + c3 * t**2 + c4 * t**3, c2 + 2 * c3 * t + 3 * c4 * t**2,
-            2 * c3 + 6 * c4 * t)
-
-
-def law_harmonic(t, C):
-    """f = C1 + C2 cos(C3 t + C4), f' = −C2 C3 sin(·), f'' = −C2 C3² cos(·)."""
-    c1, c2, c3, c4 = C
-    p = c3 * t + c4
-    return c1 + c2 * np.cos(p), -c2 * c3 * np.sin(p), -c2 * c3**2 * np.cos(p)
-
-
-def _blend(shape):
-    """f = C3 + (C4 − C3) s(u), u = (t − C1)/(C2 − C1) on [C1, C2); C3 before, C4 after.
-
-    f' = (C4 − C3) s'(u)/(C2 − C1), f'' = (C4 − C3) s''(u)/(C2 − C1)²; outside the
-    interval both are 0 (at C1 the right-hand limit, inside; at C2 after, so 0).
-    """
-    def law(t, C):
-        c1, c2, c3, c4 = C
-        h = c2 - c1
-        u = (t - c1) / h
-        s, ds, dds = shape(u)
-        inside = (t >= c1) & (t < c2)
-        f = np.where(t < c1, c3, np.where(inside, c3 + (c4 - c3) * s, c4))
-        return (f, np.where(inside, (c4 - c3) * ds / h, 0.0),
-                np.where(inside, (c4 - c3) * dds / h**2, 0.0))
-    return law
-
-
-law_ramp = _blend(lambda u: (u, np.ones_like(u), np.zeros_like(u)))
-law_bezier_c1 = _blend(lambda u: (3 * u**2 - 2 * u**3, 6 * u - 6 * u**2, 6 - 12 * u))
-law_bezier_c2 = _blend(lambda u: (6 * u**5 - 15 * u**4 + 10 * u**3,
-                                  30 * u**4 - 60 * u**3 + 30 * u**2,
-                                  120 * u**3 - 180 * u**2 + 60 * u))
-
-LAWS = {"polynomial": law_polynomial, "harmonic": law_harmonic, "ramp": law_ramp,
-        "bezier_c1": law_bezier_c1, "bezier_c2": law_bezier_c2}
-
-
-def actuator_law(model, name, t):
-    """(f, f', f'') of a model's actuator, by the independent laws above."""
-    el = model[name]
-    C = tuple(float(c) for c in el.C) + (0.0,) * (4 - len(el.C))
-    return LAWS[el.law](np.asarray(t, dtype=float), C)
-
-
 # ---- comparison ------------------------------------------------------------------------
-
-def e(a):
-    return np.stack([np.cos(a), np.sin(a)])
-
-
-def n(a):
-    return np.stack([-np.sin(a), np.cos(a)])
-
-
-def solid(name, r, fi, dr, dfi, ddr, ddfi):
-    """The nine columns of a solid from its origin r (2, k), its angle and their rates."""
-    z = np.zeros_like(np.asarray(fi, dtype=float))
-    out = {}
-    for suffix, value in zip(("x", "y", "fi", "Dx", "Dy", "Dfi", "DDx", "DDy", "DDfi"),
-                              (*r, fi, *dr, dfi, *ddr, ddfi)):
-        out[f"{name}.{suffix}"] = value + z
-    return out
-
-
-def still(name, x, y, fi, k):
-    """A solid at rest at (x, y, fi)."""
-    z = np.zeros(k)
-    return solid(name, (x + z, y + z), fi + z, (z, z), z, (z, z), z)
-
-
-def natural_scales(L, w):
-    """Scale of each variable when its reference is identically ~0."""
-    return {"x": L, "y": L, "fi": 1.0, "Dx": L * w, "Dy": L * w, "Dfi": w,
-            "DDx": L * w * w, "DDy": L * w * w, "DDfi": w * w,
-            "f(t)": 1.0, "Df(t)": w, "ro": L, "Dro": L * w, "fi_rel": 1.0, "Dfi_rel": w}
-
-
-def errors(res, ref, L, w):
-    """{column: max |res − ref| / scale}."""
-    fallback = natural_scales(L, w)
-    out = {}
-    for name, value in ref.items():
-        value = np.broadcast_to(np.asarray(value, dtype=float), res.t.shape)
-        natural = fallback[name.split(".", 1)[1]]
-        scale = float(np.max(np.abs(value)))
-        if scale < 1e-9 * natural:
-            scale = natural
-        out[name] = float(np.max(np.abs(res[name] - value))) / scale
-    return out
-
 
 def assert_matches(res, ref, L, w, rtol=RTOL):
     err = errors(res, ref, L, w)
@@ -160,43 +69,6 @@ def slider_crank(r, l, h, th, dth, ddth):
     ddxB = (-r * np.cos(th) * dth**2 - r * np.sin(th) * ddth
             - l * np.cos(phi) * dphi**2 - l * np.sin(phi) * ddphi)
     return (A, dA, ddA), (phi, dphi, ddphi), (xB, dxB, ddxB)
-
-
-def four_bar(a, b, c, d, th, dth, ddth):
-    """Four-bar O2 = (0, 0), O4 = (d, 0): crank a at θ, coupler b at φ, rocker c at ψ.
-
-    Loop closure: a e(θ) + b e(φ) − c e(ψ) − d e(0) = 0.
-    Position (circle intersection): with A = a e(θ), D = O4 − A, δ = |D|, the joint B
-    is at distance b from A and c from O4, so the angle at A between D and AB is
-    γ = acos((b² + δ² − c²)/(2 b δ)) (law of cosines); the assembly mode with the
-    coupler above the line A-O4 is φ = atan2(D) + γ, and ψ = atan2(B − O4).
-    Velocity: a θ' n(θ) + b φ' n(φ) − c ψ' n(ψ) = 0. Dot with e(ψ) (n(ψ)·e(ψ) = 0):
-        a θ' sin(ψ − θ) + b φ' sin(ψ − φ) = 0  →  φ' = −a θ' sin(ψ − θ)/(b sin(ψ − φ));
-    dot with e(φ):
-        a θ' sin(φ − θ) − c ψ' sin(φ − ψ) = 0  →  ψ' = a θ' sin(φ − θ)/(c sin(φ − ψ)).
-    Acceleration: a θ'' n(θ) − a θ'² e(θ) + b φ'' n(φ) − b φ'² e(φ) − c ψ'' n(ψ)
-    + c ψ'² e(ψ) = 0. Dot with e(ψ):
-        φ'' = (a θ'² cos(θ − ψ) − a θ'' sin(ψ − θ) + b φ'² cos(φ − ψ) − c ψ'²)
-              / (b sin(ψ − φ));
-    dot with e(φ):
-        ψ'' = (a θ'' sin(φ − θ) − a θ'² cos(θ − φ) − b φ'² + c ψ'² cos(ψ − φ))
-              / (c sin(φ − ψ)).
-    (Equivalent to Freudenstein's equation K1 cosψ − K2 cosθ + K3 = cos(θ − ψ) for ψ.)
-    """
-    A = a * e(th)
-    D = np.array([d, 0.0])[:, None] - A
-    delta = np.hypot(D[0], D[1])
-    gamma = np.arccos((b * b + delta**2 - c * c) / (2 * b * delta))
-    phi = np.unwrap(np.arctan2(D[1], D[0]) + gamma)
-    B = A + b * e(phi)
-    psi = np.unwrap(np.arctan2(B[1], B[0] - d))
-    dphi = -a * dth * np.sin(psi - th) / (b * np.sin(psi - phi))
-    dpsi = a * dth * np.sin(phi - th) / (c * np.sin(phi - psi))
-    ddphi = (a * dth**2 * np.cos(th - psi) - a * ddth * np.sin(psi - th)
-             + b * dphi**2 * np.cos(phi - psi) - c * dpsi**2) / (b * np.sin(psi - phi))
-    ddpsi = (a * ddth * np.sin(phi - th) - a * dth**2 * np.cos(th - phi) - b * dphi**2
-             + c * dpsi**2 * np.cos(psi - phi)) / (c * np.sin(phi - psi))
-    return (phi, dphi, ddphi), (psi, dpsi, ddpsi)
 
 
 def polar(Q, dQ, ddQ):
@@ -283,7 +155,6 @@ def test_slider_crank_angles_not_wrapped(slider_crank_run):
 
 # ---- four-bar (examples/four_bar.toml) ---------------------------------------------------
 
-FOUR_BAR = dict(a=0.1, b=0.35, c=0.3, d=0.4)
 COUPLER_P = np.array([0.2, 0.1])
 SPRING_ANCHOR = np.array([0.25, -0.15])
 
