@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import SolverError
-from ..kinematics import Quantity, generalized_force, rotate, torque
+from ..kinematics import Quantity, column, generalized_force, rotate, torque
 from .base import FORCE, POSITION, VELOCITY, Element, Load, Param, Var, constants
 
 
@@ -47,7 +47,7 @@ class Torsor(Element):
         fx, fy, m = constants(self.C, 3)
         solid, local = self.ref1.solid, self.ref1.local
         if self.axes == "solid":
-            force = rotate(st.q[:, 3 * solid + 2], np.array([fx, fy]))
+            force = rotate(st.q[:, column(solid, 2)], np.array([fx, fy]))
         else:
             force = np.broadcast_to([fx, fy], (st.n, 2))
         return Load(_add(generalized_force(st.point(solid, local), force),
@@ -71,7 +71,7 @@ class Torsor(Element):
         p = st.point(solid, local).value[0]
         force = np.array([fx, fy])
         if self.axes == "solid":
-            force = rotate(st.q[:, 3 * solid + 2], force)[0]
+            force = rotate(st.q[:, column(solid, 2)], force)[0]
         if fx or fy:
             pen.force(p, force)
         if m:
@@ -155,10 +155,20 @@ class Spring(_SpringDamper):
 
     def build(self, ex):
         c1, c2, c3, c4 = constants(self.C)
+        damping = c4 if ex.velocity_forces else 0.0
+        markers = [ex.point_marker(self.ref1), ex.point_marker(self.ref2)]
+        if c2 >= 0 and c3 >= 0:
+            ex.add(self, ex.items.ObjectConnectorSpringDamper(
+                markerNumbers=markers, referenceLength=c3, stiffness=c2, damping=damping,
+                force=c1))
+            return
+
+        # Exudyn refuses a negative stiffness or free length: the same law as a force
+        # function of ro = deltaL (referenceLength 0)
+        def law(mbs, t, item, ro, rate, stiffness, damping_, force):
+            return c1 + c2 * (ro - c3) + damping * rate
         ex.add(self, ex.items.ObjectConnectorSpringDamper(
-            markerNumbers=[ex.point_marker(self.ref1), ex.point_marker(self.ref2)],
-            referenceLength=c3, stiffness=c2, damping=c4 if ex.velocity_forces else 0.0,
-            force=c1))
+            markerNumbers=markers, springForceUserFunction=law))
 
     def draw(self, pen, st):
         """A zigzag between the two points."""

@@ -258,3 +258,22 @@ def test_redundant_parallelogram_reactions_are_minimum_norm(data, analysis):
         a = np.zeros((len(res.t), 2))
     total = sum(np.column_stack([res[f"{j}.Fx"], res[f"{j}.Fy"]]) for j in ("A1", "A2", "A3"))
     np.testing.assert_allclose(total + [0.0, -m * 9.81], m * a, rtol=0, atol=1e-9 * m * 9.81)
+
+
+@pytest.mark.parametrize("k, C", [(1, -50.0), (2, -0.1)], ids=["negative stiffness",
+                                                             "negative free length"])
+def test_spring_constants_exudyn_refuses_are_translated_exactly(k, C):
+    """F = C1 + C2 (ro − C3) holds for any C2 and C3 (the contract); Exudyn's
+    ObjectConnectorSpringDamper refuses C2 < 0 and C3 < 0 (fuzz seed 8245), so they are
+    given to it as a force function of ro. Exudyn's multipliers balance the native forces,
+    and the spring force is the formula."""
+    model = pam2exu.load(ALL)
+    spring = model["return_spring"]
+    constants = list(spring.C)
+    constants[k] = C
+    spring.C = constants
+    res = pam2exu.run(model, analysis="quasi_static", steps=10)
+    assert res.info["equilibrium_error"] < 1e-12
+    c1, c2, c3, _ = constants
+    np.testing.assert_allclose(res["return_spring.Força"],
+                               c1 + c2 * (res["return_spring.ro"] - c3), rtol=1e-14, atol=1e-12)
