@@ -43,8 +43,9 @@ def run(model, analysis=None, **settings):
         velocities, accelerations) or ``'kinetostatic'`` (kinematic, plus every reaction
         and actuator force by inverse dynamics). Default: the model's analysis type.
     **settings
-        Keyword overrides of the model's settings: ``t_end``, ``steps``, ``outputs`` and
-        ``solver``, described below. None (the default of each) keeps the model's.
+        Keyword overrides of the model's settings: ``t_end``, ``steps``, ``outputs``,
+        ``solver`` and ``backend``, described below. None (the default of each) keeps the
+        model's.
     t_end : float, optional
         End of the interval [0, t_end] [s].
     steps : int, optional
@@ -55,9 +56,12 @@ def run(model, analysis=None, **settings):
         ``crank.*``, ``*.Fx`` or a bare ``Fx`` (every ``*.Fx``); only what they need is
         computed.
     solver : pam2exu.backend.SolveSettings, optional
-        Exudyn's static solver settings: ``tolerance`` (Newton's absolute tolerance
-        relative to the mechanism's length, default 1e-13), ``max_iterations``, ``dense``,
-        ``verbose``.
+        The backend's settings; for Exudyn, its static solver's: ``tolerance`` (Newton's
+        absolute tolerance relative to the mechanism's length, default 1e-13),
+        ``max_iterations``, ``dense``, ``verbose``, ``predictor``.
+    backend : str, optional
+        What solves the positions (``pam2exu.registry.BACKENDS``): ``'exudyn'`` (the
+        default); an unknown name is a ModelError listing the known ones.
 
     Returns
     -------

@@ -14,6 +14,7 @@ import warnings
 
 from . import __version__
 from .errors import ModelError, Pam2ExuError, SolverError
+from .registry import ANALYSES, BACKENDS, DEFAULT_BACKEND
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -28,9 +29,12 @@ def _parser() -> argparse.ArgumentParser:
                                      "table, overridden by the options).")
     run.add_argument("model", help="model file (TOML)")
     run.add_argument("--analysis", "-a", metavar="TYPE",
-                     help="assembly, kinematic, quasi_static or kinetostatic (or PAM's "
-                          "Catalan names: ensamblatge, cinematica, quasi_estatica, "
-                          "cinetostatica)")
+                     help=", ".join(ANALYSES) + " (or PAM's Catalan names: "
+                          + ", ".join(a.alias for a in ANALYSES.values()) + ")")
+    run.add_argument("--backend", metavar="NAME",
+                     help="what solves the positions: " + ", ".join(BACKENDS)
+                          + f" (default: the model's [analysis] backend, else "
+                            f"{DEFAULT_BACKEND})")
     run.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
     run.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
     run.add_argument("--outputs", nargs="+", metavar="PAT",
@@ -53,6 +57,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="the analysis to check for (default: the model's)")
     check.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
     check.add_argument("--steps", type=int, metavar="N", help="number of intervals")
+    check.add_argument("--backend", metavar="NAME",
+                       help="what solves the positions: " + ", ".join(BACKENDS))
 
     elements = sub.add_parser(
         "elements", help="the element types: keys, anchors, outputs and sign conventions",
@@ -153,15 +159,18 @@ def _picture_parsers(sub) -> None:
 
 def _run(args) -> int:
     from .analyses import run
-    from .backend import SolveSettings
-    solver = SolveSettings(verbose=1 if args.verbose else 0)
+    from .model import load
+    model = load(args.model)
+    backend = BACKENDS.get(args.backend or model.analysis.backend)
+    # the backend's settings (an unknown name: run's model error names the known ones)
+    solver = backend.create().Settings(verbose=1 if args.verbose else 0) if backend else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # warnings are carried in res.warnings
         outputs = args.outputs
         if outputs and args.plot:
             outputs = [*outputs, *args.plot]      # the plotted variables are computed too
-        res = run(args.model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
-                  outputs=outputs, solver=solver)
+        res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
+                  outputs=outputs, solver=solver, backend=args.backend)
     table = res.select(args.outputs) if args.outputs and args.plot else res
     if args.output:
         path = table.to_csv(args.output)
@@ -196,7 +205,7 @@ def _check(args) -> int:
 
     from .analyses.common import check_mobility, prepare
     from .analyses.native import require_driven
-    job = prepare(args.model, args.analysis, args.t_end, args.steps)
+    job = prepare(args.model, args.analysis, args.t_end, args.steps, backend=args.backend)
     mech = job.mech
     model = mech.model
     mob = check_mobility(job, mech.initial_q(), need_driven=False)
@@ -211,8 +220,9 @@ def _check(args) -> int:
         print(f"condition number of the constraint Jacobian at the initial guess: "
               f"{mob.condition:.3g}")
     steps = (len(job.times) - 1) // job.every
+    at_start = ANALYSES[job.analysis].at_start
     print(f"analysis: {job.analysis}, t = 0 … {job.times[-1]:g} s in {steps} steps"
-          if job.analysis != "assembly" else "analysis: assembly, t = 0")
+          if not at_start else f"analysis: {job.analysis}, t = 0")
     if job.every > 1:
         name, moved, unit = job.motion
         print(f"'{name}' moves {moved:.3g} {unit} per step: positions are solved in "
@@ -224,7 +234,7 @@ def _check(args) -> int:
     for e in mech.elements:
         anchors = ", ".join(str(getattr(e, f"anc{k + 1}")) for k in range(len(e.anchors)))
         print(f"  {e.name:<{width}}  {e.type:<17} {anchors}")
-    if job.analysis != "assembly":
+    if ANALYSES[job.analysis].driven:
         sys.stdout.flush()
         require_driven(mech, mob, job.analysis)
     return 0

@@ -1,7 +1,8 @@
 """Planar rigid-body kinematics, vectorised over all time steps at once.
 
-The generalized coordinates of solid i are q[3i:3i+3] = (x, y, fi): the origin of its
-local frame and the angle of its x axis. A point fixed at s in the local frame is at
+The generalized coordinates of solid i are q[pose(i)] = q[3i:3i+3] = (x, y, fi): the
+origin of its local frame and the angle of its x axis (the layout is written down once,
+below: ``pose``, ``column``, ``ANGLES``). A point fixed at s in the local frame is at
 r = R + A(fi) s. A *quantity* is anything built from points, directions and angles
 (differences, dot products, lengths) together with what the velocity and acceleration
 analyses need of it:
@@ -18,6 +19,24 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
+
+# ---- the layout of q: (x, y, fi) of each solid in order -----------------------------------
+
+#: coordinates per solid: x, y, fi
+PER_SOLID = 3
+#: the angles fi of every solid, in q or in a row of it (``q[..., ANGLES]``)
+ANGLES = slice(2, None, PER_SOLID)
+
+
+def pose(solid: int) -> slice:
+    """q[pose(i)] = (x, y, fi) of solid i."""
+    return slice(PER_SOLID * solid, PER_SOLID * solid + PER_SOLID)
+
+
+def column(solid: int, k: int) -> int:
+    """The column of x (k = 0), y (1) or fi (2) of solid i in q."""
+    return PER_SOLID * solid + k
 
 
 def rotate(fi, v):
@@ -92,7 +111,7 @@ class Quantity:
         """Write dv/dq into rows row… of a full Jacobian (n, m, 3·solids), zero there before."""
         d = self.value.shape[1]
         for solid, block in self.jac.items():
-            jacobian[:, row:row + d, 3 * solid:3 * solid + 3] = block
+            jacobian[:, row:row + d, pose(solid)] = block
 
 
 def _add(a, b):
@@ -126,8 +145,8 @@ class State:
         self.n = self.q.shape[0]
 
     def coordinate(self, solid: int, k: int) -> Quantity:
-        """v = q[3 solid + k]: x (k=0), y (k=1) or fi (k=2) of a solid."""
-        col = 3 * solid + k
+        """v = q[column(solid, k)]: x (k=0), y (k=1) or fi (k=2) of a solid."""
+        col = column(solid, k)
         block = np.zeros((self.n, 1, 3))
         block[:, 0, k] = 1.0
         rate = conv = None
@@ -140,19 +159,19 @@ class State:
         return self.coordinate(solid, 2)
 
     def _rotated(self, solid: int, local, translate: bool) -> Quantity:
-        fi = self.q[:, 3 * solid + 2]
-        As = rotate(fi, np.asarray(local, dtype=float))
+        x, y, fi = (column(solid, k) for k in range(PER_SOLID))
+        As = rotate(self.q[:, fi], np.asarray(local, dtype=float))
         block = np.zeros((self.n, 2, 3))
         if translate:
             block[:, 0, 0] = block[:, 1, 1] = 1.0
         block[:, :, 2] = perp(As)
-        value = As + self.q[:, 3 * solid:3 * solid + 2] if translate else As
+        value = As + self.q[:, x:y + 1] if translate else As
         rate = conv = None
         if self.qd is not None:
-            w = self.qd[:, 3 * solid + 2:3 * solid + 3]
+            w = self.qd[:, fi:fi + 1]
             rate = w * perp(As)
             if translate:
-                rate = rate + self.qd[:, 3 * solid:3 * solid + 2]
+                rate = rate + self.qd[:, x:y + 1]
             conv = -(w * w) * As
         return Quantity(value, {solid: block}, rate, conv)
 

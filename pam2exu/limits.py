@@ -25,6 +25,8 @@ T_END = (1e-9, 1e9)
 STEPS = 10_000_000
 #: characters of a solid's or element's name
 NAME = 100
+#: characters of the model's name (titles of pictures and tables show it whole)
+MODEL_NAME = 200
 #: position solves of one run: steps × the sub-steps that keep the motion per solve small
 SOLVE_STEPS = 2_000_000
 #: bytes of the arrays one run holds (coordinates, rates and result columns)

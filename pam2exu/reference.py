@@ -22,14 +22,7 @@ from .elements import ACCELERATION, ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY
 from .errors import closest
 from .laws import LAW_ALIASES, LAWS
 from .model.solid import SOLID_OUTPUTS
-
-#: which analyses give a variable of each level (PAM's analyses; assembly gives x, y, fi)
-ANALYSES_OF_LEVEL = {
-    POSITION: ("quasi_static", "kinematic", "kinetostatic"),
-    VELOCITY: ("kinematic", "kinetostatic"),
-    ACCELERATION: ("kinematic", "kinetostatic"),
-    FORCE: ("quasi_static", "kinetostatic"),
-}
+from .registry import analyses_giving
 
 _ANCHOR_FORMS = {
     "solid": "a solid name",
@@ -74,7 +67,8 @@ def _default(cls: type[Element], key: str) -> str:
 
 
 def _analyses(level: str) -> str:
-    return ", ".join(ANALYSES_OF_LEVEL[level])
+    """The analyses giving a variable of ``level`` (``registry.analyses_giving``)."""
+    return ", ".join(analyses_giving(level))
 
 
 def _first_line(function) -> str:

@@ -13,11 +13,12 @@ from pathlib import Path
 import pytest
 
 from pam2exu import reference
-from pam2exu.analyses.common import LEVELS, SOLID_OUTPUTS
-from pam2exu.elements import ALIASES, ELEMENTS, FORCE
+from pam2exu.analyses.common import SOLID_OUTPUTS
+from pam2exu.elements import ACCELERATION, ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY
 from pam2exu.laws import LAW_ALIASES, LAWS
 from pam2exu.model.model import Analysis
 from pam2exu.model.solid import Solid
+from pam2exu.registry import ANALYSES
 
 ROOT = Path(__file__).resolve().parents[1]
 CONTRACT = (ROOT / "tests" / "data" / "model-format-contract.md").read_text(encoding="utf-8")
@@ -101,13 +102,21 @@ def test_law_table_matches_the_contract():
 def test_solid_and_analysis_keys_match_the_contract():
     solid_keys = [k for r in _rows("Solids") for k in r[0].split(", ")]
     assert solid_keys == [f.name for f in dataclasses.fields(Solid) if f.name != "position"]
-    assert [r[0] for r in _rows("Analysis")] == [f.name for f in dataclasses.fields(Analysis)]
+    assert [r[0] for r in _rows("Analysis")] == [f.name for f in dataclasses.fields(Analysis)
+                                                 if f.name not in Analysis.EXTENSIONS]
+    assert Analysis.EXTENSIONS == ("backend",)       # documented in docs/model-format.md
 
 
 def test_levels_of_the_reference_are_those_the_analyses_use():
-    for level, analyses in reference.ANALYSES_OF_LEVEL.items():
-        assert set(analyses) == {a for a, levels in LEVELS.items()
-                                 if level in levels and a != "assembly"}
+    """Which analyses give each kind of output (the contract's analysis table: assembly
+    gives only the solids' x, y, fi), as the registry declares and the pages say."""
+    expected = {POSITION: "quasi_static, kinematic, kinetostatic",
+                VELOCITY: "kinematic, kinetostatic", ACCELERATION: "kinematic, kinetostatic",
+                FORCE: "quasi_static, kinetostatic"}
+    for level, analyses in expected.items():
+        assert reference._analyses(level) == analyses
+        assert set(analyses.split(", ")) == {a.name for a in ANALYSES.values()
+                                             if level in a.levels and not a.at_start}
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
@@ -194,3 +203,4 @@ def test_the_ranges_on_the_model_format_page_are_those_of_limits():
         assert f"{value:.0e}" in section, value
     assert f"{limits.STEPS:,}" in section and f"{limits.SOLVE_STEPS:,}" in section
     assert f"{limits.MEMORY // 2**30} GiB" in section and f"at most {limits.NAME}" in section
+    assert f"at most {limits.MODEL_NAME} characters" in section

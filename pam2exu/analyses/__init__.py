@@ -1,24 +1,19 @@
-"""The analyses of PAM; ``ANALYSES`` is the registry from type name to function.
+"""The analyses of PAM, each declared in ``pam2exu.registry.ANALYSES`` (its names, what it
+gives, what it needs, and its function in a module of this package).
 
 ``run`` runs one (``pam2exu.run`` is the same); the warning classes are those the checks
 after an analysis issue.
 """
 from __future__ import annotations
 
-from ..errors import Pam2ExuError, SolverError
-from .assembly import assembly
-from ..errors import ConditionWarning, ConsistencyWarning, RedundancyWarning
+from ..errors import (ConditionWarning, ConsistencyWarning, Pam2ExuError, RedundancyWarning,
+                      SolverError)
+from ..registry import ANALYSES
 from .common import prepare
-from .kinematic import kinematic
-from .kinetostatic import kinetostatic
-from .quasi_static import quasi_static
-
-#: analysis type -> function(Job) -> Results
-ANALYSES = {"assembly": assembly, "quasi_static": quasi_static, "kinematic": kinematic,
-            "kinetostatic": kinetostatic}
 
 
-def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None):
+def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
+        backend=None):
     """Run an analysis and return its Results.
 
     ``pam2exu.run`` is this function, with ``t_end``, ``steps``, ``outputs`` and ``solver``
@@ -38,8 +33,11 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None)
         Number of intervals; results have steps + 1 rows.
     outputs : list of str, optional
         Names or patterns of the columns to compute and keep.
-    solver : backend.SolveSettings, optional
-        Exudyn solver settings.
+    solver : optional
+        The backend's settings (``backend.SolveSettings`` for Exudyn); default: its defaults.
+    backend : str, optional
+        What solves the positions (``registry.BACKENDS``: 'exudyn'); default: the model's
+        [analysis] backend.
 
     Returns
     -------
@@ -72,8 +70,8 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None)
     """
     job = None
     try:
-        job = prepare(model, analysis, t_end, steps, outputs, solver)
-        return ANALYSES[job.analysis](job)
+        job = prepare(model, analysis, t_end, steps, outputs, solver, backend)
+        return ANALYSES[job.analysis].run(job)
     except Pam2ExuError:
         raise
     except Exception as exc:         # a fault of pam2exu: say what was being done

@@ -15,7 +15,7 @@ def assembly(job: Job):
     forces only select among solutions; the constraints are met exactly).
     """
     q0 = job.mech.initial_q()
-    mob = check_mobility(job, q0, need_driven=False)
+    mob = check_mobility(job, q0)
     stiffness = GUESS_STIFFNESS if mob.dof > 0 else 0.0
     q = positions(job, redundant=mob.redundant > 0, anchor_stiffness=stiffness)
     return collect(job, q)

@@ -18,11 +18,14 @@ force analyses stop (the reactions are not defined there).
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import ConditionWarning, SolverError
+from ..kinematics import ANGLES
 from . import native
-from .common import Job, _position_failure, check_residual, singular_error, warn
+from .common import Job, _position_failure, check_residual, positions, singular_error, warn
 
 #: a velocity jump between two steps above this fraction of the velocities' scale is
 #: taken as a possible branch switch (smooth motion: O((ω dt)³) of it)
@@ -61,12 +64,9 @@ def _breakpoints(mech) -> list[float]:
 
 
 def _resolve(job: Job, k: int, start: np.ndarray, redundant: bool):
-    """(positions, steps solved, system): Exudyn at steps k… from ``start`` at step k."""
-    from ..backend import ExudynSystem, SolveSettings
-    system = ExudynSystem(job.mech, start=start)
-    part, solved = system.solve_positions(job.times[k:], job.solver or SolveSettings(),
-                                          redundant=redundant)
-    return part, solved, system
+    """The backend's Positions at steps k… from ``start`` at step k."""
+    return job.backend.solve_positions(job.mech, job.times[k:], start, job.solver,
+                                       redundant=redundant)
 
 
 def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: bool = True):
@@ -76,9 +76,9 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
     singular_ok: steps exactly at a singular position get interpolated rates (with a
     warning); False: they raise a SolverError (force analyses).
     """
-    from .common import positions
     mech, t = job.mech, job.times
-    q, solved, system = positions(job, redundant, check=False, partial=True)
+    q, found = positions(job, redundant, check=False, partial=True)
+    solved = found.solved
     breakpoints = _breakpoints(mech)
     verified: set[int] = set()
     resolves = spent = 0              # re-solves, and the position solves they took
@@ -106,7 +106,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
             k = _first_jump(defect, singular, verified)
         if k is None:
             if solved < len(t):
-                raise _position_failure(job, system, q, solved)
+                raise _position_failure(job, replace(found, q=q, solved=solved))
             break
         j = k - 1
         while singular[j]:
@@ -116,7 +116,8 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
             raise _keeps_switching(job, k, resolves, spent)
         h = t[k] - t[j]
         start = q[j] + h * qd[j] + 0.5 * h * h * qdd[j]
-        part, part_solved, part_system = _resolve(job, k, start, redundant)
+        part_found = _resolve(job, k, start, redundant)
+        part, part_solved = part_found.q, part_found.solved
         if part_solved:
             part = _unturn(mech, t[k:k + part_solved], part, part_solved, start)
         resolves += 1
@@ -135,14 +136,14 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
                 if differs.size:     # the switch happened at step f: go on from there
                     k = j0 + int(differs[0])
                     spent += len(t) - k
-                    part, part_solved, part_system = _resolve(
-                        job, k, tracked[differs[0]], redundant)
+                    part_found = _resolve(job, k, tracked[differs[0]], redundant)
+                    part, part_solved = part_found.q, part_found.solved
                     verdict = "better" if part_solved else "worse"
         if verdict == "worse" or (verdict == "same" and k + part_solved <= solved):
             continue                 # no switch (a coarse grid), or no better branch found
         q = q.copy()
         q[k:] = part
-        solved, system = k + part_solved, part_system
+        solved, found = k + part_solved, part_found
     job.info["branch_resolves"] = resolves
     if singular.any():
         qd, qdd = _interpolate_singular(t, qd, qdd, singular)
@@ -185,20 +186,18 @@ def _unwrap(mech, t, q, qd, solved):
     if not turns.any():
         return q
     out = q.copy()
-    out[:solved, 2::3] -= 2 * np.pi * np.cumsum(turns, axis=0)
+    out[:solved, ANGLES] -= 2 * np.pi * np.cumsum(turns, axis=0)
     before = np.max(np.abs(native.residuals(mech, t, q[:solved])))
     after = np.max(np.abs(native.residuals(mech, t, out[:solved])))
     return out if after <= max(before, 1e-12 * mech.scale()) * 10 else q
 
 
 def _track(job: Job, j0: int, k1: int, start, redundant: bool, count: int = SUBSTEPS):
-    """Configurations at steps j0…k1 reached from step j0 in ``count`` Exudyn steps per
-    step (Newton then follows the branch closely), or None if Exudyn fails."""
-    from ..backend import ExudynSystem, SolveSettings
+    """Configurations at steps j0…k1 reached from step j0 in ``count`` backend steps per
+    step (Newton then follows the branch closely), or None if the backend fails."""
     times = np.linspace(job.times[j0], job.times[k1], (k1 - j0) * count + 1)
-    fine, solved = ExudynSystem(job.mech, start=start).solve_positions(
-        times, job.solver or SolveSettings(), redundant=redundant)
-    return fine[::count] if solved == len(times) else None
+    fine = job.backend.solve_positions(job.mech, times, start, job.solver, redundant=redundant)
+    return fine.q[::count] if fine.solved == len(times) else None
 
 
 def _unturn(mech, t, part, solved, start):
@@ -208,7 +207,7 @@ def _unturn(mech, t, part, solved, start):
     if not turns.any():
         return part
     out = part.copy()
-    out[:, 2::3] -= 2 * np.pi * turns
+    out[:, ANGLES] -= 2 * np.pi * turns
     return out
 
 
@@ -280,9 +279,8 @@ def _interpolate_singular(t, qd, qdd, singular):
 def _warn_ill_conditioned(job: Job, q, singular, near=()) -> None:
     """Warn when the constraint Jacobian is ill-conditioned somewhere: at sampled steps,
     and at the steps ``near`` singular positions or velocity jumps."""
-    from ..backend import SolveSettings
     mech, t = job.mech, job.times
-    tolerance = (job.solver or SolveSettings()).tolerance
+    tolerance = job.solver.tolerance
     if mech.n_equations == 0:
         return
     # an SVD costs ~nq³: fewer samples for large mechanisms

@@ -12,19 +12,13 @@ import numpy as np
 from ..elements import ACCELERATION, FORCE, POSITION, VELOCITY, Var
 from ..errors import (ConditionWarning, ConsistencyWarning, ModelError, Problem,
                       RedundancyWarning, SolverError, TranslationError)
-from ..kinematics import State
+from ..kinematics import ANGLES, State, column
+from .. import registry
+from ..backend import Backend, Positions
 from ..model import Model, load
 from ..model.solid import SOLID_OUTPUTS
 from ..results import Results, select_columns
 from . import grid, loops, native
-
-#: what each analysis provides (as in PAM)
-LEVELS = {
-    "assembly": {POSITION},
-    "quasi_static": {POSITION, FORCE},
-    "kinematic": {POSITION, VELOCITY, ACCELERATION},
-    "kinetostatic": {POSITION, VELOCITY, ACCELERATION, FORCE},
-}
 
 #: constraint residual above this (× the length scale) means a wrong translation
 RESIDUAL_TOLERANCE = 1e-8
@@ -44,7 +38,9 @@ class Job:
     columns: list[str]
     units: dict[str, str]
     levels: set[str]
-    solver: object = None
+    #: what solves the positions, and its settings (``backend.Settings``)
+    backend: Backend
+    solver: object
     warnings: list[str] = field(default_factory=list)
     info: dict = field(default_factory=dict)
     every: int = 1
@@ -56,59 +52,67 @@ class Job:
 
 def available_columns(mech, analysis: str) -> dict[str, Var]:
     """Every column the analysis can produce, in order: solids, then elements."""
-    levels = LEVELS[analysis]
+    kind = registry.ANALYSES[analysis]
     out = {}
     for s in mech.solids:
         for var in SOLID_OUTPUTS:
-            if var.level in levels:
+            if var.level in kind.levels:
                 out[f"{s.name}.{var.name}"] = var
-    if analysis == "assembly":
+    if kind.at_start:
         return out
     for el in mech.elements:
         for var in el.outputs:
-            if var.level in levels:
+            if var.level in kind.levels:
                 out[f"{el.name}.{var.name}"] = var
     return out
 
 
-def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None) -> Job:
-    """Load and validate the model, apply the overrides, choose the columns."""
+def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
+            backend=None) -> Job:
+    """Load and validate the model, apply the overrides, choose the columns and the backend
+    (``solver``: the backend's settings, default ``backend.Settings()``)."""
     if not isinstance(model, Model):
         model = load(model)
     settings = replace(model.analysis, **{k: v for k, v in
                                           dict(type=analysis, t_end=t_end, steps=steps,
-                                               outputs=outputs).items() if v is not None})
+                                               outputs=outputs, backend=backend).items()
+                                          if v is not None})
     problems = [Problem("[analysis]", m) for m in settings.problems()]
     if problems:
         raise ModelError(problems, model.source)
     mech = model.mechanism()
-    kind = settings.type
-    available = available_columns(mech, kind)
+    kind = registry.ANALYSES[settings.type]
+    available = available_columns(mech, kind.name)
     try:
         columns = select_columns(list(available), settings.outputs)
     except ModelError as exc:
         raise ModelError(exc.problems, model.source) from None
-    if kind == "assembly":
+    if kind.at_start:
         plan = grid.Plan(np.zeros(1), 1, None)
         grid.check_laws(mech, plan.times)        # the actuators' values at t = 0
     else:
         plan = grid.plan(mech, settings.t_end, settings.steps, len(columns))
     levels = {available[c].level for c in columns} | {POSITION}
-    if FORCE in levels and kind == "kinetostatic":
+    if FORCE in levels and ACCELERATION in kind.levels:
         levels.add(ACCELERATION)                 # the inertia forces need qdd
     if ACCELERATION in levels:
         levels.add(VELOCITY)
-    job = Job(mech, kind, plan.times, columns, {c: available[c].unit for c in columns},
-              levels, solver, every=plan.every, motion=plan.motion)
+    engine = registry.BACKENDS[settings.backend].create()
+    job = Job(mech, kind.name, plan.times, columns, {c: available[c].unit for c in columns},
+              levels, engine, solver if solver is not None else engine.Settings(),
+              every=plan.every, motion=plan.motion)
     if plan.every > 1:
         job.info["substeps"] = plan.every
     return job
 
 
 
-def check_mobility(job: Job, q0: np.ndarray, need_driven: bool) -> native.Mobility:
-    """Rank test at the initial guess, before any Exudyn call (``warn_redundant`` follows
-    once positions are solved)."""
+def check_mobility(job: Job, q0: np.ndarray, need_driven: bool | None = None) -> native.Mobility:
+    """Rank test at the initial guess, before the backend is called (``warn_redundant``
+    follows once positions are solved); ``need_driven`` (default: what the analysis
+    declares, ``AnalysisType.driven``) raises MobilityError for a DOF not driven."""
+    if need_driven is None:
+        need_driven = registry.ANALYSES[job.analysis].driven
     native.require_defined(job.mech, float(job.times[0]), q0)
     mob = native.mobility(job.mech, float(job.times[0]), q0)
     job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
@@ -142,77 +146,69 @@ def warn(job: Job, text: str, category) -> None:
 
 
 def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
-              forces: bool = False, check: bool = True, partial: bool = False):
-    """Positions at every time from Exudyn's static solver; raises SolverError on failure.
+              check: bool = True, partial: bool = False):
+    """Positions at every time from the backend; raises SolverError on failure.
 
-    With ``forces`` the Exudyn system also has the masses, gravity and force elements
-    (without dampers), and its multipliers are kept: returns (q, system) then, else q.
     ``check=False`` leaves the residual check to ``velocities`` (which has the residual).
-    ``partial``: a failure after the first step is not raised; returns (q, solved, system)
-    with the rows from ``solved`` on NaN (``branch.motion`` may still repair it).
+    ``partial``: a failure after the first step is not raised; returns (q, Positions) with
+    the rows from ``Positions.solved`` on NaN (``branch.motion`` may still repair it).
     """
-    from ..backend import ExudynSystem, SolveSettings
     mech = job.mech
     clock = _time.perf_counter()
-    job.stage = "solving the positions with Exudyn's static solver"
+    job.stage = f"solving the positions with {job.backend.solver_name}"
     start = assemble(job, redundant, anchor_stiffness)
-    if len(job.times) == 1 and not forces:          # the assembly itself
-        q, solved, system = start[None], 1, None
+    if len(job.times) == 1:                      # the assembly itself
+        found = Positions(start[None], 1, None, start)
     else:
-        system = ExudynSystem(mech, forces=forces, velocity_forces=False, start=start)
-        q, solved = system.solve_positions(job.times, job.solver or SolveSettings(),
-                                           redundant=redundant, multipliers=forces)
-        if solved:               # step 0 is the assembly (Newton moved it by round-off)
-            q[0] = start
+        found = job.backend.solve_positions(mech, job.times, start, job.solver,
+                                            redundant=redundant)
+        if found.solved:         # step 0 is the assembly (Newton moved it by round-off)
+            found.q[0] = start
     job.info["exudyn_seconds"] = _time.perf_counter() - clock
 
-    if solved < len(job.times) and not (partial and solved > 0):
-        raise _position_failure(job, system, q, solved)
+    if found.solved < len(job.times) and not (partial and found.solved > 0):
+        raise _position_failure(job, found)
     if check:
-        check_residual(mech, job.times, q, job)
+        check_residual(mech, job.times, found.q, job)
     if redundant:
-        warn_redundant(job, q[0])
-    if partial:
-        return q, solved, system
-    return (q, system) if forces else q
+        warn_redundant(job, found.q[0])
+    return (found.q, found) if partial else found.q
 
 
 def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.ndarray:
-    """x, y, fi of every solid at the first time, solved by Exudyn from the model's guess.
+    """x, y, fi of every solid at the first time, solved by the backend from the model's guess.
 
     What the assembly analysis returns, and where every other analysis starts: each angle
     keeps the whole turn nearest its guess where the constraints allow (Newton's iteration
     may land a whole turn away, and the guess says which numbering the user means).
-    ``anchor_stiffness``: see ``ExudynSystem`` (free degrees of freedom).
+    ``anchor_stiffness``: see ``Backend.solve_positions`` (free degrees of freedom).
     """
-    from ..backend import ExudynSystem, SolveSettings
     mech = job.mech
-    system = ExudynSystem(mech, anchor_stiffness=anchor_stiffness)
-    t0 = job.times[:1]
-    q, solved = system.solve_positions(t0, job.solver or SolveSettings(), redundant=redundant)
-    if not solved:
-        raise _position_failure(job, system, q, 0)
     guess = mech.initial_q()
-    q0 = q[0].copy()
-    q0[2::3] -= 2 * np.pi * native.whole_turns(mech, float(t0[0]), q0, guess)
+    found = job.backend.solve_positions(mech, job.times[:1], guess, job.solver,
+                                        redundant=redundant, anchor_stiffness=anchor_stiffness)
+    if not found.solved:
+        raise _position_failure(job, found)
+    q0 = found.q[0].copy()
+    q0[ANGLES] -= 2 * np.pi * native.whole_turns(mech, float(job.times[0]), q0, guess)
     return q0
 
 
-def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverError:
-    """The error for Exudyn's static solver stopping at step ``solved``, with a diagnosis.
+def _position_failure(job: Job, found: Positions) -> SolverError:
+    """The error for the backend's solver stopping at step ``found.solved``, with a diagnosis.
 
     A least-squares solve at the failing time (native, for the message only) tells whether
     the constraints can hold there. If they cannot, after the previous step did: the
     motion went through a limit position, where the Jacobian is singular (dead point).
     """
-    mech, times = job.mech, job.times
+    mech, times, q, solved = job.mech, job.times, found.q, found.solved
     t = float(times[solved])
-    start = q[solved - 1] if solved > 0 else system.coordinates()
-    from ..backend import SolveSettings
+    start = q[solved - 1] if solved > 0 else found.last
+    said = f"{job.backend.label} said: {found.error}"
     left, _ = native.closest_violation(mech, t, start)
     # Newton aims at tolerance × L: what the closest configuration leaves above 1000 times
     # that cannot be closed
-    can_hold = 1e3 * (job.solver or SolveSettings()).tolerance * mech.scale()
+    can_hold = 1e3 * job.solver.tolerance * mech.scale()
     worst = [w for w in native.worst_elements(mech, left, len(mech.constraints))
              if w[1] > can_hold]
     # actuators and fixed links can always hold on their own: name the joints, if any
@@ -246,7 +242,7 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
             f"the constraints of {names} contradict each other {since} ({step}): they are "
             f"redundant (between them they fix a coordinate more than once) and their targets "
             f"disagree by {disagreement:.3g} (m or rad), so no configuration satisfies them "
-            f"all.{which} Exudyn said: {system.error}",
+            f"all.{which} {said}",
             time=t, step=solved // job.every,
             elements=tuple(f"'{e.name}' ({e.type})" for e in concerned))
     if worst and solved == 0:
@@ -260,7 +256,7 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
             f"the mechanism cannot be assembled at t = {t:.6g} s: "
             + (f"{loop.text}. " if loop else "")
             + f"The constraints cannot all hold: still violated at the closest configuration: "
-              f"{violated}. Exudyn said: {system.error}", time=t, step=0, elements=elements)
+              f"{violated}. {said}", time=t, step=0, elements=elements)
     if worst:
         t0 = float(times[solved - 1])
         return SolverError(
@@ -270,31 +266,31 @@ def _position_failure(job: Job, system, q: np.ndarray, solved: int) -> SolverErr
             f"the constraints cannot all hold (still violated at the closest "
             f"configuration: {violated}). Drive the mechanism by another member, change the "
             f"law so it stays within the limit, or end the interval before t = {t0:.6g} s. "
-            f"Exudyn said: {system.error}", time=t0, step=solved // job.every,
+            f"{said}", time=t0, step=solved // job.every,
             elements=elements)
     if solved == 0:
         return SolverError(
-            f"Exudyn's static solver did not converge at t = {t:.6g} s (the assembly): the "
+            f"{job.backend.solver_name} did not converge at t = {t:.6g} s (the assembly): the "
             "constraints can all hold there, but the Newton iteration diverged from the "
             "initial guess. Give the solids x, y, fi closer to an assembled position (angles "
-            "in radians). Exudyn said: " f"{system.error}", time=t, step=0, elements=elements)
+            f"in radians). {said}", time=t, step=0, elements=elements)
     motion = ""
     if job.motion:
         name, moved, unit = job.motion
         motion = (f" ('{name}' moves {moved:.3g} {unit} per step, solved in {job.every} "
                   "sub-steps)")
     return SolverError(
-        f"Exudyn's static solver did not converge at t = {t:.6g} s ({step}){motion}: the "
+        f"{job.backend.solver_name} did not converge at t = {t:.6g} s ({step}){motion}: the "
         "constraints can all hold there, so the Newton iteration diverged near a singular "
         "position. Try more steps, so that the actuators move less per step, or check "
         "whether the mechanism reaches a singular (dead-point) position there. "
-        f"Exudyn said: {system.error}", time=t, step=solved // job.every, elements=elements)
+        f"{said}", time=t, step=solved // job.every, elements=elements)
 
 
 def _step_text(job: Job, k: int) -> str:
     """Where step k of the solve grid is, in the user's steps."""
     steps = (len(job.times) - 1) // job.every
-    if job.analysis == "assembly":
+    if registry.ANALYSES[job.analysis].at_start:
         return "the assembly"
     if job.every == 1:
         return f"step {k} of {steps}"
@@ -313,11 +309,20 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
     worst = float(np.max(np.abs(res)))
     if job is not None:
         job.info["max_residual"] = worst
-    from ..backend import SolveSettings
-    solver = job.solver if job is not None and job.solver else SolveSettings()
     # a looser Newton tolerance leaves a larger residual: not a translation error
-    tol = max(RESIDUAL_TOLERANCE, 100 * solver.tolerance) * mech.scale()
+    tolerance = job.solver.tolerance if job is not None else 0.0
+    tol = max(RESIDUAL_TOLERANCE, 100 * tolerance) * mech.scale()
     if worst > tol:
+        over = np.max(np.abs(res), axis=1) > tol
+        first = int(np.argmax(over))
+        if job is not None and first > 0:
+            # redundant constraints whose targets part: the solver (told to ignore the
+            # singular Jacobian) can stop on a configuration that violates them
+            disagreement, _ = native.contradiction(mech, float(t[first]), q[first - 1])
+            if disagreement > tol:
+                raise _position_failure(job, Positions(
+                    q, first, "no error (it stopped on a configuration that violates the "
+                              "constraints)", q[first - 1]))
         k = int(np.argmax(np.max(np.abs(res), axis=1)))
         name, value = native.worst_elements(mech, res[k], 1)[0]
         raise TranslationError(
@@ -374,7 +379,7 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
             name = f"{s.name}.{var.name}"
             if name in wanted:
                 source = (q, qd, qdd)[k // 3]
-                values[name] = source[:, 3 * i + k % 3]
+                values[name] = source[:, column(i, k % 3)]
     st = State(t, q, qd if VELOCITY in job.levels else None)
     for el in mech.elements:
         names = {v.name for v in el.outputs if f"{el.name}.{v.name}" in wanted}

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..elements.base import Load
 from ..errors import TranslationError
-from ..kinematics import State, generalized_force, move_wrench, to_basis
+from ..kinematics import State, column, generalized_force, move_wrench, pose, to_basis
 from . import native
 
 #: a reaction component that is zero by construction must be below this × the element's force scale
@@ -70,7 +70,7 @@ def applied_forces(mech, st: State, damping: bool) -> Applied:
             continue
         target = out.force if load.potential is not None else out.external
         for solid, q in load.force.items():
-            target[:, 3 * solid:3 * solid + 3] += q
+            target[:, pose(solid)] += q
         if load.potential is not None:
             out.potential += load.potential
         if load.dissipation is not None:
@@ -90,13 +90,14 @@ def inertia_forces(mech, st: State, qdd: np.ndarray) -> tuple[np.ndarray, np.nda
         m, J = float(s.mass), float(s.inertia)
         if m == 0 and J == 0:
             continue
-        cols = slice(3 * i, 3 * i + 3)
+        cols = pose(i)
         G = st.point(i, [float(c) for c in s.cog])
         block = G.jac[i]
         a_G = np.einsum("ndk,nk->nd", block, qdd[:, cols]) + G.conv
         Q[:, cols] += np.einsum("nd,ndk->nk", m * a_G, block)
-        Q[:, 3 * i + 2] += J * qdd[:, 3 * i + 2]
-        w = st.qd[:, 3 * i + 2]
+        fi = column(i, 2)
+        Q[:, fi] += J * qdd[:, fi]
+        w = st.qd[:, fi]
         T += 0.5 * m * np.sum(G.rate**2, axis=1) + 0.5 * J * w * w
     return Q, T
 
@@ -118,7 +119,7 @@ def element_wrench(el, st: State, lam: np.ndarray, jacobian=None) -> np.ndarray:
         return np.zeros((st.n, 3))
     wrench = np.einsum("nkj,nk->nj", block, lam)
     point, direction = el.report_frame(st)
-    return to_basis(move_wrench(wrench, st.q[:, 3 * s:3 * s + 2], point), direction)
+    return to_basis(move_wrench(wrench, st.q[:, pose(s)][:, :2], point), direction)
 
 
 def reported(el) -> list[int]:

@@ -13,7 +13,7 @@ def kinematic(job: Job):
     static solver at each time; Cq qd = −C_t and Cq qdd = γ solved natively for all steps;
     the motion stays on the branch it starts on (``branch.motion``).
     """
-    mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
+    mob = check_mobility(job, job.mech.initial_q())
     redundant = mob.redundant > 0
     if VELOCITY not in job.levels:
         return collect(job, positions(job, redundant))

@@ -19,7 +19,7 @@ def kinetostatic(job: Job):
     mass at G and the inertia about G; gravity, torsors, springs and dampers applied), and
     the reactions are read from λ (``forces.reactions``). The power balance is checked.
     """
-    mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
+    mob = check_mobility(job, job.mech.initial_q())
     redundant = mob.redundant > 0
     q, qd, qdd = motion(job, redundant, singular_ok=False)
     extra = inverse_dynamics(job, q, qd, qdd, redundant) if FORCE in job.levels else {}

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MobilityError, ModelError, Problem
-from ..kinematics import State
+from ..kinematics import ANGLES, PER_SOLID, State, column
 from ..laws import Law
 from ..progress import Progress
 
@@ -84,7 +84,7 @@ def sparse_jacobian(mech, st: State):
         v, _ = el.constraint(st)
         for solid, block in v.jac.items():                      # (n, d, 3)
             r = step * m + rr.start + np.arange(block.shape[1])[None, :, None]
-            c = step * nq + 3 * solid + np.arange(3)[None, None, :]
+            c = step * nq + column(solid, np.arange(PER_SOLID))[None, None, :]
             rows.append(np.broadcast_to(r, block.shape).ravel())
             cols.append(np.broadcast_to(c, block.shape).ravel())
             data.append(block.ravel())
@@ -147,7 +147,7 @@ def turns_jumped(t, q, qd, solids: int) -> np.ndarray:
     (a step without rates is predicted from ω_j alone). Newton's iteration at a singular
     position can land on the same configuration with an angle off by whole turns.
     """
-    fi, w = q[:, 2::3][:, :solids], qd[:, 2::3][:, :solids]
+    fi, w = q[:, ANGLES][:, :solids], qd[:, ANGLES][:, :solids]
     valid = np.isfinite(w).all(axis=1)
     valid[0] = True
     last = np.maximum.accumulate(np.where(valid, np.arange(len(t)), 0))
@@ -169,7 +169,7 @@ def whole_turns(mech, t: float, q: np.ndarray, target: np.ndarray) -> np.ndarray
     angle an actuator sets keeps its turn. Each solid is tried alone, then all together
     (gears coupled by a transmission turn together).
     """
-    wanted = np.rint((q[2::3] - target[2::3]) / (2 * np.pi))
+    wanted = np.rint((q[ANGLES] - target[ANGLES]) / (2 * np.pi))
     wanted[~np.isfinite(wanted)] = 0.0
     if not wanted.any() or mech.n_equations == 0:
         return wanted
@@ -177,7 +177,7 @@ def whole_turns(mech, t: float, q: np.ndarray, target: np.ndarray) -> np.ndarray
 
     def holds(turns):
         moved = q.copy()
-        moved[2::3] -= 2 * np.pi * turns
+        moved[ANGLES] -= 2 * np.pi * turns
         return float(np.max(np.abs(residuals(mech, [t], moved)))) <= tol
 
     if holds(wanted):
@@ -264,7 +264,8 @@ def _moving(mech):
     held = {el.ref1.solid for el in mech.constraints if el.grounds}
     rows = [r for el, rr in zip(mech.constraints, mech.rows) if not el.grounds
             for r in range(rr.start, rr.stop)]
-    cols = [3 * i + k for i in range(len(mech.solids)) if i not in held for k in range(3)]
+    cols = [column(i, k) for i in range(len(mech.solids)) if i not in held
+            for k in range(PER_SOLID)]
     return np.array(rows, dtype=int), np.array(cols, dtype=int)
 
 

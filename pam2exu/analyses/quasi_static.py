@@ -20,7 +20,7 @@ def quasi_static(job: Job):
     """x, y, fi, f(t), ro, fi_rel, every reaction, spring and actuator force; no rates.
 
     Contract: every degree of freedom is driven, so the configurations do not depend on the
-    forces: they come from Exudyn's static solver on the constraints (as kinematic), and
+    forces: they come from the backend's solver on the constraints (as kinematic), and
     the reactions from the native equilibrium Cqᵀ λ = −Q_applied at every step (gravity,
     torsors and springs, no damper terms; ``forces.over_time``). Exudyn's static solver
     with the masses and force elements in the model checks them at ``CHECKED_STEPS`` steps
@@ -29,7 +29,7 @@ def quasi_static(job: Job):
     are not checked against Exudyn's. A singular (dead-point) position, where the reactions
     are not defined, is an error.
     """
-    mob = check_mobility(job, job.mech.initial_q(), need_driven=True)
+    mob = check_mobility(job, job.mech.initial_q())
     redundant = mob.redundant > 0
     if FORCE not in job.levels:
         return collect(job, positions(job, redundant))
@@ -61,29 +61,27 @@ def checked_steps(n: int) -> list[int]:
 
 
 def exudyn_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float:
-    """Largest ``equilibrium_error`` of Exudyn's multipliers at the given steps.
+    """Largest ``equilibrium_error`` of the backend's multipliers at the given steps.
 
-    At each step, Exudyn's static solver with the masses and force elements (no dampers)
-    starts from the configuration found and keeps its multipliers.
+    At each step, the backend's static solver with the masses and force elements (no
+    dampers) starts from the configuration found and gives its multipliers.
     """
-    from ..backend import ExudynSystem, SolveSettings
-    mech, settings = job.mech, job.solver or SolveSettings()
+    mech = job.mech
     worst = 0.0
     for k in rows:
-        system = ExudynSystem(mech, forces=True, velocity_forces=False, start=q[k])
-        qk, solved = system.solve_positions(job.times[k:k + 1], settings, multipliers=True)
-        if not solved:
+        found = job.backend.solve_positions(mech, job.times[k:k + 1], q[k], job.solver,
+                                            forces=True)
+        if not found.solved:
             raise TranslationError(
-                f"internal error: Exudyn's static solver with the forces did not converge at "
-                f"t = {job.times[k]:.6g} s from the configuration found without them: the "
-                f"Exudyn translation is wrong. Please report it with the model file. Exudyn "
-                f"said: {system.error}")
-        order = [i for el in mech.constraints for i in system.ae_rows(el)]
-        st = State(job.times[k:k + 1], qk)
+                f"internal error: {job.backend.solver_name} with the forces did not converge "
+                f"at t = {job.times[k]:.6g} s from the configuration found without them: the "
+                f"translation is wrong. Please report it with the model file. "
+                f"{job.backend.label} said: {found.error}")
+        st = State(job.times[k:k + 1], found.q)
         applied = forces.applied_forces(mech, st, damping=False)
         jacobian = native.equations(mech, st).jacobian
-        lam = system.multipliers[:, order]
-        worst = max(worst, equilibrium_error(mech, st, lam, applied.force, jacobian))
+        worst = max(worst, equilibrium_error(mech, st, found.multipliers, applied.force,
+                                             jacobian))
     return worst
 
 

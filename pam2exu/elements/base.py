@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import closest
 from ..limits import VALUE, is_number, shown
-from ..kinematics import Quantity, State
+from ..kinematics import Quantity, State, pose
 from ..laws import LAW_ALIASES, LAWS, Law, law_names
 
 #: What an output needs from an analysis, in the order analyses can provide it.
@@ -235,7 +235,7 @@ class Element:
         is reported (the first docstring line says it in words, for the reference pages).
         """
         s = self.receiver
-        return st.q[:, 3 * s:3 * s + 2], np.broadcast_to([1.0, 0.0], (st.n, 2))
+        return st.q[:, pose(s)][:, :2], np.broadcast_to([1.0, 0.0], (st.n, 2))
 
     def loads(self, st: State, damping: bool) -> Load | None:
         """A force element's action at the states ``st`` (None for constraint elements).

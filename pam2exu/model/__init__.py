@@ -1,8 +1,7 @@
 """Model layer: parse and validate PAM models (no Exudyn import here)."""
 from ..laws import LAWS, Law
 from .loader import load, loads
-from .model import ANALYSIS_ALIASES, ANALYSIS_TYPES, Analysis, Mechanism, Model
+from .model import Analysis, Mechanism, Model
 from .solid import Solid
 
-__all__ = ["Model", "Solid", "Analysis", "Mechanism", "Law", "LAWS", "load", "loads",
-           "ANALYSIS_TYPES", "ANALYSIS_ALIASES"]
+__all__ = ["Model", "Solid", "Analysis", "Mechanism", "Law", "LAWS", "load", "loads"]

@@ -11,7 +11,7 @@ from .solid import Solid
 
 _MODEL_KEYS = ("name", "gravity")
 _SOLID_KEYS = ("name", "x", "y", "fi", "mass", "inertia", "cog", "points", "lines")
-_ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs")
+_ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs", "backend")
 _TABLES = ("model", "solid", "element", "analysis")
 
 
@@ -19,7 +19,7 @@ def load(path: str | Path) -> Model:
     """Read a model file; raises ModelError naming the file and every problem in it.
 
     The file is TOML with the tables ``[model]`` (name, gravity), ``[[solid]]``,
-    ``[[element]]`` and ``[analysis]`` (type, t_end, steps, outputs); the format is
+    ``[[element]]`` and ``[analysis]`` (type, t_end, steps, outputs, backend); the format is
     docs/model-format.md. Every problem is collected before the error is raised; mobility
     is checked later, by ``run``.
 

@@ -8,18 +8,12 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field, fields
 
-from .. import limits
+from .. import limits, registry
+from ..kinematics import PER_SOLID
 from ..elements import ALIASES, ELEMENTS, Element
 from ..errors import ModelError, Problem, closest
 from ..limits import is_number as _number
 from .solid import Scope, Solid
-
-#: analysis types of the contract
-ANALYSIS_TYPES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
-#: PAM's Catalan names of the analyses (an extension of the contract)
-ANALYSIS_ALIASES = {"ensamblatge": "assembly", "quasi_estatica": "quasi_static",
-                    "cinematica": "kinematic", "cinetostatica": "kinetostatic"}
-
 
 
 @dataclass
@@ -34,7 +28,7 @@ class Analysis:
     ----------
     type : str
         ``'assembly'``, ``'quasi_static'``, ``'kinematic'`` or ``'kinetostatic'``
-        (``ANALYSIS_TYPES``); PAM's Catalan names (``'ensamblatge'``,
+        (``pam2exu.registry.ANALYSES``); PAM's Catalan names (``'ensamblatge'``,
         ``'quasi_estatica'``, ``'cinematica'``, ``'cinetostatica'``) are read as these.
     t_end : float
         End of the interval [0, t_end] [s], > 0 (not used by an assembly, which solves
@@ -44,6 +38,9 @@ class Analysis:
     outputs : list of str, optional
         Names or patterns of the columns to compute and keep (``crank.fi``, ``crank.*``,
         ``*.Fx`` or a bare ``Fx``); None keeps every column of the analysis.
+    backend : str
+        What solves the positions: ``'exudyn'`` (the default; ``pam2exu.registry.BACKENDS``
+        lists the backends).
 
     Examples
     --------
@@ -55,14 +52,18 @@ class Analysis:
     t_end: float = 1.0
     steps: int = 100
     outputs: list[str] | None = None
+    backend: str = registry.DEFAULT_BACKEND
+
+    #: keys beyond the contract's [analysis] table (docs/model-format.md says so)
+    EXTENSIONS = ("backend",)
 
     def __post_init__(self):
         self._canonical_type()
 
     def _canonical_type(self) -> None:
         """A Catalan analysis name becomes the contract's."""
-        if isinstance(self.type, str):
-            self.type = ANALYSIS_ALIASES.get(self.type, self.type)
+        if isinstance(self.type, str) and registry.analysis_type(self.type) is not None:
+            self.type = registry.analysis_type(self.type).name
 
     def problems(self) -> list[str]:
         """What is wrong with these settings, one message each (empty when they are sound).
@@ -75,11 +76,16 @@ class Analysis:
         """
         out = []
         self._canonical_type()
-        if self.type not in ANALYSIS_TYPES:
-            known = [*ANALYSIS_TYPES, *ANALYSIS_ALIASES]
-            out.append(f"unknown analysis type '{self.type}'{closest(self.type, known)}; "
-                       f"known types: {', '.join(ANALYSIS_TYPES)} (Catalan: "
-                       f"{', '.join(ANALYSIS_ALIASES)})")
+        if not isinstance(self.type, str) or self.type not in registry.ANALYSES:
+            names = list(registry.ANALYSES)
+            aliases = [a.alias for a in registry.ANALYSES.values()]
+            out.append(f"unknown analysis type '{self.type}'"
+                       f"{closest(str(self.type), names + aliases)}; known types: "
+                       f"{', '.join(names)} (Catalan: {', '.join(aliases)})")
+        if not isinstance(self.backend, str) or self.backend not in registry.BACKENDS:
+            names = list(registry.BACKENDS)
+            out.append(f"unknown backend '{self.backend}'{closest(str(self.backend), names)}; "
+                       f"known backends: {', '.join(names)}")
         low, high = limits.T_END
         if not _number(self.t_end) or self.t_end <= 0:
             out.append(f"t_end must be a positive number of seconds, got {self.t_end!r}")
@@ -322,6 +328,9 @@ class Model:
                                           f"(at most {limits.VALUE:g})"))
         if not isinstance(self.name, str):
             out.append(Problem("[model]", f"name must be a string, got {self.name!r}"))
+        elif len(self.name) > limits.MODEL_NAME:
+            out.append(Problem("[model]", f"name is {len(self.name)} characters long: at most "
+                                          f"{limits.MODEL_NAME} are allowed"))
         seen: dict[str, str] = {}
         for solid in self.solids:
             out += [Problem(solid.where, m) for m in _solid_problems(solid)]
@@ -510,8 +519,8 @@ class Mechanism:
 
     @property
     def nq(self) -> int:
-        """Number of generalized coordinates, 3 per solid."""
-        return 3 * len(self.solids)
+        """Number of generalized coordinates: x, y, fi of each solid (``kinematics.pose``)."""
+        return PER_SOLID * len(self.solids)
 
     def initial_q(self):
         """The initial guess q0 from the solids' x, y, fi.

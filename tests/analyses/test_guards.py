@@ -7,6 +7,7 @@ gave an IndexError; any other fault of pam2exu escaped as a bare NumPy exception
 """
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -159,3 +160,49 @@ def test_the_diagnosis_of_a_failure_stops_on_time(monkeypatch):
                                                   r"ground.O4–ground.O2 0.4 m, is longer"):
         pam2exu.run(model, analysis="assembly")
     assert len(calls) < 50                       # the search's first call ended it
+
+
+def test_a_driven_solid_also_fixed_is_a_contradiction_not_an_internal_error(tmp_path):
+    """Fuzz seed 6295: a crank held by a fixed link and turned by a motor. Exudyn, told to
+    ignore the singular Jacobian of the redundant constraints, stops on a configuration
+    that violates the motor's law; that was reported as an internal error of the
+    translation. It is the contradiction of the two constraints, from the first step."""
+    path = tmp_path / "fixed_and_driven.toml"
+    path.write_text("""
+[[solid]]
+name = "ground"
+points = { O = [0.0, 0.0] }
+[[solid]]
+name = "crank"
+points = { O = [0.0, 0.0], A = [0.1, 0.0] }
+[[element]]
+type = "fixed"
+name = "base"
+anc1 = "ground"
+[[element]]
+type = "revolute"
+name = "O"
+anc1 = "ground.O"
+anc2 = "crank.O"
+[[element]]
+type = "angular_actuator"
+name = "motor"
+anc1 = "ground"
+anc2 = "crank"
+C = [0.0, 2.0]
+[[element]]
+type = "fixed"
+name = "extra_fix"
+anc1 = "crank"
+[analysis]
+t_end = 1.0
+steps = 100
+""", encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pam2exu.RedundancyWarning)
+        with pytest.raises(pam2exu.SolverError, match=r"the constraints of .*'motor'.*'extra_fix' "
+                           r"contradict each other from t = 0 s to t = 0\.01 s .*Without "
+                           r"'extra_fix' the others agree") as info:
+            pam2exu.run(path)
+    assert not isinstance(info.value, pam2exu.TranslationError)
+    assert info.value.time == pytest.approx(0.01)

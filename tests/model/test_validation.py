@@ -573,6 +573,9 @@ def test_torsor_axes():
     ('steps = "10"', r"steps must be a positive whole number, got '10'"),
     ("steps = true", r"steps must be a positive whole number, got True"),
     ('outputs = "crank.*"', r"\[analysis\]: outputs must be a list of names or patterns"),
+    ('backend = "exudin"', r"\[analysis\]: unknown backend 'exudin' \(did you mean 'exudyn'\?\); "
+                           r"known backends: exudyn"),
+    ("backend = 1", r"\[analysis\]: unknown backend '1'; known backends: exudyn"),
     ("outputs = [1, 2]", r"outputs must be a list of names or patterns"),
 ])
 def test_bad_analysis(body, match):
@@ -582,11 +585,11 @@ def test_bad_analysis(body, match):
 
 def test_analysis_defaults_and_values():
     assert vars(loads(SOLIDS).analysis) == {"type": "kinematic", "t_end": 1.0, "steps": 100,
-                                            "outputs": None}
+                                            "outputs": None, "backend": "exudyn"}
     model = loads(SOLIDS + '\n[analysis]\ntype = "assembly"\nt_end = 2\nsteps = 7\n'
-                           'outputs = ["crank.*", "Fx"]\n')
+                           'outputs = ["crank.*", "Fx"]\nbackend = "exudyn"\n')
     assert vars(model.analysis) == {"type": "assembly", "t_end": 2, "steps": 7,
-                                    "outputs": ["crank.*", "Fx"]}
+                                    "outputs": ["crank.*", "Fx"], "backend": "exudyn"}
 
 
 # ---- files and sources -------------------------------------------------------------------
@@ -714,7 +717,7 @@ def test_shipped_example_loads():
     assert model["rod"].fi == -0.2 and model["rod"].cog == [0.15, 0.0]
     assert model["motor"].time_law() == pam2exu.Law("polynomial", (0.0, 10.0, 0.0, 0.0))
     assert vars(model.analysis) == {"type": "kinetostatic", "t_end": 0.6283185307179586,
-                                    "steps": 200, "outputs": None}
+                                    "steps": 200, "outputs": None, "backend": "exudyn"}
     assert model.problems() == []
     assert model.source == str(ROOT / "examples" / "slider_crank.toml")
 
@@ -970,6 +973,18 @@ def test_a_long_name_is_shortened_in_messages():
     m.add_solid("y" * 1_000_000)
     (problem,) = m.problems()
     assert len(str(problem)) < 200 and "1000000 characters long" in str(problem)
+
+
+def test_a_model_name_of_a_million_characters_is_a_model_error():
+    """Fuzz seed 6295: a model name of 1,000,002 characters was accepted and `draw` spent
+    97 s writing it as the picture's title; the model's name has a length limit too."""
+    m = Model("x" * 1_000_002)
+    m.add_solid("ground")
+    (problem,) = m.problems()
+    assert str(problem) == ("[model]: name is 1000002 characters long: at most 200 are "
+                            "allowed")
+    assert not Model("x" * 200).problems() or all("name" not in str(p)
+                                                    for p in Model("x" * 200).problems())
 
 
 def test_outputs_that_are_not_a_list_are_a_model_error():

@@ -1,0 +1,92 @@
+"""What the analyses ask of a backend: configurations over a time grid.
+
+A backend is one formulation of the mechanism's constraints with a solver for them
+(``registry.BACKENDS`` lists them; ``Exudyn`` is the default). The analyses and the branch
+following talk to it only through ``Backend.solve_positions``; velocities, accelerations
+and forces are pam2exu's native pass on the coordinates it returns, which are always
+x, y, fi of every solid (``kinematics.pose``), whatever the backend solves internally.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Protocol
+
+import numpy as np
+
+
+@dataclass
+class Positions:
+    """A backend's answer to ``solve_positions``.
+
+    Attributes
+    ----------
+    q : numpy.ndarray
+        (n, nq): x [m], y [m], fi [rad] of every solid at each time; the rows from
+        ``solved`` on are NaN.
+    solved : int
+        How many times, from the first, were solved.
+    error : str or None
+        The solver's own words when it stopped before the last time (quoted in messages).
+    last : numpy.ndarray
+        (nq,): where the solver stopped (the failure diagnosis starts from it when the
+        first time already failed).
+    multipliers : numpy.ndarray or None
+        (n, n_equations): with ``forces``, the Lagrange multipliers λ of the static
+        equilibrium f + Cqᵀ λ = 0 in pam2exu's row order (``Mechanism.rows``); else None.
+    iterations : int
+        Newton iterations in all (0 if the backend does not count them).
+    """
+
+    q: np.ndarray
+    solved: int
+    error: str | None
+    last: np.ndarray
+    multipliers: np.ndarray | None = None
+    iterations: int = 0
+
+
+class Backend(Protocol):
+    """A formulation with a position solver.
+
+    Attributes
+    ----------
+    name : str
+        Its name in ``registry.BACKENDS`` (``[analysis] backend``, ``--backend``).
+    label : str
+        How messages name it ("… Exudyn said: …").
+    solver_name : str
+        How messages name its position solver ("Exudyn's static solver did not converge").
+    Settings : type
+        Its settings class; an instance has at least ``tolerance`` (Newton's, relative to
+        the mechanism's length) and ``verbose`` (0: quiet).
+    """
+
+    name: ClassVar[str]
+    label: ClassVar[str]
+    solver_name: ClassVar[str]
+    Settings: ClassVar[type]
+
+    def solve_positions(self, mech, times: np.ndarray, start: np.ndarray, settings, *,
+                        redundant: bool = False, forces: bool = False,
+                        anchor_stiffness: float = 0.0) -> Positions:
+        """Configurations at the equally spaced ``times``, step after step from ``start``.
+
+        Parameters
+        ----------
+        mech : Mechanism
+        times : numpy.ndarray
+            t_k = k·dt for k = k0 … k0 + n − 1 [s] (one time alone: a grid of spacing t).
+        start : numpy.ndarray
+            (nq,) the configuration the first solve starts from.
+        settings
+            An instance of ``Settings``.
+        redundant : bool
+            The constraint Jacobian is rank deficient (consistent redundant constraints).
+        forces : bool
+            Solve the static equilibrium with the masses, gravity and force elements (no
+            dampers) and return its multipliers.
+        anchor_stiffness : float
+            If > 0, tie every coordinate to its initial guess by a spring of this
+            stiffness, so that free degrees of freedom stay nearest the guess (assembly).
+        """
+        ...

@@ -1,0 +1,32 @@
+"""The Exudyn backend: each solve translates the mechanism (``ExudynSystem``) and runs
+Exudyn's static solver, one load step per time."""
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Positions
+from .system import ExudynSystem, SolveSettings
+
+
+class Exudyn:
+    """``Backend`` on Exudyn's static solver (``registry.BACKENDS['exudyn']``)."""
+
+    name = "exudyn"
+    label = "Exudyn"
+    solver_name = "Exudyn's static solver"
+    Settings = SolveSettings
+
+    def solve_positions(self, mech, times, start, settings, *, redundant=False, forces=False,
+                        anchor_stiffness=0.0) -> Positions:
+        """See ``Backend.solve_positions``."""
+        system = ExudynSystem(mech, forces=forces, velocity_forces=False,
+                              anchor_stiffness=anchor_stiffness, start=start)
+        q, solved = system.solve_positions(times, settings, redundant=redundant,
+                                           multipliers=forces)
+        lam = None
+        if forces:
+            order = [i for el in mech.constraints for i in system.ae_rows(el)]
+            lam = system.multipliers[:, order]
+        error = None if system.error is None else str(system.error)
+        return Positions(q, solved, error, system.coordinates(), lam,
+                         system.newton_iterations or 0)

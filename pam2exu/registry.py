@@ -1,0 +1,120 @@
+"""The analyses and backends pam2exu knows: one declaration each.
+
+Everything that needs to know which analyses or backends exist reads these tables: the
+model (names and PAM's Catalan aliases, in its validation), ``pam2exu.analyses`` (what an
+analysis computes, whether it needs every degree of freedom driven, which function runs
+it), the CLI and the generated reference pages.
+
+Adding an analysis is one module with its function ``f(job) -> Results`` and one entry in
+``ANALYSES``; adding a backend is one module with a class implementing
+``pam2exu.backend.Backend`` and one entry in ``BACKENDS``.
+
+A declaration names what implements it as ``'module:attribute'``, imported when first
+used (a callable may be given instead): so reading and validating a model loads neither
+the analyses nor Exudyn, and this module imports nothing of the package but the output
+levels.
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from .elements.base import ACCELERATION, FORCE, POSITION, VELOCITY
+
+
+def resolve(target: str | Callable) -> Any:
+    """The object a declaration names: ``'package.module:attribute'`` imported, or itself."""
+    if not isinstance(target, str):
+        return target
+    module, _, attribute = target.partition(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
+@dataclass(frozen=True)
+class AnalysisType:
+    """One analysis: its names, what it gives, what it needs, and the function that runs it.
+
+    Parameters
+    ----------
+    name : str
+        Its name in ``[analysis] type`` and ``-a`` (the contract's).
+    alias : str
+        PAM's Catalan name, read as ``name``.
+    levels : frozenset of str
+        The kinds of output it gives (``POSITION``, ``VELOCITY``, ``ACCELERATION``,
+        ``FORCE``), which select the output columns it can produce.
+    driven : bool
+        Every degree of freedom must be driven by an actuator (else ``MobilityError``).
+    at_start : bool
+        It solves t = 0 only and gives the solids' x, y, fi (no element outputs).
+    summary : str
+        One line for help texts.
+    function : str or callable
+        ``'module:function'`` of ``f(job) -> Results``, or the function itself.
+    """
+
+    name: str
+    alias: str
+    levels: frozenset
+    driven: bool
+    at_start: bool
+    summary: str
+    function: str | Callable
+
+    def run(self, job):
+        """Run the analysis on a prepared ``Job``."""
+        return resolve(self.function)(job)
+
+
+@dataclass(frozen=True)
+class BackendType:
+    """One backend: its name, what it is, and the class implementing ``Backend``."""
+
+    name: str
+    summary: str
+    implementation: str | Callable
+
+    def create(self):
+        """A new instance of the backend."""
+        return resolve(self.implementation)()
+
+
+_ALL = frozenset({POSITION, VELOCITY, ACCELERATION, FORCE})
+
+#: the analyses, in the contract's order
+ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
+    AnalysisType("assembly", "ensamblatge", frozenset({POSITION}), driven=False,
+                 at_start=True, summary="the constraints solved at t = 0 from the guess",
+                 function="pam2exu.analyses.assembly:assembly"),
+    AnalysisType("quasi_static", "quasi_estatica", frozenset({POSITION, FORCE}), driven=True,
+                 at_start=False, summary="positions and static equilibrium, no rates",
+                 function="pam2exu.analyses.quasi_static:quasi_static"),
+    AnalysisType("kinematic", "cinematica", frozenset({POSITION, VELOCITY, ACCELERATION}),
+                 driven=True, at_start=False,
+                 summary="positions, velocities and accelerations",
+                 function="pam2exu.analyses.kinematic:kinematic"),
+    AnalysisType("kinetostatic", "cinetostatica", _ALL, driven=True, at_start=False,
+                 summary="the kinematic analysis, then every force (inverse dynamics)",
+                 function="pam2exu.analyses.kinetostatic:kinetostatic"),
+)}
+
+#: the backends; the first is the default
+BACKENDS: dict[str, BackendType] = {b.name: b for b in (
+    BackendType("exudyn", "Exudyn's static solver on the translated model",
+                "pam2exu.backend.exudyn_backend:Exudyn"),
+)}
+DEFAULT_BACKEND = "exudyn"
+
+
+def analysis_type(name: str) -> AnalysisType | None:
+    """The analysis called ``name`` or whose Catalan alias is ``name``; None if there is none."""
+    if name in ANALYSES:
+        return ANALYSES[name]
+    return next((a for a in ANALYSES.values() if a.alias == name), None)
+
+
+def analyses_giving(level: str) -> list[str]:
+    """The analyses (names, in order) whose outputs include the solids' and elements'
+    variables of ``level`` (an analysis ``at_start`` gives only the solids' x, y, fi)."""
+    return [a.name for a in ANALYSES.values() if level in a.levels and not a.at_start]
