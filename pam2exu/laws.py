@@ -180,11 +180,6 @@ class Law:
             The law [u], its first [u/s] and second [u/s²] time derivatives, where [u] is
             rad (angular actuator) or m (linear actuator).
 
-        Raises
-        ------
-        KeyError
-            The law's name is not one of ``law_names()``.
-
         Examples
         --------
         >>> f, df, ddf = Law("polynomial", [0.0, 2.0, 0.0, 1.0])([0.0, 1.0])
@@ -211,11 +206,6 @@ class Law:
         -------
         float
             f(t) [rad or m, as the actuator].
-
-        Raises
-        ------
-        KeyError
-            The law's name is not one of ``law_names()``.
         """
         return float(self(t)[0])
 

@@ -18,7 +18,7 @@ import re
 import sys
 from pathlib import Path
 
-from .elements import ACCELERATION, ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY, Element
+from .elements import ALIASES, ELEMENTS, FORCE, Element
 from .errors import closest
 from .laws import LAW_ALIASES, LAWS
 from .model.solid import SOLID_OUTPUTS

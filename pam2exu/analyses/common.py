@@ -10,10 +10,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..elements import ACCELERATION, FORCE, POSITION, VELOCITY, Var
-from ..errors import (ConditionWarning, ConsistencyWarning, ModelError, Problem,
-                      RedundancyWarning, SolverError, TranslationError)
-from ..kinematics import ANGLES, State, column
 from .. import registry
+from ..errors import ModelError, Problem, RedundancyWarning, SolverError, TranslationError
+from ..kinematics import ANGLES, State, column
 from ..backend import Backend, Positions
 from ..model import Model, load
 from ..model.solid import SOLID_OUTPUTS

@@ -2,8 +2,6 @@
 Exudyn's static solver, one load step per time."""
 from __future__ import annotations
 
-import numpy as np
-
 from .base import Positions
 from .system import ExudynSystem, SolveSettings
 

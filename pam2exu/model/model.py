@@ -5,14 +5,13 @@ returns the validated, resolved form the translation and the analyses work on.
 """
 from __future__ import annotations
 
-import copy
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 
 from .. import limits, registry
-from ..kinematics import PER_SOLID
 from ..elements import ALIASES, ELEMENTS, Element
 from ..errors import ModelError, Problem, closest
 from ..limits import is_number as _number
+from .mechanism import Mechanism
 from .solid import Scope, Solid
 
 
@@ -452,119 +451,3 @@ def _solid_problems(s: Solid) -> list[str]:
         out += range_problems(f"line '{name}' angle", line.get("angle"), limits.ANGLE, "rad")
 
     return out
-
-
-@dataclass
-class Mechanism:
-    """A validated model with its anchors resolved: what translation and analyses use.
-
-    The generalized coordinates are q = (x, y, fi) of each solid in order, so solid i
-    owns q[3i:3i+3]. Made by ``Model.mechanism()``, which validates the model first.
-
-    Parameters
-    ----------
-    model : Model
-        A model without problems (not checked here: use ``Model.mechanism``).
-
-    Attributes
-    ----------
-    model : Model
-        The model it was made from.
-    solids : list of Solid
-        The model's solids, in order.
-    elements : list of Element
-        Copies of the model's elements, bound to their anchors (``ref1``, ``ref2``).
-    constraints : list of Element
-        The elements that add constraint equations, in order.
-    rows : list of slice
-        The rows of each constraint element's equations in C(q, t) = 0.
-    n_equations : int
-        Number of constraint equations.
-    index : dict
-        Solid name → index i (its coordinates are q[3i:3i+3]).
-    """
-
-    model: Model
-    solids: list[Solid] = field(init=False)
-    elements: list[Element] = field(init=False)
-
-    def __post_init__(self):
-        self.solids = list(self.model.solids)
-        scope = Scope(self.solids)
-        scope.elements = self.model.elements
-        self.elements = [copy.copy(e) for e in self.model.elements]
-        for el in self.elements:
-            el.bind(scope)
-        self.constraints = [e for e in self.elements if e.equations]
-        #: the actuators: constraint elements that drive a coordinate by a time law
-        self.drivers = [e for e in self.constraints if e.drives]
-
-        rows, start = [], 0
-        for el in self.constraints:
-            rows.append(slice(start, start + el.equations))
-            start += el.equations
-        self.rows = rows
-        self.n_equations = start
-        self.index = scope.index
-
-    @property
-    def name(self) -> str:
-        """The model's name."""
-        return self.model.name
-
-    @property
-    def gravity(self) -> float:
-        """Magnitude of the gravitational acceleration, along −y [m/s²]."""
-        return float(self.model.gravity)
-
-    @property
-    def nq(self) -> int:
-        """Number of generalized coordinates: x, y, fi of each solid (``kinematics.pose``)."""
-        return PER_SOLID * len(self.solids)
-
-    def initial_q(self):
-        """The initial guess q0 from the solids' x, y, fi.
-
-        Returns
-        -------
-        numpy.ndarray
-            Shape (nq,): x [m], y [m], fi [rad] of each solid in order.
-        """
-        import numpy as np
-        return np.array([float(v) for s in self.solids for v in (s.x, s.y, s.fi)])
-
-    def owner_of_row(self, row: int) -> Element:
-        """The constraint element whose equations include row ``row``.
-
-        Parameters
-        ----------
-        row : int
-            A row of C(q, t) = 0, 0 … n_equations − 1.
-
-        Returns
-        -------
-        Element
-            One of ``constraints``.
-
-        Raises
-        ------
-        IndexError
-            ``row`` is not a row of the equations.
-        """
-        for el, rows in zip(self.constraints, self.rows):
-            if rows.start <= row < rows.stop:
-                return el
-        raise IndexError(row)
-
-    def scale(self) -> float:
-        """A length typical of the mechanism [m]: the largest point or pose offset, at least 1e-3.
-
-        Returns
-        -------
-        float
-            max(1e-3, |x|, |y| of every solid, |coordinates| of every point) [m]; the
-            scale of the solver tolerances and self-checks.
-        """
-        values = [abs(float(v)) for s in self.solids for v in (s.x, s.y)]
-        values += [abs(float(c)) for s in self.solids for p in s.points.values() for c in p]
-        return max([1e-3, *values])

@@ -1,0 +1,108 @@
+"""The mechanism: a validated model with its anchors resolved, what the translation and the
+analyses work on (``Model.mechanism()`` makes it)."""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+
+from typing import TYPE_CHECKING
+
+from ..elements import Element
+from ..kinematics import PER_SOLID
+from .solid import Scope, Solid
+
+if TYPE_CHECKING:                      # the annotation only: model.py imports this module
+    from .model import Model
+
+
+@dataclass
+class Mechanism:
+    """A validated model with its anchors resolved: what translation and analyses use.
+
+    The generalized coordinates are q = (x, y, fi) of each solid in order, so solid i
+    owns q[3i:3i+3]. Made by ``Model.mechanism()``, which validates the model first.
+
+    Parameters
+    ----------
+    model : Model
+        A model without problems (not checked here: use ``Model.mechanism``).
+
+    Attributes
+    ----------
+    model : Model
+        The model it was made from.
+    solids : list of Solid
+        The model's solids, in order.
+    elements : list of Element
+        Copies of the model's elements, bound to their anchors (``ref1``, ``ref2``).
+    constraints : list of Element
+        The elements that add constraint equations, in order.
+    rows : list of slice
+        The rows of each constraint element's equations in C(q, t) = 0.
+    n_equations : int
+        Number of constraint equations.
+    index : dict
+        Solid name → index i (its coordinates are q[3i:3i+3]).
+    """
+
+    model: Model
+    solids: list[Solid] = field(init=False)
+    elements: list[Element] = field(init=False)
+
+    def __post_init__(self):
+        self.solids = list(self.model.solids)
+        scope = Scope(self.solids)
+        scope.elements = self.model.elements
+        self.elements = [copy.copy(e) for e in self.model.elements]
+        for el in self.elements:
+            el.bind(scope)
+        self.constraints = [e for e in self.elements if e.equations]
+        #: the actuators: constraint elements that drive a coordinate by a time law
+        self.drivers = [e for e in self.constraints if e.drives]
+
+        rows, start = [], 0
+        for el in self.constraints:
+            rows.append(slice(start, start + el.equations))
+            start += el.equations
+        self.rows = rows
+        self.n_equations = start
+        self.index = scope.index
+
+    @property
+    def name(self) -> str:
+        """The model's name."""
+        return self.model.name
+
+    @property
+    def gravity(self) -> float:
+        """Magnitude of the gravitational acceleration, along −y [m/s²]."""
+        return float(self.model.gravity)
+
+    @property
+    def nq(self) -> int:
+        """Number of generalized coordinates: x, y, fi of each solid (``kinematics.pose``)."""
+        return PER_SOLID * len(self.solids)
+
+    def initial_q(self):
+        """The initial guess q0 from the solids' x, y, fi.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (nq,): x [m], y [m], fi [rad] of each solid in order.
+        """
+        import numpy as np
+        return np.array([float(v) for s in self.solids for v in (s.x, s.y, s.fi)])
+
+    def scale(self) -> float:
+        """A length typical of the mechanism [m]: the largest point or pose offset, at least 1e-3.
+
+        Returns
+        -------
+        float
+            max(1e-3, |x|, |y| of every solid, |coordinates| of every point) [m]; the
+            scale of the solver tolerances and self-checks.
+        """
+        values = [abs(float(v)) for s in self.solids for v in (s.x, s.y)]
+        values += [abs(float(c)) for s in self.solids for p in s.points.values() for c in p]
+        return max([1e-3, *values])
