@@ -1,4 +1,4 @@
-"""Free-body sketches (pam2exu/pictures/free_body.py): one per element type that reports a
+"""Free-body sketches (docs/make_free_body.py): one per element type that reports a
 force or a torque, each arrow labelled with the output's PAM name and pointing in its
 positive sense.
 
@@ -20,6 +20,8 @@ tests/analyses/test_reactions.py checks against closed forms:
 - torsor (applied, no output): Fx, Fy along x, y (axes = "global") or along the solid's
   x', y' (axes = "solid"), M counter-clockwise.
 """
+import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -27,13 +29,27 @@ import pytest
 from PIL import Image
 
 from pam2exu.elements import ELEMENTS, FORCE
-from pam2exu.pictures import free_body
-from pam2exu.pictures.free_body import FREE_BODY_TYPES, free_body_sketch
 from pam2exu.results.plot import PictureError
 
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _make_free_body():
+    """docs/make_free_body.py, loaded by its path (docs/ is not a package; as
+    tests/test_api_docs.py loads docs/make_api.py)."""
+    spec = importlib.util.spec_from_file_location("make_free_body",
+                                                  ROOT / "docs" / "make_free_body.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["make_free_body"] = module      # its dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+free_body = _make_free_body()
+FREE_BODY_TYPES, free_body_sketch = free_body.FREE_BODY_TYPES, free_body.free_body_sketch
 PNG = b"\x89PNG\r\n\x1a\n"
 PIXELS = (round(free_body.SIZE[0] * free_body.DPI), round(free_body.SIZE[1] * free_body.DPI))
-DOCS_IMG = Path(__file__).resolve().parents[1] / "docs" / "img"
+DOCS_IMG = ROOT / "docs" / "img"
 #: the torsor reports nothing; its sketch shows its applied loads, C = [Fx, Fy, M]
 APPLIED = {"torsor": ["Fx", "Fy", "M"]}
 
@@ -275,9 +291,9 @@ def test_free_body_sketch_returns_what_it_drew(tmp_path):
 
 @pytest.mark.parametrize("element_type", FREE_BODY_TYPES)
 def test_docs_have_every_sketch(element_type):
-    """docs/img/fbd_<type>.png (regenerate: python -m pam2exu.pictures.free_body docs/img)."""
+    """docs/img/fbd_<type>.png (regenerate: python docs/make_free_body.py docs/img)."""
     path = DOCS_IMG / f"fbd_{element_type}.png"
-    assert path.is_file(), f"missing {path}: run python -m pam2exu.pictures.free_body docs/img"
+    assert path.is_file(), f"missing {path}: run python docs/make_free_body.py docs/img"
     assert path.stat().st_size <= 40_000
     _check_png(path)
 

@@ -333,7 +333,7 @@ class Pen:
                    zorder=Z_BAR)
         self._line([p, q], color=ACTUATOR, lw=1.5, zorder=Z_BAR)
 
-    # ---- free-body sketches (pictures/free_body.py) -------------------------------------
+    # ---- free-body sketches (docs/make_free_body.py) ------------------------------------
     def arrow(self, a, b, color=INK, width: float = 2.0, head: float = 12) -> None:
         """A straight arrow from a to b: a force of a free-body sketch, drawn to scale."""
         self._arrow(a, b, color, width=width, head=head)

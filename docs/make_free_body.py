@@ -14,15 +14,20 @@ they were checked against the code they come from: each element class's ``wrench
 ``report_frame``, ``receiver`` and ``loads`` (pam2exu/elements/), and
 ``analyses.forces.element_wrench``.
 
-The symbols are ``Pen``'s (pen.py), so a sketch looks like a ``pam2exu draw`` picture: solid 1
-blue, solid 2 orange, ground and arm grey, actuators red, applied torsors green, reactions
-dark. The element itself, cut away, is drawn faintly where it has a symbol between the
-bodies (spring, actuators).
+The symbols are ``Pen``'s (pam2exu/pictures/pen.py), so a sketch looks like a ``pam2exu
+draw`` picture: solid 1 blue, solid 2 orange, ground and arm grey, actuators red, applied
+torsors green, reactions dark. The element itself, cut away, is drawn faintly where it has a
+symbol between the bodies (spring, actuators).
 
 ``free_body_sketch(element_type, path)`` writes one sketch and returns what it drew
-(``FreeBody``); ``python -m pam2exu.pictures.free_body OUTDIR`` writes
-``OUTDIR/fbd_<type>.png`` for every type in ``FREE_BODY_TYPES`` (docs/img/ holds them, for
-the glossary of output names).
+(``FreeBody``); ``python docs/make_free_body.py OUTDIR`` writes ``OUTDIR/fbd_<type>.png``
+for every type in ``FREE_BODY_TYPES`` (docs/img/ holds them, for the glossary of output
+names):
+
+    python docs/make_free_body.py docs/img
+
+Docs tooling beside docs/make_api.py: pam2exu never imports it (tests/test_free_body.py
+loads it by its path). Run from a clone, it puts the repository root on ``sys.path``.
 """
 from __future__ import annotations
 
@@ -33,9 +38,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import closest
-from ..results.plot import PictureError, save
-from .pen import ACTUATOR, GROUND, INK, LOAD, PALETTE, Pen
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:          # run from a clone without installing
+    sys.path.insert(0, str(ROOT))
+
+from pam2exu.errors import PictureError, closest  # noqa: E402
+from pam2exu.pictures.pen import ACTUATOR, GROUND, INK, LOAD, PALETTE, Pen  # noqa: E402
+from pam2exu.results.plot import save  # noqa: E402
 
 #: size of a sketch [in] and its resolution (300 × 240 pixels)
 SIZE = (3.0, 2.4)
@@ -518,7 +527,7 @@ def free_body_sketch(element_type: str, path: str | Path) -> FreeBody:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m pam2exu.pictures.free_body",
+        prog="python docs/make_free_body.py",
         description="Write OUTDIR/fbd_<type>.png, the free-body sketch of every element type "
                     "that reports a force or a torque (and of the applied torsor).")
     parser.add_argument("outdir", type=Path, help="directory to write to (created if missing)")
