@@ -275,8 +275,8 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
     # plain Exudyn
     add("## 2. pam2exu against a plain Exudyn script")
     add("")
-    add("`plain_exudyn_four_bar` (`benchmarks/plain_exudyn.py`) writes the four-bar's position solve "
-        "directly in Exudyn: a `NodeRigidBody2D` and an `ObjectRigidBody2D` per moving link, "
+    add("`plain_exudyn_four_bar` (`benchmarks/plain_exudyn.py`) writes the four-bar's "
+        "position solve directly in Exudyn: a `NodeRigidBody2D` and an `ObjectRigidBody2D` per moving link, "
         "`ObjectGround`, four `ObjectJointRevolute2D`, the crank's angle driven by an "
         "`ObjectConnectorCoordinate`; the static solver with one load step per time step "
         "(steps + 1 load steps, as pam2exu), the same Newton tolerances and dense solver, "
