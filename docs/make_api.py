@@ -51,7 +51,7 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
       *[("pam2exu", cls.__name__) for cls in ELEMENTS.values()]]),
     ("Results",
      "Every analysis returns a `Results` table; `read_csv` reads one back from a file.",
-     [("pam2exu", "Results"), ("pam2exu", "read_csv"),
+     [("pam2exu", "Results"), ("pam2exu.results", "RunInfo"), ("pam2exu", "read_csv"),
       ("pam2exu.results", "select_columns"), ("pam2exu.results.units", "unit_of")]),
     ("Comparing results",
      ("`compare` checks a result against a reference, variable by variable; the user guide "

@@ -17,6 +17,7 @@ from ..backend import Backend, Positions
 from ..model import Model, load
 from ..model.solid import SOLID_OUTPUTS
 from ..results import Results, select_columns
+from ..results.info import RunInfo
 from . import grid, loops, native
 
 #: constraint residual above this (× the length scale) means a wrong translation
@@ -41,7 +42,7 @@ class Job:
     backend: Backend
     solver: object
     warnings: list[str] = field(default_factory=list)
-    info: dict = field(default_factory=dict)
+    info: RunInfo = field(default_factory=RunInfo)
     every: int = 1
     #: (actuator, its largest motion per user step, unit), for messages
     motion: tuple | None = None

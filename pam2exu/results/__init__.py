@@ -3,8 +3,9 @@ from ..errors import CompareInputError
 from .compare import compare
 from .comparison import Comparison, VariableComparison
 from .plot import plot
+from .info import RunInfo
 from .reading import read_csv, read_names
 from .table import Results, select_columns
 
 __all__ = ["Results", "select_columns", "read_csv", "plot", "compare", "Comparison",
-           "VariableComparison", "CompareInputError", "read_names"]
+           "VariableComparison", "CompareInputError", "read_names", "RunInfo"]

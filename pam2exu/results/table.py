@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, Problem, closest
+from .info import RunInfo
 
 
 class Results:
@@ -46,7 +47,7 @@ class Results:
         The model's name ('' when unknown).
     warnings : list of str, optional
         Warnings issued during the run.
-    info : dict, optional
+    info : RunInfo or dict, optional
         Facts about the run (see Attributes).
 
     Attributes
@@ -61,13 +62,14 @@ class Results:
     warnings : list of str
         Warnings raised during the run (redundant constraints, singular positions, the
         power balance), also issued as Python warnings.
-    info : dict
-        Run facts: ``dof`` and ``redundant_equations`` (rank test at the initial guess),
-        ``condition_number`` of the constraint Jacobian at the initial guess,
-        ``max_residual`` (largest constraint residual at Exudyn's positions [m or rad]),
-        ``exudyn_seconds`` (time in Exudyn's solver [s]), and per analysis
-        ``max_condition_number``, ``branch_resolves``, ``equilibrium_error`` (relative),
-        ``reactions_from``, ``power_balance_error`` and ``power_balance_tolerance`` [W].
+    info : RunInfo
+        Run facts, read as a dictionary of those the run set: ``dof`` and
+        ``redundant_equations`` (rank test at the initial guess), ``condition_number`` of
+        the constraint Jacobian at the initial guess, ``max_residual`` (largest constraint
+        residual at the backend's positions [m or rad]), ``exudyn_seconds`` (time in the
+        backend's position solves [s]), and per analysis ``max_condition_number``,
+        ``branch_resolves``, ``equilibrium_error`` (relative), ``reactions_from``,
+        ``power_balance_error`` and ``power_balance_tolerance`` [W] (``RunInfo``).
 
     Examples
     --------
@@ -95,7 +97,7 @@ class Results:
         self.units = {"t": "s", **(units or {})}
         self.analysis, self.model = analysis, model
         self.warnings = list(warnings or [])
-        self.info = dict(info or {})
+        self.info = RunInfo(**dict(info or {}))
 
     @property
     def t(self) -> np.ndarray:

@@ -1,0 +1,102 @@
+"""The facts of a run that are not columns: ``Results.info``, one typed field each."""
+from __future__ import annotations
+
+from collections.abc import MutableMapping
+from dataclasses import dataclass, fields
+
+from ..errors import closest
+
+
+@dataclass
+class RunInfo(MutableMapping):
+    """Facts about a run, set by the analyses (None: not measured by this run).
+
+    It reads as a dictionary of the facts that are set (``res.info["max_residual"]``,
+    ``"equilibrium_error" in res.info``, ``dict(res.info)``); setting a name that is not a
+    field is a KeyError, so that no module can write a fact nobody reads.
+
+    Attributes
+    ----------
+    dof : int
+        Degrees of freedom not driven (rank test at the initial guess).
+    redundant_equations : int
+        Redundant constraint equations (rank test at the initial guess).
+    condition_number : float
+        Condition number of the constraint Jacobian at the initial guess (equilibrated;
+        ``analyses.native.condition_numbers``) [-].
+    max_residual : float
+        Largest constraint residual at the backend's positions [m or rad].
+    exudyn_seconds : float
+        Time in the backend's position solves, building included [s].
+    substeps : int
+        Position solves per user step, when the motion per step needed more than one.
+    max_condition_number : float
+        Worst condition number sampled over the run (kinematic, kinetostatic) [-].
+    branch_resolves : int
+        Steps solved again by the branch following (kinematic, kinetostatic).
+    equilibrium_error : float
+        quasi_static: Exudyn's multipliers against the native equilibrium at the checked
+        steps, relative [-].
+    reactions_from : str
+        quasi_static: how the reactions were computed.
+    power_balance_error : float
+        kinetostatic: largest violation of the power balance [W].
+    power_balance_tolerance : float
+        kinetostatic: its tolerance, from the finite difference's own error [W].
+    power_balance_steps : int
+        kinetostatic: steps at which the power balance was checked.
+    power_balance : str
+        kinetostatic: why the power balance was not checked (too few rows).
+
+    Examples
+    --------
+    >>> info = RunInfo(max_residual=3e-15)
+    >>> info["max_residual"], "equilibrium_error" in info, dict(info)
+    (3e-15, False, {'max_residual': 3e-15})
+    >>> info["max_residul"] = 1.0
+    Traceback (most recent call last):
+    ...
+    KeyError: "no run fact 'max_residul' (did you mean 'max_residual'?)"
+    """
+
+    dof: int | None = None
+    redundant_equations: int | None = None
+    condition_number: float | None = None
+    max_residual: float | None = None
+    exudyn_seconds: float | None = None
+    substeps: int | None = None
+    max_condition_number: float | None = None
+    branch_resolves: int | None = None
+    equilibrium_error: float | None = None
+    reactions_from: str | None = None
+    power_balance_error: float | None = None
+    power_balance_tolerance: float | None = None
+    power_balance_steps: int | None = None
+    power_balance: str | None = None
+
+    def _field(self, key: str) -> str:
+        if key not in _NAMES:
+            raise KeyError(f"no run fact {key!r}{closest(key, _NAMES)}")
+        return key
+
+    def __getitem__(self, key: str):
+        value = getattr(self, self._field(key))
+        if value is None:
+            raise KeyError(key)
+        return value
+
+    def __setitem__(self, key: str, value) -> None:
+        setattr(self, self._field(key), value)
+
+    def __delitem__(self, key: str) -> None:
+        self[key]                                   # KeyError when not set
+        setattr(self, key, None)
+
+    def __iter__(self):
+        return (name for name in _NAMES if getattr(self, name) is not None)
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
+_NAMES = tuple(f.name for f in fields(RunInfo))
