@@ -23,7 +23,7 @@ import exudyn as exu
 import numpy as np
 
 import pam2exu
-from pam2exu.analyses import common
+from pam2exu.analyses import checks
 from pam2exu.backend import SolveSettings
 from references import closed_form, slider_crank
 
@@ -76,12 +76,12 @@ def best_of(fn, repeats):
 @contextlib.contextmanager
 def residual_check_off():
     """Switch off pam2exu's after-run residual check (loose tolerances only, marked †)."""
-    saved = common.RESIDUAL_TOLERANCE
-    common.RESIDUAL_TOLERANCE = math.inf
+    saved = checks.RESIDUAL_TOLERANCE
+    checks.RESIDUAL_TOLERANCE = math.inf
     try:
         yield
     finally:
-        common.RESIDUAL_TOLERANCE = saved
+        checks.RESIDUAL_TOLERANCE = saved
 
 
 @dataclass

@@ -258,7 +258,7 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         add("† pam2exu stops this run with a `TranslationError`: its check after the run "
             "finds Exudyn's constraint residual above 1e-8 of the length scale (the check "
             "that guards against a wrong translation). The run was repeated with that check "
-            "switched off (`pam2exu.analyses.common.RESIDUAL_TOLERANCE = inf`, in the "
+            "switched off (`pam2exu.analyses.checks.RESIDUAL_TOLERANCE = inf`, in the "
             "benchmark only) to measure its speed and error. So a tolerance looser than about "
             "1e-8 is not usable as pam2exu stands.")
         add("")

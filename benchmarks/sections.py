@@ -23,7 +23,7 @@ import exudyn as exu
 import numpy as np
 
 import pam2exu
-from pam2exu.analyses.common import prepare
+from pam2exu.analyses.job import prepare
 from pam2exu.backend import ExudynSystem, SolveSettings
 from references import slider_crank
 

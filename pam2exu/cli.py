@@ -203,7 +203,7 @@ def _check(args) -> int:
     degree of freedom driven and one is not."""
     import numpy as np
 
-    from .analyses.common import check_mobility, prepare
+    from .analyses.job import check_mobility, prepare
     from .analyses.native import require_driven
     job = prepare(args.model, args.analysis, args.t_end, args.steps, backend=args.backend)
     mech = job.mech

@@ -192,7 +192,7 @@ def script(model, t_end: float | None = None, steps: int | None = None,
     >>> "import exudyn as exu" in source, "def polynomial(t, C1, C2, C3, C4):" in source
     (True, True)
     """
-    from .analyses.common import check_mobility, prepare
+    from .analyses.job import check_mobility, prepare
     from .backend.script import ScriptSystem, code
     from .backend.system import SolveSettings, solver_options
 

@@ -16,7 +16,8 @@ import pytest
 
 import pam2exu
 from pam2exu import registry
-from pam2exu.analyses.common import check_mobility, collect, positions
+from pam2exu.analyses.job import check_mobility, collect
+from pam2exu.analyses.positions import positions
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "pam2exu"
@@ -102,8 +103,9 @@ def _cycle(edges: dict[str, set[str]]) -> list[str] | None:
 
 def test_the_walker_finds_imports_and_cycles():
     """The walker itself: the package's own imports are seen, and a cycle is found."""
-    top, _ = GRAPH["pam2exu.analyses.common"]
-    assert {"pam2exu.registry", "pam2exu.backend", "pam2exu.model", "pam2exu.model.solid"} <= top
+    top, _ = GRAPH["pam2exu.analyses.job"]
+    assert {"pam2exu.registry", "pam2exu.backend", "pam2exu.model", "pam2exu.model.solid",
+            "pam2exu.analyses.checks"} <= top
     assert _cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert _cycle({"a": {"b"}, "b": {"c"}}) is None
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from pam2exu import reference
-from pam2exu.analyses.common import SOLID_OUTPUTS
+from pam2exu.model.solid import SOLID_OUTPUTS
 from pam2exu.elements import ACCELERATION, ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY
 from pam2exu.laws import LAW_ALIASES, LAWS
 from pam2exu.model.model import Analysis

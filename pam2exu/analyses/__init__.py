@@ -9,7 +9,7 @@ from __future__ import annotations
 from ..errors import (ConditionWarning, ConsistencyWarning, Pam2ExuError, RedundancyWarning,
                       SolverError)
 from ..registry import ANALYSES
-from .common import prepare
+from .job import prepare
 
 
 def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,

@@ -1,7 +1,8 @@
 """Assembly: the constraints solved at t = 0, by Exudyn; one row of x, y, fi per solid."""
 from __future__ import annotations
 
-from .common import Job, check_mobility, collect, positions
+from .job import Job, check_mobility, collect
+from .positions import positions
 
 #: stiffness tying each coordinate to its guess when degrees of freedom are free [N/m]
 GUESS_STIFFNESS = 1.0

@@ -25,7 +25,10 @@ import numpy as np
 from ..errors import ConditionWarning, SolverError
 from ..kinematics import ANGLES
 from . import native
-from .common import Job, _position_failure, check_residual, positions, singular_error, warn
+from .checks import check_residual
+from .failure import position_failure, singular_error
+from .job import Job, warn
+from .positions import positions
 
 #: a velocity jump between two steps above this fraction of the velocities' scale is
 #: taken as a possible branch switch (smooth motion: O((ω dt)³) of it)
@@ -106,7 +109,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
             k = _first_jump(defect, singular, verified)
         if k is None:
             if solved < len(t):
-                raise _position_failure(job, replace(found, q=q, solved=solved))
+                raise position_failure(job, replace(found, q=q, solved=solved))
             break
         j = k - 1
         while singular[j]:

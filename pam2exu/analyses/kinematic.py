@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from ..elements import ACCELERATION, VELOCITY
 from .branch import motion
-from .common import Job, check_mobility, collect, positions
+from .job import Job, check_mobility, collect
+from .positions import positions
 
 
 def kinematic(job: Job):

@@ -8,7 +8,7 @@ from ..kinematics import State
 from . import forces
 from .branch import motion
 from ..errors import ConsistencyWarning
-from .common import Job, check_mobility, collect, warn
+from .job import Job, check_mobility, collect, warn
 
 
 def kinetostatic(job: Job):

@@ -8,7 +8,8 @@ from ..elements import FORCE
 from ..errors import TranslationError
 from ..kinematics import State
 from . import forces, native
-from .common import Job, check_mobility, collect, positions, velocities
+from .job import Job, check_mobility, collect
+from .positions import positions, velocities
 
 #: Exudyn's multipliers must satisfy the native equilibrium to this, relative to the forces
 EQUILIBRIUM_TOLERANCE = 1e-9

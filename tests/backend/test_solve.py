@@ -11,7 +11,7 @@ import pytest
 
 import pam2exu
 from pam2exu.analyses.quasi_static import checked_steps
-from pam2exu.analyses.common import prepare
+from pam2exu.analyses.job import prepare
 from pam2exu.backend import ExudynSystem, SolveSettings, system
 
 

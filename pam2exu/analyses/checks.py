@@ -1,0 +1,72 @@
+"""The self-checks after the numerics: pam2exu's constraints hold at the backend's
+positions, and no result is NaN or infinite."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..backend import Positions
+from ..errors import SolverError, TranslationError
+from . import native
+from .failure import position_failure
+
+if TYPE_CHECKING:                 # annotations only: job.py imports this module
+    from .job import Job
+
+
+#: constraint residual above this (× the length scale) means a wrong translation
+RESIDUAL_TOLERANCE = 1e-8
+
+
+def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = None) -> None:
+    """Self-check: pam2exu's own constraint equations hold at Exudyn's configuration.
+
+    res: the residual C(q, t) when already computed.
+    """
+    if mech.n_equations == 0:
+        return
+    if res is None:
+        res = native.residuals(mech, t, q)
+    worst = float(np.max(np.abs(res)))
+    if job is not None:
+        job.info["max_residual"] = worst
+    # a looser Newton tolerance leaves a larger residual: not a translation error
+    tolerance = job.solver.tolerance if job is not None else 0.0
+    tol = max(RESIDUAL_TOLERANCE, 100 * tolerance) * mech.scale()
+    if worst > tol:
+        over = np.max(np.abs(res), axis=1) > tol
+        first = int(np.argmax(over))
+        if job is not None and first > 0:
+            # redundant constraints whose targets part: the solver (told to ignore the
+            # singular Jacobian) can stop on a configuration that violates them
+            disagreement, _ = native.contradiction(mech, float(t[first]), q[first - 1])
+            if disagreement > tol:
+                raise position_failure(job, Positions(
+                    q, first, "no error (it stopped on a configuration that violates the "
+                              "constraints)", q[first - 1]))
+        k = int(np.argmax(np.max(np.abs(res), axis=1)))
+        name, value = native.worst_elements(mech, res[k], 1)[0]
+        raise TranslationError(
+            f"internal error: at t = {t[k]:.6g} s Exudyn's configuration violates pam2exu's "
+            f"equations of element {name} by {value:.3g} (tolerance {tol:.1g}): the Exudyn "
+            "translation of this element is wrong. Please report it with the model file.")
+
+
+def check_finite(job: Job, t: np.ndarray, values: dict[str, np.ndarray]) -> None:
+    """SolverError when a column has a value that is not finite (NaN, ±inf)."""
+    bad = {name: np.nonzero(~np.isfinite(v))[0] for name, v in values.items()}
+    bad = {name: rows for name, rows in bad.items() if rows.size}
+    if not bad:
+        return
+    k = min(int(rows[0]) for rows in bad.values())
+    names = [name for name, rows in bad.items() if rows[0] == k]
+    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    raise SolverError(
+        f"the {job.analysis} analysis gave values that are not numbers (NaN or infinite) "
+        f"first at t = {t[k]:.6g} s (row {k}), in {shown}"
+        + (f"; {len(bad)} columns in all" if len(bad) > len(names) else "")
+        + ". The mechanism is at or near a position where these are not defined (a "
+          "singular position, two points of an element that coincide): end the interval "
+          "before this time, or change the model so it avoids that position.",
+        time=float(t[k]), step=k)

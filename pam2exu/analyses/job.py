@@ -1,0 +1,176 @@
+"""An analysis before its numerics: the Job (model, grid, columns, backend), how it is
+prepared from a model and the overrides, the mobility check, the warnings kept with it,
+and the Results table it ends in."""
+from __future__ import annotations
+
+import os
+import sys
+import warnings
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .. import registry
+from ..backend import Backend
+from ..elements import ACCELERATION, FORCE, POSITION, VELOCITY, Var
+from ..errors import ModelError, Problem, RedundancyWarning
+from ..kinematics import State, column
+from ..model import Model, load
+from ..model.solid import SOLID_OUTPUTS
+from ..results import Results, select_columns
+from ..results.info import RunInfo
+from . import grid, native
+from .checks import check_finite
+
+
+@dataclass
+class Job:
+    """One analysis of one mechanism, with everything decided before the numerics.
+
+    ``times`` is the grid positions are solved on; the results keep every ``every``-th row
+    of it (the user's times, ``grid.Plan``).
+    """
+
+    mech: object
+    analysis: str
+    times: np.ndarray
+    columns: list[str]
+    units: dict[str, str]
+    levels: set[str]
+    #: what solves the positions, and its settings (``backend.Settings``)
+    backend: Backend
+    solver: object
+    warnings: list[str] = field(default_factory=list)
+    info: RunInfo = field(default_factory=RunInfo)
+    every: int = 1
+    #: (actuator, its largest motion per user step, unit), for messages
+    motion: tuple | None = None
+    #: what the analysis is doing, for the message of an unexpected failure
+    stage: str = "checking the analysis settings"
+
+
+def available_columns(mech, analysis: str) -> dict[str, Var]:
+    """Every column the analysis can produce, in order: solids, then elements."""
+    kind = registry.ANALYSES[analysis]
+    out = {}
+    for s in mech.solids:
+        for var in SOLID_OUTPUTS:
+            if var.level in kind.levels:
+                out[f"{s.name}.{var.name}"] = var
+    if kind.at_start:
+        return out
+    for el in mech.elements:
+        for var in el.outputs:
+            if var.level in kind.levels:
+                out[f"{el.name}.{var.name}"] = var
+    return out
+
+
+def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
+            backend=None) -> Job:
+    """Load and validate the model, apply the overrides, choose the columns and the backend
+    (``solver``: the backend's settings, default ``backend.Settings()``)."""
+    if not isinstance(model, Model):
+        model = load(model)
+    settings = replace(model.analysis, **{k: v for k, v in
+                                          dict(type=analysis, t_end=t_end, steps=steps,
+                                               outputs=outputs, backend=backend).items()
+                                          if v is not None})
+    problems = [Problem("[analysis]", m) for m in settings.problems()]
+    if problems:
+        raise ModelError(problems, model.source)
+    mech = model.mechanism()
+    kind = registry.ANALYSES[settings.type]
+    available = available_columns(mech, kind.name)
+    try:
+        columns = select_columns(list(available), settings.outputs)
+    except ModelError as exc:
+        raise ModelError(exc.problems, model.source) from None
+    if kind.at_start:
+        plan = grid.Plan(np.zeros(1), 1, None)
+        grid.check_laws(mech, plan.times)        # the actuators' values at t = 0
+    else:
+        plan = grid.plan(mech, settings.t_end, settings.steps, len(columns))
+    levels = {available[c].level for c in columns} | {POSITION}
+    if FORCE in levels and ACCELERATION in kind.levels:
+        levels.add(ACCELERATION)                 # the inertia forces need qdd
+    if ACCELERATION in levels:
+        levels.add(VELOCITY)
+    engine = registry.BACKENDS[settings.backend].create()
+    job = Job(mech, kind.name, plan.times, columns, {c: available[c].unit for c in columns},
+              levels, engine, solver if solver is not None else engine.Settings(),
+              every=plan.every, motion=plan.motion)
+    if plan.every > 1:
+        job.info["substeps"] = plan.every
+    return job
+
+
+def check_mobility(job: Job, q0: np.ndarray, need_driven: bool | None = None) -> native.Mobility:
+    """Rank test at the initial guess, before the backend is called (``warn_redundant``
+    follows once positions are solved); ``need_driven`` (default: what the analysis
+    declares, ``AnalysisType.driven``) raises MobilityError for a DOF not driven."""
+    if need_driven is None:
+        need_driven = registry.ANALYSES[job.analysis].driven
+    native.require_defined(job.mech, float(job.times[0]), q0)
+    mob = native.mobility(job.mech, float(job.times[0]), q0)
+    job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
+                    condition_number=mob.condition)
+    if need_driven:
+        native.require_driven(job.mech, mob, job.analysis)
+    return mob
+
+
+def warn_redundant(job: Job, q: np.ndarray) -> None:
+    """Warn once about redundant constraints, naming the elements of the self-stress found
+    at the first solved configuration (where the rank test is exact)."""
+    mob = native.mobility(job.mech, float(job.times[0]), q)
+    if not mob.redundant or mob.dof:
+        return
+    names = ", ".join(f"'{n}'" for n in mob.redundant_elements)
+    text = (f"{mob.redundant} redundant constraint equation(s) among {names}: positions, "
+            f"velocities and accelerations are unique, the reactions of these elements "
+            f"are not (they are given as the minimum-norm solution)")
+    warn(job, text, RedundancyWarning)
+
+
+def warn(job: Job, text: str, category) -> None:
+    """Keep a warning with the results and issue it at the caller's line outside pam2exu."""
+    job.warnings.append(text)
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame, level = sys._getframe(1), 2
+    while frame is not None and frame.f_code.co_filename.startswith(package):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(text, category, stacklevel=level)
+
+
+def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Results:
+    """The Results table of the chosen columns, on the user's times (rows of the solve grid).
+
+    The last guard of every analysis: a value that is not finite is a SolverError naming
+    the columns and the first time, never a result.
+    """
+    job.stage = "collecting the result columns"
+    mech, rows = job.mech, slice(None, None, job.every)
+    t = job.times[rows]
+    q, qd, qdd = (None if a is None else a[rows] for a in (q, qd, qdd))
+    extra = {k: v[rows] for k, v in (extra or {}).items()}
+    wanted = set(job.columns)
+    values: dict[str, np.ndarray] = {}
+    for i, s in enumerate(mech.solids):
+        for k, var in enumerate(SOLID_OUTPUTS):
+            name = f"{s.name}.{var.name}"
+            if name in wanted:
+                source = (q, qd, qdd)[k // 3]
+                values[name] = source[:, column(i, k % 3)]
+    st = State(t, q, qd if VELOCITY in job.levels else None)
+    for el in mech.elements:
+        names = {v.name for v in el.outputs if f"{el.name}.{v.name}" in wanted}
+        if names:
+            for var, v in el.compute(st, names).items():
+                if var in names:
+                    values[f"{el.name}.{var}"] = v
+    values.update(extra)
+    values = {k: v + 0.0 for k, v in values.items()}    # no negative zeros in tables
+    check_finite(job, t, values)
+    return Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
+                   mech.name, job.warnings, job.info)
