@@ -12,7 +12,7 @@ solid 1 of a transmission); thin grey dimensions are the position outputs a forc
 variables") and docs/analyses.md ("Reactions: which wrench, where, in which basis"), and
 they were checked against the code they come from: each element class's ``wrench``,
 ``report_frame``, ``receiver`` and ``loads`` (pam2exu/elements/), and
-``analyses.forces.element_wrench``.
+``analyses.force_pass.element_wrench``.
 
 The symbols are ``Pen``'s (pam2exu/pictures/pen.py), so a sketch looks like a ``pam2exu
 draw`` picture: solid 1 blue, solid 2 orange, ground and arm grey, actuators red, applied

@@ -5,7 +5,7 @@ import numpy as np
 
 from ..elements import FORCE
 from ..kinematics import State
-from . import forces
+from . import force_pass
 from .branch import motion
 from ..errors import ConsistencyWarning
 from .job import Job, check_mobility, collect, warn
@@ -17,7 +17,7 @@ def kinetostatic(job: Job):
     Contract: positions from Exudyn's static solver, qd and qdd natively (as kinematic);
     then at every step Cqᵀ λ = Q_inertia − Q_applied is solved natively (inertia from the
     mass at G and the inertia about G; gravity, torsors, springs and dampers applied), and
-    the reactions are read from λ (``forces.reactions``). The power balance is checked.
+    the reactions are read from λ (``force_pass.reactions``). The power balance is checked.
     """
     mob = check_mobility(job, job.mech.initial_q())
     redundant = mob.redundant > 0
@@ -29,15 +29,15 @@ def kinetostatic(job: Job):
 def inverse_dynamics(job: Job, q, qd, qdd, redundant: bool) -> dict[str, np.ndarray]:
     """Reactions, spring and actuator forces at every step, then the power balance check."""
     job.stage = "computing the reactions and actuator forces (inverse dynamics)"
-    out, e = forces.over_time(job.mech, job.times, q, redundant, qd, qdd)
-    power = forces.actuator_power(job.mech, State(job.times, q), out)
+    out, e = force_pass.over_time(job.mech, job.times, q, redundant, qd, qdd)
+    power = force_pass.actuator_power(job.mech, State(job.times, q), out)
     check_power_balance(job, power, e.energy, e.dissipation, e.external)
     return out
 
 
 def check_power_balance(job: Job, power, energy, dissipation, external) -> None:
     """Σ actuator power = dE/dt + dissipation − torsor power; warns when it does not hold."""
-    balance = forces.power_balance(job.mech, job.times, power, energy, dissipation, external)
+    balance = force_pass.power_balance(job.mech, job.times, power, energy, dissipation, external)
     if balance is None:
         job.info["power_balance"] = "not checked (fewer than 9 rows: steps < 8)"
         return

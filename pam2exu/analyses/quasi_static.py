@@ -1,5 +1,5 @@
 """Quasi-static analysis: positions by Exudyn, static equilibrium natively, cross-checked
-against Exudyn's static solver with the forces."""
+against Exudyn's static solver with the force_pass."""
 from __future__ import annotations
 
 import numpy as np
@@ -7,7 +7,7 @@ import numpy as np
 from ..elements import FORCE
 from ..errors import TranslationError
 from ..kinematics import State
-from . import forces, native
+from . import force_pass, native
 from .job import Job, check_mobility, collect
 from .positions import positions, velocities
 
@@ -23,7 +23,7 @@ def quasi_static(job: Job):
     Contract: every degree of freedom is driven, so the configurations do not depend on the
     forces: they come from the backend's solver on the constraints (as kinematic), and
     the reactions from the native equilibrium Cqᵀ λ = −Q_applied at every step (gravity,
-    torsors and springs, no damper terms; ``forces.over_time``). Exudyn's static solver
+    torsors and springs, no damper terms; ``force_pass.over_time``). Exudyn's static solver
     with the masses and force elements in the model checks them at ``CHECKED_STEPS`` steps
     (its multipliers λ, f + Cqᵀ λ = 0, must satisfy the native equilibrium). With
     redundant constraints λ is not unique: the reactions are the minimum-norm solution and
@@ -37,7 +37,7 @@ def quasi_static(job: Job):
     q = positions(job, redundant, check=False)
     velocities(job, q, redundant)      # raises at a singular position: reactions undefined
     job.stage = "computing the reactions (static equilibrium)"
-    out, _ = forces.over_time(job.mech, job.times, q, redundant)
+    out, _ = force_pass.over_time(job.mech, job.times, q, redundant)
     if redundant:
         job.info["reactions_from"] = "native minimum-norm solve"
     else:
@@ -79,7 +79,7 @@ def exudyn_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float:
                 f"translation is wrong. Please report it with the model file. "
                 f"{job.backend.label} said: {found.error}")
         st = State(job.times[k:k + 1], found.q)
-        applied = forces.applied_forces(mech, st, damping=False)
+        applied = force_pass.applied_forces(mech, st, damping=False)
         jacobian = native.equations(mech, st).jacobian
         worst = max(worst, equilibrium_error(mech, st, found.multipliers, applied.force,
                                              jacobian))
@@ -89,7 +89,7 @@ def exudyn_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float:
 def equilibrium_error(mech, st, lam, applied, jacobian) -> float:
     """max |Cqᵀ λ + Q_applied| relative to the largest force (moments divided by the length scale)."""
     per_length = np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
-    residual = forces.equilibrium_residual(mech, st, lam, -applied, jacobian) * per_length
+    residual = force_pass.equilibrium_residual(mech, st, lam, -applied, jacobian) * per_length
     size = max(np.max(np.abs(applied * per_length), initial=0.0),
                np.max(np.abs(np.einsum("nmq,nm->nq", jacobian, lam) * per_length), initial=0.0))
     return float(np.max(np.abs(residual), initial=0.0) / size) if size > 0 else 0.0

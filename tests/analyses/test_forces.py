@@ -14,7 +14,8 @@ import pytest
 import exudyn as exu
 
 import pam2exu
-from pam2exu.analyses import ConsistencyWarning, RedundancyWarning, forces
+from pam2exu.analyses import ConsistencyWarning, RedundancyWarning
+from pam2exu.analyses import force_pass as forces
 from pam2exu.backend import ExudynSystem, SolveSettings
 from pam2exu.elements import ELEMENTS, Prismatic, Spring
 from pam2exu.kinematics import State
