@@ -174,3 +174,33 @@ def test_every_analysis_and_backend_of_the_registry_resolves():
     for b in registry.BACKENDS.values():
         backend = b.create()
         assert backend.name == b.name and hasattr(backend.Settings(), "tolerance")
+
+
+# ---- docs/architecture.md stays true -----------------------------------------------------
+
+ARCHITECTURE = ROOT / "docs" / "architecture.md"
+
+
+def _named_files() -> set[str]:
+    """The files and folders docs/architecture.md names: `pam2exu/…`, `docs/…`, `tests/…`,
+    `references/`, `benchmarks/`, and the bare `x.py` of a row that names its folder."""
+    text = ARCHITECTURE.read_text(encoding="utf-8")
+    named = set(re.findall(r"`((?:pam2exu|docs|tests|references|benchmarks)/[\w/.]*)`", text))
+    for row in text.splitlines():
+        folder = re.match(r"\| `((?:pam2exu|benchmarks)/\w*/?)`", row)
+        if folder and folder.group(1).endswith("/"):
+            named |= {folder.group(1) + f for f in re.findall(r"`(\w+\.py)`", row)}
+    return named
+
+
+def test_every_file_the_architecture_page_names_exists():
+    named = _named_files()
+    assert len(named) > 40
+    assert [n for n in sorted(named) if not (ROOT / n).exists()] == []
+
+
+def test_every_module_of_the_package_is_on_the_architecture_page():
+    named = {n for n in _named_files() if n.endswith(".py")}
+    modules = {str(p.relative_to(ROOT)) for p in PACKAGE.rglob("*.py")
+               if p.name not in ("__init__.py", "__main__.py")}
+    assert sorted(modules - named) == []
