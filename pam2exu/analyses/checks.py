@@ -20,23 +20,24 @@ RESIDUAL_TOLERANCE = 1e-8
 
 
 def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = None) -> None:
-    """Self-check: pam2exu's own constraint equations hold at Exudyn's configuration.
+    """Self-check: pam2exu's own constraint equations hold at the backend's configuration.
 
-    res: the residual C(q, t) when already computed.
+    res: the residual C(q, t) when already computed. Redundant constraints that contradict
+    each other from some step on are reported as such (``failure.position_failure``).
     """
     if mech.n_equations == 0:
         return
     if res is None:
         res = native.residuals(mech, t, q)
-    worst = float(np.max(np.abs(res)))
+    per_step = np.max(np.abs(res), axis=1)
+    worst = float(np.max(per_step))
     if job is not None:
         job.info["max_residual"] = worst
     # a looser Newton tolerance leaves a larger residual: not a translation error
     tolerance = job.solver.tolerance if job is not None else 0.0
     tol = max(RESIDUAL_TOLERANCE, 100 * tolerance) * mech.scale()
     if worst > tol:
-        over = np.max(np.abs(res), axis=1) > tol
-        first = int(np.argmax(over))
+        first = int(np.argmax(per_step > tol))
         if job is not None and first > 0:
             # redundant constraints whose targets part: the solver (told to ignore the
             # singular Jacobian) can stop on a configuration that violates them
@@ -45,7 +46,7 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
                 raise position_failure(job, Positions(
                     q, first, "no error (it stopped on a configuration that violates the "
                               "constraints)", q[first - 1]))
-        k = int(np.argmax(np.max(np.abs(res), axis=1)))
+        k = int(np.argmax(per_step))
         name, value = native.worst_elements(mech, res[k], 1)[0]
         raise TranslationError(
             f"internal error: at t = {t[k]:.6g} s Exudyn's configuration violates pam2exu's "
