@@ -26,7 +26,7 @@ from ..errors import ConditionWarning, SolverError
 from ..kinematics import ANGLES
 from . import native
 from .checks import check_residual
-from .failure import position_failure, singular_error
+from .failure import motion_per_step, position_failure, singular_error
 from .job import Job, warn
 from .positions import positions
 
@@ -170,11 +170,7 @@ def _keeps_switching(job: Job, k: int, resolves: int, spent: int) -> SolverError
     else:
         much = (f"solving it again would take {spent:,} position solves, more than "
                 f"{RESOLVE_WORK} times the run")
-    motion = ""
-    if job.motion:
-        name, moved, unit = job.motion
-        motion = (f" '{name}' moves {moved:.3g} {unit} per step (solved in {job.every} "
-                  "sub-steps).")
+    motion = f" {motion_per_step(job)}." if job.motion else ""
     return SolverError(
         f"at t = {t[k]:.6g} s the mechanism keeps switching branch near singular positions "
         f"({much}).{motion} Use more steps, so the actuators move less per step, or end the "

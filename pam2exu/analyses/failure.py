@@ -93,11 +93,7 @@ def position_failure(job: Job, found: Positions) -> SolverError:
             "constraints can all hold there, but the Newton iteration diverged from the "
             "initial guess. Give the solids x, y, fi closer to an assembled position (angles "
             f"in radians). {said}", time=t, step=0, elements=elements)
-    motion = ""
-    if job.motion:
-        name, moved, unit = job.motion
-        motion = (f" ('{name}' moves {moved:.3g} {unit} per step, solved in {job.every} "
-                  "sub-steps)")
+    motion = f" ({motion_per_step(job)})" if job.motion else ""
     return SolverError(
         f"{job.backend.solver_name} did not converge at t = {t:.6g} s ({step}){motion}: the "
         "constraints can all hold there, so the Newton iteration diverged near a singular "
@@ -127,3 +123,10 @@ def singular_error(job: Job, k: int) -> SolverError:
         f"velocities{'' if job.analysis == 'kinematic' else ' and reactions'} are not "
         "defined. Drive the mechanism by another member, or stop the interval before this "
         "time.", time=float(t[k]), step=k)
+
+
+def motion_per_step(job: Job) -> str:
+    """"'motor' moves 1.8 rad per step, solved in 8 sub-steps": the fastest actuator's
+    motion per user step, where the plan solved each step in sub-steps (``job.motion``)."""
+    name, moved, unit = job.motion
+    return f"'{name}' moves {moved:.3g} {unit} per step, solved in {job.every} sub-steps"

@@ -66,6 +66,15 @@ def test_a_crank_at_360_rad_per_second_is_solved_in_sub_steps_and_is_exact():
     assert np.max(np.abs(res["coupler.Dfi"] - dphi)) < 1e-9 * 360.0
 
 
+def test_failure_messages_state_the_motion_per_step_of_a_sub_stepped_run():
+    """The phrase both failure messages (Newton's divergence, endless branch switching)
+    use: 360 rad/s in 200 steps is 1.8 rad per step, solved in 8 sub-steps."""
+    from pam2exu.analyses.failure import motion_per_step
+    from pam2exu.analyses.job import prepare
+    job = prepare(fast_four_bar(360.0), "kinematic")
+    assert motion_per_step(job) == "'motor' moves 1.8 rad per step, solved in 8 sub-steps"
+
+
 def test_the_default_grid_has_no_sub_steps():
     """2π/200 = 0.031 rad per step: the user's grid is solved as it is."""
     res = pam2exu.run(EXAMPLES / "four_bar.toml", analysis="kinematic")
