@@ -48,9 +48,10 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
                               "constraints)", q[first - 1]))
         k = int(np.argmax(per_step))
         name, value = native.worst_elements(mech, res[k], 1)[0]
+        label = job.backend.label if job is not None else "the backend"
         raise TranslationError(
-            f"internal error: at t = {t[k]:.6g} s Exudyn's configuration violates pam2exu's "
-            f"equations of element {name} by {value:.3g} (tolerance {tol:.1g}): the Exudyn "
+            f"internal error: at t = {t[k]:.6g} s {label}'s configuration violates pam2exu's "
+            f"equations of element {name} by {value:.3g} (tolerance {tol:.1g}): the {label} "
             "translation of this element is wrong. Please report it with the model file.")
 
 
