@@ -1,4 +1,4 @@
-"""Assembly: the constraints solved at t = 0, by Exudyn; one row of x, y, fi per solid."""
+"""Assembly: the constraints solved at t = 0 by the backend (Exudyn); one row of x, y, fi per solid."""
 from __future__ import annotations
 
 from .job import Job, check_mobility, collect

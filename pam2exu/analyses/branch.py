@@ -75,7 +75,7 @@ def _resolve(job: Job, k: int, start: np.ndarray, redundant: bool):
 def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: bool = True):
     """(q, qd, qdd) on the branch the mechanism starts on (see the module's doc).
 
-    Positions come from Exudyn; steps where the velocities jump are solved again.
+    Positions come from the backend; steps where the velocities jump are solved again.
     singular_ok: steps exactly at a singular position get interpolated rates (with a
     warning); False: they raise a SolverError (force analyses).
     """

@@ -1,4 +1,4 @@
-"""Kinematic analysis: positions by Exudyn, velocities and accelerations natively."""
+"""Kinematic analysis: positions by the backend (Exudyn), velocities and accelerations natively."""
 from __future__ import annotations
 
 from ..elements import ACCELERATION, VELOCITY

@@ -65,7 +65,7 @@ def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nda
 
 
 def velocities(job: Job, q: np.ndarray, redundant: bool):
-    """(qd, qdd) from the native pass, after the residual check of Exudyn's positions;
+    """(qd, qdd) from the native pass, after the residual check of the backend's positions;
     SolverError at a singular position (``branch.motion`` follows the branch instead)."""
     mech, t = job.mech, job.times
     accelerations = ACCELERATION in job.levels

@@ -1,5 +1,5 @@
-"""Quasi-static analysis: positions by Exudyn, static equilibrium natively, cross-checked
-against Exudyn's static solver with the force_pass."""
+"""Quasi-static analysis: positions by the backend, static equilibrium natively,
+cross-checked against the backend's static solver with the forces."""
 from __future__ import annotations
 
 import numpy as np
