@@ -46,16 +46,19 @@ def still(name, x, y, fi, k):
     return solid(name, (x + z, y + z), fi + z, (z, z), z, (z, z), z)
 
 
-def natural_scales(L, w):
-    """Scale of each variable when its reference is identically ~0."""
+def natural_scales(L, w, F=1.0):
+    """Scale of each variable when its reference is identically ~0 (length L [m], angular
+    velocity w [rad/s], force F [N])."""
     return {"x": L, "y": L, "fi": 1.0, "Dx": L * w, "Dy": L * w, "Dfi": w,
             "DDx": L * w * w, "DDy": L * w * w, "DDfi": w * w,
-            "f(t)": 1.0, "Df(t)": w, "ro": L, "Dro": L * w, "fi_rel": 1.0, "Dfi_rel": w}
+            "f(t)": 1.0, "Df(t)": w, "ro": L, "Dro": L * w, "fi_rel": 1.0, "Dfi_rel": w,
+            "Fx": F, "Fy": F, "Fnormal": F, "Força": F, "Mz": F * L, "Parell": F * L}
 
 
-def errors(res, ref, L, w):
-    """{column: max |res − ref| / scale}."""
-    fallback = natural_scales(L, w)
+def errors(res, ref, L, w, F=1.0):
+    """{column: max |res − ref| / scale}: the scale is the largest |ref|, or the natural
+    scale (``natural_scales``) where the reference is identically ~0."""
+    fallback = natural_scales(L, w, F)
     out = {}
     for name, value in ref.items():
         value = np.broadcast_to(np.asarray(value, dtype=float), res.t.shape)

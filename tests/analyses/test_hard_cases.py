@@ -43,6 +43,7 @@ import pytest
 
 import pam2exu
 from pam2exu.analyses import RedundancyWarning
+from references.closed_form import errors
 
 #: the ill-conditioning warnings these cases raise on purpose are checked in res.warnings
 pytestmark = pytest.mark.filterwarnings("ignore::pam2exu.ConditionWarning")
@@ -110,26 +111,6 @@ def positions_only(ref):
 
 def rates_only(ref):
     return {k: v for k, v in ref.items() if k.rsplit(".", 1)[1] not in ("x", "y", "fi")}
-
-
-def natural_scales(L, w, F=1.0):
-    return {"x": L, "y": L, "fi": 1.0, "Dx": L * w, "Dy": L * w, "Dfi": w,
-            "DDx": L * w * w, "DDy": L * w * w, "DDfi": w * w, "f(t)": 1.0, "Df(t)": w,
-            "Fx": F, "Fy": F, "Fnormal": F, "Força": F, "Mz": F * L, "Parell": F * L}
-
-
-def errors(res, ref, L, w, F=1.0):
-    """{column: max |res − ref| / scale} (scale: see the module docstring)."""
-    fallback = natural_scales(L, w, F)
-    out = {}
-    for name, value in ref.items():
-        value = np.broadcast_to(np.asarray(value, dtype=float), res.t.shape)
-        natural = fallback[name.rsplit(".", 1)[1]]
-        scale = float(np.max(np.abs(value)))
-        if scale < 1e-9 * natural:
-            scale = natural
-        out[name] = float(np.max(np.abs(res[name] - value))) / scale
-    return out
 
 
 def assert_matches(res, ref, L, w, F=1.0, rtol=RTOL):
