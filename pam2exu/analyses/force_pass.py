@@ -171,19 +171,17 @@ def _report_matrix(mech, st: State) -> np.ndarray:
 
 
 def multipliers(mech, st: State, rhs: np.ndarray, redundant: bool,
-                jacobian: np.ndarray | None = None, rcond: float = 1e-10) -> np.ndarray:
+                rcond: float = 1e-10) -> np.ndarray:
     """λ (n, m) with Cqᵀ λ = rhs at every step.
 
     Redundant constraints: of all solutions, the one whose reported reaction components
     R = B λ have the least sum of squares: R = (Cqᵀ B⁻¹)⁺ rhs, λ = B⁻¹ R.
     """
-    if not redundant and jacobian is None and mech.n_equations >= native.SPARSE_FROM:
+    if not redundant and mech.n_equations >= native.SPARSE_FROM:
         lam = _sparse_multipliers(mech, st, rhs)
         if lam is not None:
             return lam
-    if jacobian is None:
-        jacobian = native.equations(mech, st).jacobian
-    A = np.swapaxes(jacobian, 1, 2)                      # Cqᵀ, (n, nq, m)
+    A = np.swapaxes(native.equations(mech, st).jacobian, 1, 2)                      # Cqᵀ, (n, nq, m)
     if not redundant:
         return np.linalg.solve(A, rhs[..., None])[..., 0]
     B = _report_matrix(mech, st)

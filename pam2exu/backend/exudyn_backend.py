@@ -27,4 +27,4 @@ class Exudyn:
             lam = system.multipliers[:, order]
         error = None if system.error is None else str(system.error)
         return Positions(q, solved, error, system.coordinates(), lam,
-                         system.newton_iterations or 0)
+                         system.newton_iterations)

@@ -20,7 +20,7 @@ import numpy as np
 import exudyn as exu
 from exudyn import itemInterface as items
 
-from ..kinematics import State
+from ..kinematics import State, column, pose
 from .symbolic import offset_function
 
 log = logging.getLogger("pam2exu")
@@ -157,7 +157,7 @@ class ExudynSystem:
         self.start = mech.initial_q() if start is None else np.asarray(start, dtype=float)
         for i, s in enumerate(mech.solids):
             self.begin(s)
-            x, y, fi = (float(v) for v in self.start[3 * i:3 * i + 3])
+            x, y, fi = (float(v) for v in self.start[pose(i)])
             if i in self.grounded:
                 c, sn = np.cos(fi), np.sin(fi)
                 self.nodes.append(None)
@@ -198,7 +198,7 @@ class ExudynSystem:
                     mbs.AddObject(items.ObjectConnectorCoordinateSpringDamper(
                         markerNumbers=[self.ground_coordinate(), self.coordinate_marker(i, k)],
                         stiffness=anchor_stiffness * (L2 if k == 2 else 1.0),
-                        offset=float(q0[3 * i + k])))
+                        offset=float(q0[column(i, k)])))
         self.begin("sensors")
         self.sensors = {i: mbs.AddSensor(items.SensorNode(
             nodeNumber=n, storeInternal=True, writeToFile=False,
@@ -267,7 +267,7 @@ class ExudynSystem:
 
     def relative_rotation_marker(self, reference: int, solid: int):
         """fi_solid − fi_reference, continued past ±π by a NodeGenericData."""
-        fi0, fi1 = self.start[3 * reference + 2], self.start[3 * solid + 2]
+        fi0, fi1 = self.start[column(reference, 2)], self.start[column(solid, 2)]
         data = self.mbs.AddNode(self.items.NodeGenericData(
             numberOfDataCoordinates=1, initialCoordinates=[float(fi1 - fi0)]))
         return self.mbs.AddMarker(self.items.MarkerBodiesRelativeRotationCoordinate(
@@ -296,7 +296,7 @@ class ExudynSystem:
         k = 0
         for i, node in enumerate(self.nodes):
             if node is not None:
-                q[3 * i:3 * i + 3] = ode2[k:k + 3]
+                q[pose(i)] = ode2[k:k + 3]
                 k += 3
         return q
 
@@ -335,9 +335,10 @@ class ExudynSystem:
         step each, from the start configuration.
 
         Returns (q, n_solved): q has a row per time; when Exudyn stops early, the rows
-        after n_solved are NaN. ``self.newton_iterations``: Newton iterations in all. With ``multipliers``, Exudyn's Lagrange multipliers of
-        every step are kept in ``self.multipliers`` (n, AE size); in the static solver
-        they satisfy f + Cqᵀ λ = 0, f the applied generalized forces.
+        after n_solved are NaN. ``self.newton_iterations``: Newton iterations in all. With
+        ``multipliers``, Exudyn's Lagrange multipliers of every step are kept in
+        ``self.multipliers`` (n, AE size); in the static solver they satisfy
+        f + Cqᵀ λ = 0, f the applied generalized forces.
 
         Exudyn's load step k ≥ 1 is solved at time k·dt; the laws are evaluated one
         step earlier, so load step k gives time t_{k−1} (``loadStepStart`` cannot be < 0).
@@ -394,7 +395,6 @@ class ExudynSystem:
 
         if self.stepped or predict is not None:
             mbs.SetPreStepUserFunction(pre_step)
-        self.multipliers = None
         if multipliers:
             lam = self.multipliers = np.full((n, mbs.systemData.AEsize()), np.nan)
             get = mbs.systemData.GetAECoordinates
@@ -422,7 +422,7 @@ class ExudynSystem:
         finally:
             exu.config.printToConsole = False
         solver = mbs.sys.get("staticSolver")      # SolveStatic keeps it (storeSolver=True)
-        self.newton_iterations = int(solver.it.newtonStepsCount) if solver else None
+        self.newton_iterations = int(solver.it.newtonStepsCount) if solver else 0
         data = {i: np.asarray(mbs.GetSensorStoredData(s)) for i, s in self.sensors.items()}
         q = np.full((n, self.mech.nq), np.nan)
         first = next(iter(data.values()), None)
@@ -433,9 +433,9 @@ class ExudynSystem:
             k_rows -= k0
             on_grid &= (k_rows >= 0) & (k_rows < n)
             for i, d in data.items():
-                q[k_rows[on_grid], 3 * i:3 * i + 3] = d[1:, 1:4][on_grid]
+                q[k_rows[on_grid], pose(i)] = d[1:, 1:4][on_grid]
             for i in self.grounded:
-                q[k_rows[on_grid], 3 * i:3 * i + 3] = self.mech.initial_q()[3 * i:3 * i + 3]
+                q[k_rows[on_grid], pose(i)] = self.mech.initial_q()[pose(i)]
         solved = int(np.argmin(np.isfinite(q).all(axis=1))) if not np.isfinite(q).all() else n
         if error is None and solved < n:
             error = RuntimeError("the static solver stopped early")
