@@ -61,8 +61,9 @@ class Analysis:
 
     def _canonical_type(self) -> None:
         """A Catalan analysis name becomes the contract's."""
-        if isinstance(self.type, str) and registry.analysis_type(self.type) is not None:
-            self.type = registry.analysis_type(self.type).name
+        kind = registry.analysis_type(self.type) if isinstance(self.type, str) else None
+        if kind is not None:
+            self.type = kind.name
 
     def problems(self) -> list[str]:
         """What is wrong with these settings, one message each (empty when they are sound).
