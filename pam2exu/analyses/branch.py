@@ -28,7 +28,7 @@ from . import native
 from .checks import check_residual
 from .failure import motion_per_step, position_failure, singular_error
 from .job import Job, warn
-from .positions import positions
+from .positions import positions, rates
 
 #: a velocity jump between two steps above this fraction of the velocities' scale is
 #: taken as a possible branch switch (smooth motion: O((ω dt)³) of it)
@@ -67,29 +67,31 @@ def _breakpoints(mech) -> list[float]:
 
 
 def _resolve(job: Job, k: int, start: np.ndarray, redundant: bool):
-    """The backend's Positions at steps k… from ``start`` at step k."""
+    """The backend's Positions at steps k… from ``start`` at step k (with its rates if it
+    gives them)."""
     return job.backend.solve_positions(job.mech, job.times[k:], start, job.solver,
-                                       redundant=redundant)
+                                       redundant=redundant, rates=True)
 
 
 def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: bool = True):
     """(q, qd, qdd) on the branch the mechanism starts on (see the module's doc).
 
-    Positions come from the backend; steps where the velocities jump are solved again.
+    Positions come from the backend, rates from it too if it gives them (else from the
+    native pass); steps where the velocities jump are solved again.
     singular_ok: steps exactly at a singular position get interpolated rates (with a
     warning); False: they raise a SolverError (force analyses).
     """
     mech, t = job.mech, job.times
     q, found = positions(job, redundant, check=False, partial=True)
     solved = found.solved
+    own = found if found.qd is not None else None       # the backend's rates, if any
     breakpoints = _breakpoints(mech)
     verified: set[int] = set()
     resolves = spent = 0              # re-solves, and the position solves they took
     while True:
         job.stage = "computing velocities and following the branch"
         tk, qk = t[:solved], q[:solved]
-        with np.errstate(all="ignore"):
-            qd, qdd, residual = native.rates(mech, tk, qk, True, redundant)
+        qd, qdd, residual = rates(job, tk, qk, redundant, own)
         check_residual(mech, tk, qk, job, residual)
         singular = ~(np.isfinite(qd).all(axis=1) & np.isfinite(qdd).all(axis=1))
         q = _unwrap(mech, tk, q, qd, solved)
@@ -146,6 +148,8 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
             continue                 # no switch (a coarse grid), or no better branch found
         q = q.copy()
         q[k:] = part
+        if own is not None:
+            own = _joined(own, k, part_found, len(t))
         solved, found = k + part_solved, part_found
     job.info["branch_resolves"] = resolves
     if singular.any():
@@ -159,6 +163,16 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
     near = np.nonzero(_spikes(defect) | _with_neighbours(singular))[0]
     _warn_ill_conditioned(job, q, singular, near)
     return q, qd, (qdd if accelerations else None)
+
+
+def _joined(own, k: int, part, n: int):
+    """The backend's rates of steps before k, then those of ``part`` (from step k on); None
+    when the part has none."""
+    if part.qd is None:
+        return None
+    joined = replace(own, qd=own.qd.copy(), qdd=own.qdd.copy())
+    joined.qd[k:], joined.qdd[k:] = part.qd[:n - k], part.qdd[:n - k]
+    return joined
 
 
 def _keeps_switching(job: Job, k: int, resolves: int, spent: int) -> SolverError:

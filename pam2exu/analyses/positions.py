@@ -7,7 +7,7 @@ import time as _time
 import numpy as np
 
 from ..backend import Positions
-from ..elements import ACCELERATION
+from ..elements import ACCELERATION, VELOCITY
 from ..kinematics import ANGLES
 from . import native
 from .checks import check_residual
@@ -22,6 +22,8 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     ``check=False`` leaves the residual check to ``velocities`` (which has the residual).
     ``partial``: a failure after the first step is not raised; returns (q, Positions) with
     the rows from ``Positions.solved`` on NaN (``branch.motion`` may still repair it).
+    When the analysis needs velocities and the backend ``gives_rates``, it is asked for
+    them too (``Positions.qd``, ``qdd``; ``rates`` uses them).
     """
     mech = job.mech
     clock = _time.perf_counter()
@@ -31,7 +33,8 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
         found = Positions(start[None], 1, None, start)
     else:
         found = job.backend.solve_positions(mech, job.times, start, job.solver,
-                                            redundant=redundant)
+                                            redundant=redundant,
+                                            rates=VELOCITY in job.levels)
         if found.solved:         # step 0 is the assembly (Newton moved it by round-off)
             found.q[0] = start
     job.info["exudyn_seconds"] = _time.perf_counter() - clock
@@ -64,14 +67,28 @@ def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nda
     return q0
 
 
-def velocities(job: Job, q: np.ndarray, redundant: bool):
-    """(qd, qdd) from the native pass, after the residual check of the backend's positions;
-    SolverError at a singular position (``branch.motion`` follows the branch instead)."""
+def rates(job: Job, t, q, redundant: bool, found: Positions | None = None,
+          accelerations: bool = True):
+    """(qd, qdd, C(q, t)) at the steps t: the backend's own (``found.qd``, ``qdd``) when it
+    gave them for these rows, else the native pass's (``native.rates``); rows at a singular
+    position are NaN either way."""
+    if found is not None and found.qd is not None:
+        n = len(t)
+        with np.errstate(all="ignore"):
+            residual = native.residuals(job.mech, t, q)
+        return found.qd[:n], (found.qdd[:n] if accelerations else None), residual
+    with np.errstate(all="ignore"):
+        return native.rates(job.mech, t, q, accelerations, redundant)
+
+
+def velocities(job: Job, q: np.ndarray, redundant: bool, found: Positions | None = None):
+    """(qd, qdd) from the backend or the native pass (``rates``), after the residual check of
+    the backend's positions; SolverError at a singular position (``branch.motion`` follows
+    the branch instead)."""
     mech, t = job.mech, job.times
     accelerations = ACCELERATION in job.levels
     job.stage = "computing velocities and accelerations"
-    with np.errstate(all="ignore"):
-        qd, qdd, residual = native.rates(mech, t, q, accelerations, redundant)
+    qd, qdd, residual = rates(job, t, q, redundant, found, accelerations)
     check_residual(mech, t, q, job, residual)
     bad = ~np.isfinite(qd).all(axis=1)
     if qdd is not None:

@@ -35,6 +35,10 @@ class Positions:
         equilibrium f + Cqᵀ λ = 0 in pam2exu's row order (``Mechanism.rows``); else None.
     iterations : int
         Newton iterations in all (0 if the backend does not count them).
+    qd, qdd : numpy.ndarray or None
+        (n, nq): with ``rates`` and a backend that ``gives_rates``, the velocities and
+        accelerations of x, y, fi from the backend's own formulation (NaN from ``solved``
+        on); else None, and the native pass computes them.
     """
 
     q: np.ndarray
@@ -43,6 +47,8 @@ class Positions:
     last: np.ndarray
     multipliers: np.ndarray | None = None
     iterations: int = 0
+    qd: np.ndarray | None = None
+    qdd: np.ndarray | None = None
 
 
 class Backend(Protocol):
@@ -59,16 +65,19 @@ class Backend(Protocol):
     Settings : type
         Its settings class; an instance has at least ``tolerance`` (Newton's, relative to
         the mechanism's length) and ``verbose`` (0: quiet).
+    gives_rates : bool
+        ``solve_positions(..., rates=True)`` returns velocities and accelerations too.
     """
 
     name: ClassVar[str]
     label: ClassVar[str]
     solver_name: ClassVar[str]
     Settings: ClassVar[type]
+    gives_rates: ClassVar[bool]
 
     def solve_positions(self, mech, times: np.ndarray, start: np.ndarray, settings, *,
                         redundant: bool = False, forces: bool = False,
-                        anchor_stiffness: float = 0.0) -> Positions:
+                        anchor_stiffness: float = 0.0, rates: bool = False) -> Positions:
         """Configurations at the equally spaced ``times``, step after step from ``start``.
 
         Parameters
@@ -88,5 +97,7 @@ class Backend(Protocol):
         anchor_stiffness : float
             If > 0, tie every coordinate to its initial guess by a spring of this
             stiffness, so that free degrees of freedom stay nearest the guess (assembly).
+        rates : bool
+            Also return ``Positions.qd`` and ``qdd`` (ignored unless ``gives_rates``).
         """
         ...

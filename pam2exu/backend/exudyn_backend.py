@@ -13,9 +13,10 @@ class Exudyn:
     label = "Exudyn"
     solver_name = "Exudyn's static solver"
     Settings = SolveSettings
+    gives_rates = False
 
     def solve_positions(self, mech, times, start, settings, *, redundant=False, forces=False,
-                        anchor_stiffness=0.0) -> Positions:
+                        anchor_stiffness=0.0, rates=False) -> Positions:
         """See ``Backend.solve_positions``."""
         system = ExudynSystem(mech, forces=forces, velocity_forces=False,
                               anchor_stiffness=anchor_stiffness, start=start)

@@ -46,6 +46,11 @@ class AngularActuator(Actuator):
             offset=self.time_law().value(0.0) + shift))
         ex.drive(obj, "offset", self.time_law(), shift)
 
+    def natural(self, nc):
+        """fi2 − fi1 = f(t) in the solids' angle coordinates: linear."""
+        nc.equation(self, [nc.angle(self.ref2.solid) - nc.angle(self.ref1.solid)],
+                    self.time_law())
+
     def draw(self, pen, st):
         """An arc arrow about solid 2's origin."""
         pen.rotation(st.point(self.ref2.solid, (0.0, 0.0)).value[0])
@@ -89,6 +94,11 @@ class LinearActuator(Actuator):
             markerNumbers=[ex.point_marker(self.ref1), ex.point_marker(self.ref2)],
             distance=law.value(0.0)))
         ex.drive(obj, "distance", law)
+
+    def natural(self, nc):
+        """|Q − P|² = f(t)²: quadratic in z."""
+        P, Q = (nc.point(r.solid, r.local) for r in self.refs)
+        nc.equation(self, [(Q - P).dot(Q - P)], self.time_law(), power=2)
 
     def draw(self, pen, st):
         """A thick bar from P to Q."""

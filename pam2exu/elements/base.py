@@ -254,6 +254,21 @@ class Element:
         """
         raise NotImplementedError
 
+    # ---- natural coordinates -----------------------------------------------------------
+    def natural(self, nc) -> None:
+        """Declare this element's equations in natural coordinates to ``nc`` (a
+        ``backend.natural.Formulation``): from its points, directions and angles
+        (``nc.point``, ``nc.direction``, ``nc.angle``), ``nc.equation(self, [expressions],
+        target)``; a revolute shares a basic point (``nc.coincide``), a fixed link makes its
+        solid ground (``nc.ground``). Force elements declare nothing here."""
+        if self.equations:
+            raise NotImplementedError(f"{self.type} declares no natural-coordinate equations")
+
+    def natural_loads(self, nl) -> None:
+        """Apply this element's forces, computed from natural coordinates, to ``nl`` (a
+        ``backend.natural.loads.Loads``: ``nl.point``, ``nl.direction``, ``nl.angle`` give
+        where things are, ``nl.force`` and ``nl.moment`` apply). Constraint elements: none."""
+
     # ---- pictures ----------------------------------------------------------------------
     def draw(self, pen, st: State) -> None:
         """Draw the element's symbol with ``pen`` (a ``pictures.pen.Pen``) at the one

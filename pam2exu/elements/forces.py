@@ -64,6 +64,15 @@ class Torsor(Element):
             ex.add(self, ex.items.LoadTorqueVector(markerNumber=marker, loadVector=[0.0, 0.0, m],
                                                    bodyFixed=solid_axes), kind="load")
 
+    def natural_loads(self, nl):
+        """F = (Fx, Fy), or A(fi) (Fx, Fy) in solid axes, at the point; M on the solid."""
+        fx, fy, m = constants(self.C, 3)
+        solid, local = self.ref1.solid, self.ref1.local
+        force = (nl.direction(solid, (fx, fy)) if self.axes == "solid"
+                 else np.broadcast_to([fx, fy], (nl.n, 2)))
+        nl.force(solid, local, force)
+        nl.moment(solid, np.full(nl.n, m))
+
     def draw(self, pen, st):
         """An arrow along the force at its point, an arc arrow for the moment."""
         fx, fy, m = constants(self.C, 3)
@@ -170,6 +179,16 @@ class Spring(_SpringDamper):
         ex.add(self, ex.items.ObjectConnectorSpringDamper(
             markerNumbers=markers, springForceUserFunction=law))
 
+    def natural_loads(self, nl):
+        """F = C1 + C2 (ro − C3) pulls P towards Q and Q towards P (no damper: static)."""
+        c1, c2, c3, _ = constants(self.C)
+        P, Q = (nl.point(r.solid, r.local) for r in self.refs)
+        gap = Q - P
+        ro = np.hypot(gap[:, 0], gap[:, 1])
+        pull = ((c1 + c2 * (ro - c3)) / ro)[:, None] * gap
+        nl.force(self.ref1.solid, self.ref1.local, pull)
+        nl.force(self.ref2.solid, self.ref2.local, -pull)
+
     def draw(self, pen, st):
         """A zigzag between the two points."""
         pen.zigzag(*(st.point(r.solid, r.local).value[0] for r in self.refs))
@@ -210,6 +229,14 @@ class TorsionalSpring(_SpringDamper):
                 ex.add(self, ex.items.LoadTorqueVector(
                     markerNumber=ex.point_marker(ref), loadVector=[0.0, 0.0, sign * c1]),
                     kind="load")
+
+    def natural_loads(self, nl):
+        """Parell = C1 + C2 (fi2 − fi1 − C3): counter-clockwise on solid 1, clockwise on 2."""
+        c1, c2, c3, _ = constants(self.C)
+        s1, s2 = (r.solid for r in self.refs)
+        torque_ = c1 + c2 * (nl.angle(s2) - nl.angle(s1) - c3)
+        nl.moment(s1, torque_)
+        nl.moment(s2, -torque_)
 
     def draw(self, pen, st):
         """A spiral about solid 2's origin."""

@@ -50,6 +50,10 @@ class Fixed(Element):
                 markerNumbers=[ground, ex.coordinate_marker(self.ref1.solid, k)],
                 offset=float(self.pose[k])))
 
+    def natural(self, nc):
+        """The solid is ground: its points are constants (no coordinates, no equation)."""
+        nc.ground(self.ref1.solid, self.pose)
+
     def draw(self, pen, st):
         """A ground line under the held solid's origin."""
         pen.ground(st.point(self.ref1.solid, (0.0, 0.0)).value[0])
@@ -82,6 +86,10 @@ class Revolute(Element):
     def build(self, ex):
         ex.add(self, ex.items.ObjectJointRevolute2D(
             markerNumbers=[ex.point_marker(self.ref1), ex.point_marker(self.ref2)]))
+
+    def natural(self, nc):
+        """One basic point shared by both solids: no equation."""
+        nc.coincide(self.ref1, self.ref2, self)
 
     def draw(self, pen, st):
         """A pin joint at solid 2's point (on a support when it holds a solid to ground)."""
@@ -133,6 +141,13 @@ class Prismatic(Element):
             axisMarker0=[*line2.direction, 0.0], normalMarker1=[*line1.normal, 0.0],
             constrainRotation=True))
 
+    def natural(self, nc):
+        """(p1 − p2)·n1 = 0 and t2·n1 = 0: quadratic in z (points and directions are linear)."""
+        line1, line2 = self.refs
+        n1 = nc.direction(line1.solid, line1.normal)
+        gap = nc.point(line1.solid, line1.point) - nc.point(line2.solid, line2.point)
+        nc.equation(self, [gap.dot(n1), nc.direction(line2.solid, line2.direction).dot(n1)])
+
     def draw(self, pen, st):
         """Line 1 as a guide, a slider block on solid 2's defining point along line 2."""
         line1, line2 = self.refs
@@ -173,6 +188,12 @@ class PinSlot(Element):
             markerNumbers=[ex.point_marker(pin), ex.point_marker(guide)],
             axisMarker0=[*guide.direction, 0.0], normalMarker1=[*guide.normal, 0.0],
             constrainRotation=False))
+
+    def natural(self, nc):
+        """(p_guide − p_pin)·n_guide = 0: quadratic in z."""
+        guide, pin = self.refs
+        gap = nc.point(guide.solid, guide.point) - nc.point(pin.solid, pin.local)
+        nc.equation(self, [gap.dot(nc.direction(guide.solid, guide.normal))])
 
     def draw(self, pen, st):
         """The guide line, the pin on it."""
@@ -262,6 +283,12 @@ class Transmission(Element):
         rel1 = ex.relative_rotation_marker(self.arm_solid, self.ref1.solid)
         ex.add(self, ex.items.ObjectConnectorCoordinate(
             markerNumbers=[rel2, rel1], factor1=self.ratio, offset=-self.offset))
+
+    def natural(self, nc):
+        """T (fi1 − fi_arm) − (fi2 − fi_arm) = −C in the solids' angle coordinates: linear."""
+        arm = nc.angle(self.arm_solid)
+        rel1, rel2 = (nc.angle(r.solid) - arm for r in self.refs)
+        nc.equation(self, [rel1 * self.ratio - rel2], -self.offset)
 
     def draw(self, pen, st):
         """Pitch circles about the two solids' origins, radii in the ratio |T|."""

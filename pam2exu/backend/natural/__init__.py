@@ -1,0 +1,152 @@
+"""The natural-coordinate backend: a second, independent formulation of the constraints
+(Unda & García de Jalón, 1985), solved by pam2exu's own vectorised Newton method.
+
+``Formulation`` turns a mechanism into basic points, unit vectors and angles with linear and
+quadratic equations (each element declares its own: ``Element.natural``); ``Solver`` solves
+them for all time steps at once; ``Natural`` is the ``Backend`` the analyses call
+(``registry.BACKENDS['natural']``), returning x, y, fi of every solid and, on request, their
+velocities and accelerations from the formulation's own linear solves.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import SolverError
+from ...kinematics import ANGLES, PER_SOLID, column
+from ..base import Positions
+from .formulation import Coordinate, Formulation, Frame
+from .loads import multipliers
+from .solver import MAX_SUBSTEPS, NaturalSettings, Solver, anchored
+
+__all__ = ["Natural", "NaturalSettings", "Formulation", "Frame", "Coordinate"]
+
+
+class Natural:
+    """``Backend`` on the natural-coordinate formulation (``registry.BACKENDS['natural']``)."""
+
+    name = "natural"
+    label = "the natural-coordinate backend"
+    solver_name = "The natural-coordinate Newton solver"
+    Settings = NaturalSettings
+    #: it can return velocities and accelerations with the positions
+    gives_rates = True
+
+    def __init__(self):
+        self._forms: dict = {}
+
+    def formulation(self, mech, all_angles: bool = False) -> Formulation:
+        """The mechanism's formulation (made once per mechanism and kind)."""
+        key = (id(mech), all_angles)
+        if key not in self._forms:
+            self._forms[key] = (mech, Formulation(mech, all_angles))
+        return self._forms[key][1]
+
+    def weights(self, form: Formulation, mech) -> np.ndarray:
+        """What Newton's step is measured in: points / L, unit vectors and angles as they are."""
+        L = mech.scale()
+        return np.array([1.0 / L if c.kind == "point" else 1.0 for c in form.coordinates])
+
+    def solve_positions(self, mech, times, start, settings, *, redundant=False, forces=False,
+                        anchor_stiffness=0.0, rates=False) -> Positions:
+        """See ``Backend.solve_positions``; ``rates``: also return q̇ and q̈."""
+        times = np.asarray(times, dtype=float)
+        start = np.asarray(start, dtype=float)
+        form = self.formulation(mech, all_angles=anchor_stiffness > 0)
+        w = self.weights(form, mech)
+        solver = Solver(form.terms, w, settings, least_squares=redundant)
+        n = len(times)
+        q = np.full((n, mech.nq), np.nan)
+        z_start = form.from_q(start)[0]
+        try:
+            if anchor_stiffness > 0:
+                z0 = self._anchored(form, mech, times[0], z_start, settings, w)
+            else:
+                z1, ok = solver.newton(times[:1], z_start[None])
+                z0 = z1[0] if ok[0] else None
+        except SolverError as exc:
+            return Positions(q, 0, str(exc), start)
+        if z0 is None:
+            return Positions(q, 0, self._failed(form, solver, times[0], z1[0], settings), start)
+        z, solved = solver.run(times, z0)
+        error = None
+        if solved < n:
+            error = self._failed(form, solver, times[solved], z[solved - 1], settings)
+        q[:solved] = self.to_q(form, mech, z[:solved], start)
+        found = Positions(q, solved, error, q[solved - 1], iterations=solver.iterations)
+        if rates and solved:
+            zd, zdd = solver.rates(times[:solved], z[:solved])
+            found.qd, found.qdd = (np.full_like(q, np.nan) for _ in range(2))
+            found.qd[:solved], found.qdd[:solved] = self.to_rates(form, mech, z[:solved],
+                                                                  zd, zdd)
+        if forces and solved:
+            found.multipliers = multipliers(form, times[:solved], z[:solved], q[:solved])
+        return found
+
+    def _anchored(self, form, mech, t0, z_start, settings, w):
+        """The assembly with free degrees of freedom: nearest the model's x, y, fi (the same
+        distance as the Exudyn backend's springs: x, y in m, fi times the length scale)."""
+        K = form.pose_forms()
+        q0 = mech.initial_q()
+        L2 = mech.scale() ** 2
+        rows, target, weight = [], [], []
+        for i, f in enumerate(form.frames):
+            if i in form.grounds:
+                continue
+            x0, y0, fi0 = (q0[column(i, k)] for k in range(PER_SOLID))
+            rows += [K[4 * i], K[4 * i + 1], np.eye(form.nz + 1)[f.angle]]
+            target += [x0, y0, fi0]
+            weight += [1.0, 1.0, L2]
+        return anchored(form.terms, t0, z_start, np.array(rows), np.array(target),
+                        np.array(weight), settings, w)
+
+    def _failed(self, form, solver, t, z, settings) -> str:
+        with np.errstate(all="ignore"):
+            phi = np.abs(form.terms.residual(np.array([t]), z[None])[0])
+        text = (f"Newton's iteration did not converge at t = {t:.6g} s in "
+                f"{settings.max_iterations} iterations, nor in {MAX_SUBSTEPS} sub-steps")
+        if phi.size and np.isfinite(phi).all():
+            k = int(np.argmax(phi))
+            text += f" (largest natural-coordinate residual {phi[k]:.3g}, {form.labels[k]})"
+        return text
+
+    # ---- back to x, y, fi ---------------------------------------------------------------------
+    def to_q(self, form: Formulation, mech, z: np.ndarray, start: np.ndarray) -> np.ndarray:
+        """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
+        value in the whole turn nearest ``start``."""
+        K = form.pose_forms()
+        pose = np.c_[z, np.ones(len(z))] @ K.T                    # x, y, cos, sin per solid
+        q = np.empty((len(z), mech.nq))
+        for i, f in enumerate(form.frames):
+            x, y, c, s = (pose[:, 4 * i + k] for k in range(4))
+            q[:, column(i, 0)], q[:, column(i, 1)] = x, y
+            if f.fixed_angle is not None:
+                fi = np.full(len(z), f.fixed_angle)
+            elif f.angle is not None:
+                fi = z[:, f.angle]
+            else:
+                fi = np.unwrap(np.arctan2(s, c))
+                fi += 2 * np.pi * np.rint((start[column(i, 2)] - fi[0]) / (2 * np.pi))
+            q[:, column(i, 2)] = fi
+        return q
+
+    def to_rates(self, form: Formulation, mech, z, zd, zdd):
+        """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)."""
+        K = form.pose_forms()[:, :form.nz]
+        pose = np.c_[z, np.ones(len(z))] @ form.pose_forms().T
+        d1, d2 = zd @ K.T, zdd @ K.T
+        qd, qdd = np.empty((len(z), mech.nq)), np.empty((len(z), mech.nq))
+        for i, f in enumerate(form.frames):
+            for k in range(2):
+                qd[:, column(i, k)], qdd[:, column(i, k)] = d1[:, 4 * i + k], d2[:, 4 * i + k]
+            if f.fixed_angle is not None:
+                w, a = 0.0, 0.0
+            elif f.angle is not None:
+                w, a = zd[:, f.angle], zdd[:, f.angle]
+            else:
+                c, s = pose[:, 4 * i + 2], pose[:, 4 * i + 3]
+                dc, ds, ddc, dds = (x[:, 4 * i + k] for x in (d1, d2) for k in (2, 3))
+                r2 = c * c + s * s
+                w = (c * ds - s * dc) / r2
+                a = (c * dds - s * ddc) / r2 - 2 * (c * dc + s * ds) * w / r2
+            qd[:, column(i, 2)], qdd[:, column(i, 2)] = w, a
+        return qd, qdd

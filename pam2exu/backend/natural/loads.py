@@ -1,0 +1,97 @@
+"""Forces in natural coordinates: what the natural backend's static equilibrium gives the
+quasi-static analysis to check (``Positions.multipliers``).
+
+Each force acts on one solid, whose points are r(s) = p + a v + b Ω v (``Frame``): a force
+F at s does the virtual work F·(δp + a δv + b Ω δv), so it is (F, a F − b Ω F) on the
+solid's (p, v); a moment M does M δfi = M (Ω v)·δv / |v|². On x, y, fi (p = R + A s_p,
+v = A d): Q_xy = Q_p, Q_fi = Q_p·Ω(p − R) + Q_v·Ω v. The multipliers then follow from
+pam2exu's own Cqᵀ λ = −Q (least squares, minimum norm), in its row order.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...kinematics import State, column, pose, perp
+
+
+class Loads:
+    """The generalized forces of gravity and of the force elements at configurations z.
+
+    Parameters
+    ----------
+    form : Formulation
+    z : numpy.ndarray
+        (n, nz) natural coordinates.
+    q : numpy.ndarray
+        (n, nq) the same configurations as x, y, fi.
+    """
+
+    def __init__(self, form, z: np.ndarray, q: np.ndarray):
+        self.form, self.q, self.n = form, q, q.shape[0]
+        self.zx = np.c_[z, np.ones(self.n)]
+        ns = len(form.frames)
+        self.Qp, self.Qv = np.zeros((self.n, ns, 2)), np.zeros((self.n, ns, 2))
+
+    def _value(self, vec) -> np.ndarray:
+        """A linear Vec at the configurations, (n, 2)."""
+        return self.zx @ np.c_[self.form.matrix(vec), self.form.constants(vec)].T
+
+    def point(self, solid: int, local) -> np.ndarray:
+        """Where the point ``local`` of the solid is, (n, 2)."""
+        return self._value(self.form.frames[solid].point(local))
+
+    def direction(self, solid: int, local) -> np.ndarray:
+        """The solid's local vector ``local`` in the global basis, (n, 2)."""
+        return self._value(self.form.frames[solid].direction(local))
+
+    def angle(self, solid: int) -> np.ndarray:
+        """The solid's angle fi, (n,)."""
+        return self.q[:, column(solid, 2)]
+
+    def force(self, solid: int, local, force) -> None:
+        """A force (n, 2) at the point ``local`` of the solid: (F, a F − b Ω F) on (p, v)."""
+        f = self.form.frames[solid]
+        a, b = f._ab((local[0] - f.sp[0], local[1] - f.sp[1]))
+        force = np.asarray(force, dtype=float)
+        self.Qp[:, solid] += force
+        self.Qv[:, solid] += a * force - b * perp(force)
+
+    def moment(self, solid: int, moment) -> None:
+        """A moment (n,) on the solid: M Ω v / |v|² on v."""
+        v = self._value(self.form.frames[solid].v)
+        self.Qv[:, solid] += np.asarray(moment, dtype=float)[:, None] * perp(v) / \
+            np.sum(v * v, axis=1, keepdims=True)
+
+    def gravity(self, g: float) -> None:
+        """(0, −m g) at every solid's centre of mass."""
+        for i, s in enumerate(self.form.mech.solids):
+            if float(s.mass) and g:
+                weight = np.broadcast_to([0.0, -float(s.mass) * g], (self.n, 2))
+                self.force(i, (float(s.cog[0]), float(s.cog[1])), weight)
+
+    def on_pose(self) -> np.ndarray:
+        """Q (n, nq) on x, y, fi of every solid."""
+        out = np.zeros_like(self.q)
+        for i, f in enumerate(self.form.frames):
+            p, v = self._value(f.p), self._value(f.v)
+            arm = p - self.q[:, pose(i)][:, :2]
+            out[:, pose(i)][:, :2] = self.Qp[:, i]
+            out[:, column(i, 2)] = (np.sum(self.Qp[:, i] * perp(arm), axis=1)
+                                    + np.sum(self.Qv[:, i] * perp(v), axis=1))
+        return out
+
+
+def multipliers(form, t: np.ndarray, z: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """λ (n, m) in pam2exu's row order with Cqᵀ λ = −Q: the static equilibrium of gravity and
+    the force elements (no dampers), the forces taken from natural coordinates."""
+    mech = form.mech
+    loads = Loads(form, z, q)
+    loads.gravity(mech.gravity)
+    for el in mech.elements:
+        el.natural_loads(loads)
+    Q = loads.on_pose()
+    st = State(t, q)
+    J = np.zeros((len(t), mech.n_equations, mech.nq))
+    for el, rows in zip(mech.constraints, mech.rows):
+        el.constraint(st)[0].rows(J, rows.start)
+    return np.stack([np.linalg.lstsq(J[k].T, -Q[k], rcond=1e-12)[0] for k in range(len(t))])
