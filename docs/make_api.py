@@ -58,6 +58,12 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
       "is [compare.md](compare.md)."),
      [("pam2exu", "compare"), ("pam2exu", "Comparison"),
       ("pam2exu.results", "VariableComparison"), ("pam2exu.results", "read_names")]),
+    ("Verifying a model on two backends",
+     ("`verify` runs one analysis on two backends (two formulations of the constraints) and "
+      "compares them within a tolerance derived from the solvers' tolerances and the "
+      "condition number; the user guide is [verify.md](verify.md)."),
+     [("pam2exu", "verify"), ("pam2exu", "Verification"), ("pam2exu.verify", "Rule"),
+      ("pam2exu.verify", "agreement")]),
     ("Exporting to Exudyn",
      "A standalone Exudyn script of a model; the user guide is [export.md](export.md).",
      [("pam2exu", "export"), ("pam2exu.export", "script")]),

@@ -2,7 +2,8 @@
 
 Load a model (``load``, ``loads``) or build one (``Model``), run an analysis (``run``), get a
 ``Results`` table of named columns (``crank.fi``, ``motor.Mz``, …), compare it with a
-reference (``compare``) or export the model as a standalone Exudyn script (``export``).
+reference (``compare``), verify it on two backends (``verify``) or export the model as a
+standalone Exudyn script (``export``).
 The API reference is docs/api.md.
 
 >>> import pam2exu
@@ -20,6 +21,7 @@ from .pictures import animate, draw
 from .results import CompareInputError, Comparison, Results, plot, read_csv
 from .results.compare import compare
 from .results.plot import PictureError
+from .verify import Verification, verify
 
 __version__ = "0.1.0"
 
@@ -131,8 +133,9 @@ def run(model, analysis=None, **settings):
 
 
 __all__ = ["Model", "Solid", "Law", "load", "loads", "run", "Results", "read_csv", "compare",
-           "Comparison", "export", "plot", "draw", "animate", "ELEMENTS",
-           "Fixed", "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor", "Spring",
-           "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError", "ModelError",
-           "MobilityError", "SolverError", "TranslationError", "CompareInputError",
-           "PictureError", "RedundancyWarning", "ConsistencyWarning", "ConditionWarning"]
+           "Comparison", "verify", "Verification", "export", "plot", "draw", "animate",
+           "ELEMENTS", "Fixed", "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor",
+           "Spring", "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError",
+           "ModelError", "MobilityError", "SolverError", "TranslationError",
+           "CompareInputError", "PictureError", "RedundancyWarning", "ConsistencyWarning",
+           "ConditionWarning"]

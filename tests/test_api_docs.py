@@ -224,7 +224,7 @@ DOCTEST_MODULES = ["pam2exu", "pam2exu.errors", "pam2exu.laws", "pam2exu.model.m
                    "pam2exu.results.table", "pam2exu.results.names", "pam2exu.results.reading",
                    "pam2exu.results.compare", "pam2exu.results.comparison",
                    "pam2exu.results.units", "pam2exu.results.plot", "pam2exu.results.info",
-                   "pam2exu.pictures.mechanism", "pam2exu.export"]
+                   "pam2exu.pictures.mechanism", "pam2exu.export", "pam2exu.verify"]
 
 
 @pytest.mark.parametrize("name", DOCTEST_MODULES)

@@ -101,6 +101,10 @@ class Comparison:
         max |t_result − t_reference| over the rows matched [s]; 0 when interpolated.
     wrapped : list of str
         The angles [rad] compared modulo 2π (``wrap_angles=True``).
+    rule : str
+        The pass rule's line of the header when the tolerances are not one rtol and atol
+        (``pam2exu verify``: one per variable, in the rows' ``tolerance``); '' for the rule
+        atol + rtol · scale.
 
     Examples
     --------
@@ -130,6 +134,7 @@ class Comparison:
     time_digits: str = ""               # what the times carry when matched to it
     time_difference: float = 0.0        # max |t_result - t_reference| of the rows matched [s]
     wrapped: list[str] = field(default_factory=list)    # angles compared modulo 2π
+    rule: str = ""                      # the rule's line when not atol + rtol·scale
 
     @property
     def passed(self) -> bool:
@@ -160,7 +165,7 @@ class Comparison:
         -------
         list of str
             One line each: the result, the reference, how the times were matched, the
-            pass rule with rtol and atol, the angles compared modulo 2π, then the ``notes``.
+            pass rule with rtol and atol (or ``rule``), the angles compared modulo 2π, then the ``notes``.
         """
         lo, hi = self.overlap
         if self.method is None and self.time_digits:
@@ -181,6 +186,7 @@ class Comparison:
         return [f"result: {self.result} ({self.result_rows} rows)",
                 f"reference: {self.reference} ({self.reference_rows} rows)",
                 times,
+                self.rule or
                 (f"rule: a variable passes when max |result − reference| ≤ atol + rtol·scale, "
                  f"scale = max |reference| (rtol = {self.rtol:g}, atol = {self.atol:g})"),
                 *([f"angles compared modulo 2π (the difference reduced to (−π, π], scale π): "
