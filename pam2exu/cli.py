@@ -2,6 +2,7 @@
 
 Exit codes: 0 success, 1 solver failure, 2 model error (or bad command line).
 ``compare``: 0 every variable within the tolerance, 1 some outside, 2 bad input.
+``verify``: 0 the two backends agree, 1 they differ or a run fails, 2 bad input.
 ``plot``, ``draw``, ``animate``: 2 also for a picture that cannot be made as asked (an
 unknown image format, no ffmpeg for .mp4, a variable that matches nothing).
 Errors are printed to stderr as one paragraph; ``--debug`` shows the traceback.
@@ -15,6 +16,7 @@ import warnings
 from . import __version__
 from .errors import ModelError, Pam2ExuError, SolverError
 from .registry import ANALYSES, BACKENDS, DEFAULT_BACKEND
+from .verify import BACKENDS_COMPARED, verify
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -93,6 +95,22 @@ def _parser() -> argparse.ArgumentParser:
     comp.add_argument("--wrap-angles", action="store_true",
                       help="compare angles (rad) modulo 2π, for exports whose angles wrap at "
                            "±π (PAM's)")
+
+    ver = sub.add_parser(
+        "verify", help="run the model on two backends and compare them, variable by variable",
+        description="Run the analysis on two backends (two formulations of the constraints) "
+                    "and print, per variable, the largest difference, where it occurs and "
+                    "whether it is within a tolerance derived from the solvers' tolerances "
+                    "and the condition number. Exit 0 when they agree, 1 when they differ "
+                    "(or a run fails), 2 for bad input. See docs/verify.md.")
+    ver.add_argument("model", help="model file (TOML)")
+    ver.add_argument("--analysis", "-a", metavar="TYPE",
+                     help="the analysis (default: the model's)")
+    ver.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
+    ver.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
+    ver.add_argument("--against", metavar="BACKEND", default=BACKENDS_COMPARED[1],
+                     help=f"the backend verified against {BACKENDS_COMPARED[0]} (default "
+                          f"{BACKENDS_COMPARED[1]}; known: " + ", ".join(BACKENDS) + ")")
 
     exp = sub.add_parser(
         "export", help="write a standalone Exudyn script of the model (positions to CSV)",
@@ -281,6 +299,18 @@ def _compare(args) -> int:
     return 0 if table.passed else 1
 
 
+def _verify(args) -> int:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")      # warnings are carried in each run's Results
+        found = verify(args.model, analysis=args.analysis, steps=args.steps,
+                       t_end=args.t_end, backends=(BACKENDS_COMPARED[0], args.against))
+    for backend, res in zip(found.backends, (found.reference, found.result)):
+        for w in res.warnings:
+            print(f"warning ({backend}): {w}", file=sys.stderr)
+    print(found.to_markdown())
+    return 0 if found.ok else 1
+
+
 def _picture(kind: str, make, debug: bool = False) -> int:
     """Run ``make()``; bad input for a picture (PictureError, unreadable CSV) exits 2."""
     from .results.compare import CompareInputError
@@ -342,7 +372,7 @@ def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     try:
         return {"run": _run, "check": _check, "elements": _elements, "compare": _compare,
-                "export": _export, "plot": _plot, "draw": _draw,
+                "verify": _verify, "export": _export, "plot": _plot, "draw": _draw,
                 "animate": _animate}[args.command](args)
     except BrokenPipeError:              # output piped into head & co.
         sys.stderr.close()
