@@ -42,3 +42,17 @@ def pytest_addoption(parser):
     parser.addoption("--fuzz-long", action="store_true", default=False,
                      help="tests/fuzz: run the long fuzz campaign (10,000 mutants) instead of "
                           "the CI one")
+
+
+@pytest.fixture(params=list(pam2exu.registry.BACKENDS))
+def every_backend(request, monkeypatch):
+    """Run the test once per backend: ``pam2exu.run`` uses it unless the call names one
+    (a module opts in with ``pytestmark = pytest.mark.usefixtures("every_backend")``)."""
+    run = pam2exu.run
+
+    def run_on(*args, **settings):
+        settings.setdefault("backend", request.param)
+        return run(*args, **settings)
+
+    monkeypatch.setattr(pam2exu, "run", run_on)
+    return request.param

@@ -51,8 +51,8 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
         label = job.backend.label if job is not None else "the backend"
         raise TranslationError(
             f"internal error: at t = {t[k]:.6g} s {label}'s configuration violates pam2exu's "
-            f"equations of element {name} by {value:.3g} (tolerance {tol:.1g}): the {label} "
-            "translation of this element is wrong. Please report it with the model file.")
+            f"equations of element {name} by {value:.3g} (tolerance {tol:.1g}): the translation "
+            f"of this element for {label} is wrong. Please report it with the model file.")
 
 
 def check_finite(job: Job, t: np.ndarray, values: dict[str, np.ndarray]) -> None:

@@ -42,17 +42,18 @@ def quasi_static(job: Job):
         job.info["reactions_from"] = "native minimum-norm solve"
     else:
         rows = checked_steps(len(job.times))
-        job.stage = "checking the reactions with Exudyn's static solver"
+        label = job.backend.label
+        job.stage = f"checking the reactions with {job.backend.solver_name}"
         worst = exudyn_equilibrium_error(job, q, rows)
-        job.info["reactions_from"] = (f"native solve, Exudyn's multipliers agree at "
+        job.info["reactions_from"] = (f"native solve, {label}'s multipliers agree at "
                                       f"{len(rows)} steps")
         job.info["equilibrium_error"] = worst
         if worst > EQUILIBRIUM_TOLERANCE:
             raise TranslationError(
-                f"internal error: Exudyn's multipliers leave a relative equilibrium error of "
+                f"internal error: {label}'s multipliers leave a relative equilibrium error of "
                 f"{worst:.2g} against pam2exu's own forces (tolerance "
-                f"{EQUILIBRIUM_TOLERANCE:g}): the Exudyn translation of a force element is "
-                "wrong. Please report it with the model file.")
+                f"{EQUILIBRIUM_TOLERANCE:g}): the translation of a force element for {label} "
+                "is wrong. Please report it with the model file.")
     return collect(job, q, extra=out)
 
 

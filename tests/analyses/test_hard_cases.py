@@ -46,7 +46,8 @@ from pam2exu.analyses import RedundancyWarning
 from references.closed_form import errors
 
 #: the ill-conditioning warnings these cases raise on purpose are checked in res.warnings
-pytestmark = pytest.mark.filterwarnings("ignore::pam2exu.ConditionWarning")
+pytestmark = [pytest.mark.filterwarnings("ignore::pam2exu.ConditionWarning"),
+              pytest.mark.usefixtures("every_backend")]   # each test on each backend
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 RTOL = 1e-9

@@ -29,6 +29,9 @@ import pam2exu
 from references.closed_form import FOUR_BAR, e, errors, four_bar, n, solid, still
 from references.laws import LAWS, actuator_law
 
+#: each test runs on each backend (``every_backend`` in conftest.py)
+pytestmark = pytest.mark.usefixtures("every_backend")
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 RTOL = 1e-9
 TWO_PI = 2.0 * math.pi

@@ -30,6 +30,9 @@ from references.slider_crank import (cross, dot, errors, kinematic_ref, kinemati
                                      law_polynomial, model_toml, n, newton_euler, rot,
                                      slider_crank_params, torsor_load)
 
+#: each test runs on each backend (``every_backend`` in conftest.py)
+pytestmark = pytest.mark.usefixtures("every_backend")
+
 RTOL = 1e-9
 TWO_PI = 2.0 * math.pi
 

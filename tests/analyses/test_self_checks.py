@@ -44,7 +44,7 @@ def test_a_wrong_translation_is_caught_by_the_residual_check(monkeypatch):
     assert found, message
     # one component of the 1e-6 m offset, turned with the rocker: between 1/√2 and 1 of it
     assert 0.7e-6 < float(found.group(1)) <= 1.0e-6
-    assert "the Exudyn translation of this element is wrong" in message
+    assert "the translation of this element for Exudyn is wrong" in message
 
 
 def test_the_translation_of_the_examples_passes_the_residual_check():

@@ -62,11 +62,17 @@ class Natural:
                 z0 = self._anchored(form, mech, times[0], z_start, settings, w)
             else:
                 z1, ok = solver.newton(times[:1], z_start[None])
+                if not ok[0]:                  # a poor guess: shorter steps
+                    z1, ok = (np.array(x) for x in solver.damped(times[0], z_start))
+                    z1 = z1[None]
+                    ok = np.atleast_1d(ok)
                 z0 = z1[0] if ok[0] else None
         except SolverError as exc:
             return Positions(q, 0, str(exc), start)
-        if z0 is None:
-            return Positions(q, 0, self._failed(form, solver, times[0], z1[0], settings), start)
+        if z0 is None:                   # where Newton stopped: the diagnosis starts there
+            last = self.to_q(form, mech, z1[:1], start)[0]
+            return Positions(q, 0, self._failed(form, solver, times[0], z1[0], settings),
+                             last if np.isfinite(last).all() else start)
         z, solved = solver.run(times, z0)
         error = None
         if solved < n:

@@ -327,12 +327,15 @@ class Formulation:
         return z
 
     # ---- the constant mass matrix -----------------------------------------------------------
-    def mass_matrix(self) -> np.ndarray:
+    def mass_matrix(self, solids=None) -> np.ndarray:
         """M (nz, nz), constant: T = ½ żᵀ M ż; per solid, with ṗ = P ż and v̇ = V ż,
-        T = ½ [m |ṗ|² + 2 m ṗ·(a_G v̇ + b_G Ω v̇) + J_p |v̇|² / |d|²], J_p = I_G + m |s_G − s_p|²."""
+        T = ½ [m |ṗ|² + 2 m ṗ·(a_G v̇ + b_G Ω v̇) + J_p |v̇|² / |d|²], J_p = I_G + m |s_G − s_p|².
+        ``solids``: only these solids' share (indices; default all)."""
         M = np.zeros((self.nz, self.nz))
         omega = np.array([[0.0, -1.0], [1.0, 0.0]])
         for i, f in enumerate(self.frames):
+            if solids is not None and i not in solids:
+                continue
             solid = self.mech.solids[i]
             m, inertia = float(solid.mass), float(solid.inertia)
             if i in self.grounds or (m == 0 and inertia == 0):

@@ -127,22 +127,62 @@ class Solver:
         ok = np.zeros(len(t), dtype=bool)
         active = np.arange(len(t))
         eps = np.finfo(float).eps
+        last = np.full(len(t), np.inf)        # the previous step's size
         for _ in range(self.settings.max_iterations):
             if not active.size:
                 break
             ta, za = t[active], z[active]
             with np.errstate(all="ignore"):
                 phi = terms.residual(ta, za)
-                floor = np.all(np.abs(phi) <= 64 * eps * terms.magnitude(ta, za), axis=1)
+                magnitude = terms.magnitude(ta, za)
+                size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
+                                 where=magnitude > 0)
+                size[phi == 0] = 0.0
+                floor = np.all(size <= 64 * eps, axis=1)
                 dz = self.solve(terms.jacobian(za), -phi)
                 step = np.max(np.abs(dz) * self.w, axis=1, initial=0.0)
             self.iterations += len(active)
             finite = np.isfinite(step)
             z[active[finite]] = za[finite] + dz[finite]
-            done = finite & ((step <= tol) | floor)
+            small = step <= tol
+            if self.least_squares:        # a least-squares step also stops where Φ ≠ 0
+                small &= np.all(size <= max(64 * eps, 100 * tol), axis=1)
+            # at round-off, steps stop shrinking (at a singular position Φ is quadratic in
+            # the error, and a step that still halves is still worth taking)
+            stalled = floor & (step > 0.7 * last[active])
+            last[active] = step
+            done = finite & (small | stalled)
             ok[active[done]] = True
             active = active[finite & ~done]
         return z, ok
+
+    def damped(self, t: float, z: np.ndarray, iterations: int = 200):
+        """(z, ok): Newton's iteration at one time from a poor guess, each step shortened
+        until it lowers |Φ| (backtracking), then full steps near the solution."""
+        terms = self.terms
+        t = np.array([t])
+
+        def size(x):
+            with np.errstate(all="ignore"):
+                phi = terms.residual(t, x[None])[0]
+                return float(np.sqrt(np.sum((phi / (1.0 + terms.magnitude(t, x[None])[0])) ** 2)))
+
+        now = size(z)
+        for _ in range(iterations):
+            with np.errstate(all="ignore"):
+                dz = self.solve(terms.jacobian(z[None]), -terms.residual(t, z[None]))[0]
+            if not np.isfinite(dz).all():
+                return z, False
+            alpha = 1.0
+            while alpha > 1e-6 and not size(z + alpha * dz) <= (1 - 1e-4 * alpha) * now:
+                alpha *= 0.5
+            z = z + alpha * dz
+            now = size(z)
+            if alpha == 1.0:
+                done, ok = self.newton(t, z[None])
+                if ok[0]:
+                    return done[0], True
+        return z, False
 
     def step(self, t0: float, z0: np.ndarray, t1: float, guess: np.ndarray | None = None):
         """z at t1 from z0 at t0 (None if Newton fails even in MAX_SUBSTEPS sub-steps)."""
@@ -171,20 +211,27 @@ class Solver:
         if stride < 4:
             return self._sequential(t, z, 0, n)
         rows_per_chunk = max(1, CHUNK_BYTES // (8 * max(1, self.terms.m) * self.terms.nz))
+        base = stride
         k, zd, zdd = 0, *(r[0] for r in self.rates(t[:1], z[:1]))
         while k < n - 1:
             j = min(n - 1, k + stride)
-            h = t[j] - t[k]
-            guess = z[k] + h * zd + 0.5 * h * h * zdd
-            zj = self.step(t[k], z[k], t[j], guess)
-            miss = np.inf if zj is None else float(np.max(np.abs(zj - guess) * self.w))
-            if zj is None or miss > COARSE_MISS or j - k < 4:
+            if j - k < 4:                      # too fast or too near a singular position
                 z, solved = self._sequential(t, z, k, j + 1)
                 if solved <= j:
                     return z, solved
-                k = j
+                k, stride = j, min(base, 4 * stride)
                 zd, zdd = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
                 continue
+            h = t[j] - t[k]
+            guess = z[k] + h * zd + 0.5 * h * h * zdd
+            zj, ok = self.newton(t[j:j + 1], guess[None])
+            zj = zj[0]
+            miss = float(np.max(np.abs(zj - guess) * self.w)) if ok[0] else np.inf
+            if miss > COARSE_MISS:             # a shorter interval
+                stride = max(1, stride // 4)
+                continue
+            if miss < COARSE_MISS / 64:
+                stride = min(base, 2 * stride)
             z[j] = zj
             zdj, zddj = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
             inner = np.arange(k + 1, j)

@@ -1,0 +1,152 @@
+"""The natural-coordinate backend against independent computations.
+
+References: the Exudyn backend on the same models (a different formulation and solver); the
+native pass (pam2exu's reference-point Jacobian) for the velocities and accelerations the
+natural backend computes itself; the kinetic energy of a rigid body from its mass at G and
+its inertia about G; pam2exu's own force pass for the static multipliers.
+"""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pam2exu
+from pam2exu.analyses import native
+from pam2exu.analyses.job import prepare
+from pam2exu.backend.natural import Natural
+from pam2exu.elements.forces import Spring
+from pam2exu.kinematics import column
+from pam2exu.registry import ANALYSES
+
+ROOT = Path(__file__).resolve().parents[2]
+MODELS = sorted((ROOT / "examples").glob("*.toml")) + [ROOT / "tests/data/parallelogram5.toml"]
+
+
+def quietly(function, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")        # parallelogram5: redundant constraints
+        return function(*args, **kwargs)
+
+
+def relative_difference(a, b) -> tuple[float, str]:
+    """Largest |a − b| of any column over the largest |value| of its unit in a, and where."""
+    scale: dict[str, float] = {}
+    for c in a.columns:
+        scale[a.units[c]] = max(scale.get(a.units[c], 0.0), float(np.max(np.abs(a[c]))))
+    worst = (0.0, "")
+    for c in a.columns:
+        d = float(np.max(np.abs(a[c] - b[c]))) / max(scale[a.units[c]], 1e-300)
+        worst = max(worst, (d, c))
+    return worst
+
+
+@pytest.mark.parametrize("analysis", list(ANALYSES))
+@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+def test_both_backends_give_the_same_results(path, analysis):
+    """Issue 12 acceptance: every shipped model, every analysis, 1e-9 relative (per unit)."""
+    exudyn = quietly(pam2exu.run, path, analysis=analysis)
+    natural = quietly(pam2exu.run, path, analysis=analysis, backend="natural")
+    assert natural.columns == exudyn.columns
+    difference, where = relative_difference(exudyn, natural)
+    assert difference < 1e-9, (where, difference)
+
+
+@pytest.mark.parametrize("name", ["four_bar", "all_elements", "slider_crank", "scotch_yoke"])
+def test_own_rates_equal_the_native_pass(name):
+    """The backend's q̇, q̈ (its own linear solves, exact quadratic velocity terms) against
+    the native reference-point pass at the same positions."""
+    job = prepare(ROOT / "examples" / f"{name}.toml", analysis="kinematic", steps=100)
+    backend = Natural()
+    found = backend.solve_positions(job.mech, job.times, job.mech.initial_q(), job.solver,
+                                    rates=True)
+    assert found.solved == len(job.times)
+    qd, qdd, _ = native.rates(job.mech, job.times, found.q, True, False)
+    speed = np.max(np.abs(qd)) + 1e-300
+    assert np.max(np.abs(found.qd - qd)) < 1e-11 * speed
+    assert np.max(np.abs(found.qdd - qdd)) < 1e-10 * np.max(np.abs(qdd))
+
+
+def kinetic_energy(solid, x_dot, y_dot, fi, fi_dot) -> float:
+    """T = ½ m |v_G|² + ½ I_G ω², v_G = Ṙ + ω Ω A(fi) s_G (the reference-point formula)."""
+    gx, gy = (float(c) for c in solid.cog)
+    c, s = np.cos(fi), np.sin(fi)
+    AsG = np.array([c * gx - s * gy, s * gx + c * gy])
+    vG = np.array([x_dot, y_dot]) + fi_dot * np.array([-AsG[1], AsG[0]])
+    return 0.5 * float(solid.mass) * vG @ vG + 0.5 * float(solid.inertia) * fi_dot ** 2
+
+
+@pytest.mark.parametrize("name", ["four_bar", "all_elements", "slider_crank", "scotch_yoke"])
+def test_constant_mass_matrix_gives_each_bodys_kinetic_energy(name):
+    """Issue 12 acceptance: for each body and random rigid velocities, ½ żᵀ M_body ż equals
+    the body's kinetic energy from m at G and I_G, to 1e-13 relative."""
+    job = prepare(ROOT / "examples" / f"{name}.toml", analysis="assembly")
+    form = Natural().formulation(job.mech)
+    q = quietly(pam2exu.run, ROOT / "examples" / f"{name}.toml", analysis="assembly")
+    q = np.array([q[f"{s.name}.{v}"][0] for s in job.mech.solids for v in ("x", "y", "fi")])
+    z = form.from_q(q)[0]
+    rng = np.random.default_rng(12)
+    J = form.terms.dense(form.terms.jacobian(z[None]))[0]
+    checked = 0
+    for i, solid in enumerate(job.mech.solids):
+        if i in form.grounds or not (float(solid.mass) or float(solid.inertia)):
+            continue
+        rows = [r for r, label in enumerate(form.labels)
+                if label == f"rigid '{solid.name}'"]          # the body stays rigid
+        null = np.linalg.svd(J[rows])[2][len(rows):].T
+        for _ in range(5):
+            zd = null @ rng.normal(size=null.shape[1])
+            f = form.frames[i]
+            v, vd = form.matrix(f.v) @ z + form.constants(f.v), form.matrix(f.v) @ zd
+            p_dot = form.matrix(f.p) @ zd
+            w = (v[0] * vd[1] - v[1] * vd[0]) / (v @ v)
+            fi = q[column(i, 2)]
+            c, s = np.cos(fi), np.sin(fi)
+            Asp = np.array([c * f.sp[0] - s * f.sp[1], s * f.sp[0] + c * f.sp[1]])
+            R_dot = p_dot - w * np.array([-Asp[1], Asp[0]])
+            reference = kinetic_energy(solid, *R_dot, fi, w)
+            got = 0.5 * zd @ form.mass_matrix([i]) @ zd
+            assert got == pytest.approx(reference, rel=1e-13, abs=1e-300)
+            checked += 1
+    assert checked >= 5
+
+
+def test_quasi_static_multipliers_come_from_natural_forces():
+    """The quasi-static check holds the natural backend's static multipliers (forces taken
+    from natural coordinates: gravity, torsors, springs, torsional springs) against pam2exu's
+    own equilibrium; a spring whose natural-coordinate force is off by 1e-6 is caught."""
+    path = ROOT / "examples" / "all_elements.toml"
+    res = quietly(pam2exu.run, path, analysis="quasi_static", backend="natural")
+    assert res.info["equilibrium_error"] < 1e-12
+
+
+def test_a_wrong_natural_force_is_caught(monkeypatch):
+    path = ROOT / "examples" / "all_elements.toml"
+    right = Spring.natural_loads
+
+    def off(self, nl):
+        class Scaled:                 # the spring's force 1e-6 too large
+            def __getattr__(self, name):
+                return getattr(nl, name)
+
+            def force(self, solid, local, force):
+                nl.force(solid, local, force * (1 + 1e-6))
+        right(self, Scaled())
+
+    monkeypatch.setattr(Spring, "natural_loads", off)
+    with pytest.raises(pam2exu.TranslationError, match="multipliers"):
+        quietly(pam2exu.run, path, analysis="quasi_static", backend="natural")
+
+
+def test_free_assembly_is_the_nearest_configuration():
+    """Without its motor the four-bar has a free degree of freedom: both backends settle it
+    nearest the guess (the same weighted distance), to 1e-9."""
+    model = pam2exu.load(ROOT / "examples" / "four_bar.toml")
+    model.elements = [e for e in model.elements if e.name != "motor"]
+    exudyn = quietly(pam2exu.run, model, analysis="assembly")
+    natural = quietly(pam2exu.run, model, analysis="assembly", backend="natural")
+    difference, where = relative_difference(exudyn, natural)
+    assert difference < 1e-9, (where, difference)
+    assert abs(natural["crank.fi"][0] - 0.02) > 1e-6        # the crank did move
