@@ -80,7 +80,7 @@ class Natural:
         q[:solved] = self.to_q(form, mech, z[:solved], start)
         found = Positions(q, solved, error, q[solved - 1], iterations=solver.iterations)
         if rates and solved:
-            zd, zdd = solver.rates(times[:solved], z[:solved])
+            zd, zdd = solver.run_rates(times[:solved], z[:solved])
             found.qd, found.qdd = (np.full_like(q, np.nan) for _ in range(2))
             found.qd[:solved], found.qdd[:solved] = self.to_rates(form, mech, z[:solved],
                                                                   zd, zdd)
@@ -119,40 +119,52 @@ class Natural:
     def to_q(self, form: Formulation, mech, z: np.ndarray, start: np.ndarray) -> np.ndarray:
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
         value in the whole turn nearest ``start``."""
-        K = form.pose_forms()
-        pose = np.c_[z, np.ones(len(z))] @ K.T                    # x, y, cos, sin per solid
+        pose = np.c_[z, np.ones(len(z))] @ form.pose_forms().T   # x, y, cos, sin per solid
         q = np.empty((len(z), mech.nq))
-        for i, f in enumerate(form.frames):
-            x, y, c, s = (pose[:, 4 * i + k] for k in range(4))
-            q[:, column(i, 0)], q[:, column(i, 1)] = x, y
-            if f.fixed_angle is not None:
-                fi = np.full(len(z), f.fixed_angle)
-            elif f.angle is not None:
-                fi = z[:, f.angle]
-            else:
-                fi = np.unwrap(np.arctan2(s, c))
-                fi += 2 * np.pi * np.rint((start[column(i, 2)] - fi[0]) / (2 * np.pi))
-            q[:, column(i, 2)] = fi
+        q[:, 0::PER_SOLID], q[:, 1::PER_SOLID] = pose[:, 0::4], pose[:, 1::4]
+        kind = self._angle_kinds(form)
+        fi = q[:, ANGLES]
+        fi[:, kind.fixed] = kind.fixed_values
+        fi[:, kind.coordinate] = z[:, kind.columns]
+        free = kind.free
+        if free.size:
+            raw = np.unwrap(np.arctan2(pose[:, 4 * free + 3], pose[:, 4 * free + 2]), axis=0)
+            raw += 2 * np.pi * np.rint((start[ANGLES][free] - raw[0]) / (2 * np.pi))
+            fi[:, free] = raw
+        q[:, ANGLES] = fi
         return q
+
+    def _angle_kinds(self, form: Formulation):
+        """Which solids' fi are constant (ground), an angle coordinate, or atan2 of the vector."""
+        from types import SimpleNamespace
+        fixed = [i for i, f in enumerate(form.frames) if f.fixed_angle is not None]
+        coordinate = [i for i, f in enumerate(form.frames)
+                      if f.fixed_angle is None and f.angle is not None]
+        free = [i for i, f in enumerate(form.frames) if f.fixed_angle is None and f.angle is None]
+        return SimpleNamespace(
+            fixed=np.array(fixed, dtype=int),
+            fixed_values=np.array([form.frames[i].fixed_angle for i in fixed]),
+            coordinate=np.array(coordinate, dtype=int),
+            columns=np.array([form.frames[i].angle for i in coordinate], dtype=int),
+            free=np.array(free, dtype=int))
 
     def to_rates(self, form: Formulation, mech, z, zd, zdd):
         """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)."""
-        K = form.pose_forms()[:, :form.nz]
-        pose = np.c_[z, np.ones(len(z))] @ form.pose_forms().T
-        d1, d2 = zd @ K.T, zdd @ K.T
+        K = form.pose_forms()
+        pose = np.c_[z, np.ones(len(z))] @ K.T
+        d1, d2 = zd @ K[:, :form.nz].T, zdd @ K[:, :form.nz].T
         qd, qdd = np.empty((len(z), mech.nq)), np.empty((len(z), mech.nq))
-        for i, f in enumerate(form.frames):
-            for k in range(2):
-                qd[:, column(i, k)], qdd[:, column(i, k)] = d1[:, 4 * i + k], d2[:, 4 * i + k]
-            if f.fixed_angle is not None:
-                w, a = 0.0, 0.0
-            elif f.angle is not None:
-                w, a = zd[:, f.angle], zdd[:, f.angle]
-            else:
-                c, s = pose[:, 4 * i + 2], pose[:, 4 * i + 3]
-                dc, ds, ddc, dds = (x[:, 4 * i + k] for x in (d1, d2) for k in (2, 3))
-                r2 = c * c + s * s
-                w = (c * ds - s * dc) / r2
-                a = (c * dds - s * ddc) / r2 - 2 * (c * dc + s * ds) * w / r2
-            qd[:, column(i, 2)], qdd[:, column(i, 2)] = w, a
+        for out, d in ((qd, d1), (qdd, d2)):
+            out[:, 0::PER_SOLID], out[:, 1::PER_SOLID] = d[:, 0::4], d[:, 1::4]
+        kind = self._angle_kinds(form)
+        w, a = np.zeros((len(z), len(form.frames))), np.zeros((len(z), len(form.frames)))
+        w[:, kind.coordinate], a[:, kind.coordinate] = zd[:, kind.columns], zdd[:, kind.columns]
+        f = kind.free
+        if f.size:
+            c, s = pose[:, 4 * f + 2], pose[:, 4 * f + 3]
+            dc, ds, ddc, dds = d1[:, 4 * f + 2], d1[:, 4 * f + 3], d2[:, 4 * f + 2], d2[:, 4 * f + 3]
+            r2 = c * c + s * s
+            w[:, f] = (c * ds - s * dc) / r2
+            a[:, f] = (c * dds - s * ddc) / r2 - 2 * (c * dc + s * ds) * w[:, f] / r2
+        qd[:, ANGLES], qdd[:, ANGLES] = w, a
         return qd, qdd

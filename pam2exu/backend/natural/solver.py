@@ -26,7 +26,7 @@ from ...errors import SolverError
 #: system (cost linear in the mechanism's size) instead of dense batched solves
 SPARSE_FROM = 40
 #: intervals of the coarse pass (fewer when the run is short)
-COARSE = 200
+COARSE = 100
 #: the coarse predictor may miss by this much (relative: lengths / L, angles in rad)
 #: before its interval is solved step by step
 COARSE_MISS = 2e-2
@@ -34,6 +34,8 @@ COARSE_MISS = 2e-2
 CHUNK_BYTES = 64 * 2**20
 #: a step that failed is cut into at most this many sub-steps
 MAX_SUBSTEPS = 64
+#: the extrapolation of a step looks back this many times 8 steps for solved ones
+COARSE_GAP = 64
 
 
 @dataclass
@@ -111,12 +113,27 @@ class Solver:
         except RuntimeError:
             return None
 
-    def rates(self, t, z, data=None):
-        """(ż, z̈) at the steps (z solved): Φ_z ż = g', Φ_z z̈ = γ."""
+    def run_rates(self, t, z):
+        """(ż, z̈) at the steps of the last ``run`` (z its answer, solved rows only): those
+        found with the positions, the others solved now."""
+        n = len(t)
+        zd, zdd = self.zd[:n].copy(), self.zdd[:n].copy()
+        missing = np.nonzero(~self.own_rates[:n])[0]
+        if missing.size:
+            zd[missing], zdd[missing] = self.rates(t[missing], z[missing])
+        return zd, zdd
+
+    def rates(self, t, z):
+        """(ż, z̈) at the steps (z solved): Φ_z ż = g', Φ_z z̈ = γ; in chunks that bound
+        the memory of the Jacobians."""
         terms = self.terms
-        data = terms.jacobian(z) if data is None else data
-        zd = self.solve(data, terms.velocity_rhs(t))
-        zdd = self.solve(data, terms.gamma(t, z, zd))
+        zd, zdd = np.empty_like(z), np.empty_like(z)
+        rows = max(1, CHUNK_BYTES // (8 * max(1, terms.m) * max(1, terms.nz)))
+        for a in range(0, len(t), rows):
+            s = slice(a, a + rows)
+            data = terms.jacobian(z[s])
+            zd[s] = self.solve(data, terms.velocity_rhs(t[s]))
+            zdd[s] = self.solve(data, terms.gamma(t[s], z[s], zd[s]))
         return zd, zdd
 
     # ---- Newton -------------------------------------------------------------------------------
@@ -134,21 +151,25 @@ class Solver:
             ta, za = t[active], z[active]
             with np.errstate(all="ignore"):
                 phi = terms.residual(ta, za)
-                magnitude = terms.magnitude(ta, za)
-                size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
-                                 where=magnitude > 0)
-                size[phi == 0] = 0.0
-                floor = np.all(size <= 64 * eps, axis=1)
                 dz = self.solve(terms.jacobian(za), -phi)
                 step = np.max(np.abs(dz) * self.w, axis=1, initial=0.0)
+                small = step <= tol
+                # |Φ| relative to its terms: wanted where the step alone does not decide
+                ask = ~small | self.least_squares
+                size = np.zeros_like(phi)
+                if ask.any():
+                    magnitude = terms.magnitude(ta[ask], za[ask])
+                    size[ask] = np.divide(np.abs(phi[ask]), magnitude,
+                                          out=np.abs(phi[ask]) * np.inf, where=magnitude > 0)
+                    size[phi == 0] = 0.0
             self.iterations += len(active)
             finite = np.isfinite(step)
             z[active[finite]] = za[finite] + dz[finite]
-            small = step <= tol
             if self.least_squares:        # a least-squares step also stops where Φ ≠ 0
                 small &= np.all(size <= max(64 * eps, 100 * tol), axis=1)
             # at round-off, steps stop shrinking (at a singular position Φ is quadratic in
             # the error, and a step that still halves is still worth taking)
+            floor = np.all(size <= 64 * eps, axis=1)
             stalled = floor & (step > 0.7 * last[active])
             last[active] = step
             done = finite & (small | stalled)
@@ -203,73 +224,351 @@ class Solver:
         return None
 
     def run(self, t: np.ndarray, z0: np.ndarray):
-        """(z (n, nz), solved, t_failed): the steps of ``t`` from the solved z0 at t[0]."""
+        """(z (n, nz), solved): the steps of ``t`` from the solved z0 at t[0] (module doc)."""
         n = len(t)
         z = np.full((n, self.terms.nz), np.nan)
         z[0] = z0
+        #: rates found with the positions (``_bulk``) at the steps marked in own_rates
+        self.zd, self.zdd = np.empty_like(z), np.empty_like(z)
+        self.own_rates = np.zeros(n, dtype=bool)
         stride = max(1, n // COARSE)
         if stride < 4:
             return self._sequential(t, z, 0, n)
-        rows_per_chunk = max(1, CHUNK_BYTES // (8 * max(1, self.terms.m) * self.terms.nz))
-        base = stride
+        base, intervals = stride, []      # (k, j, ż_k, ż_j, miss) to fill in the second pass
+        end = n                                # the steps solved (all, unless one fails)
         k, zd, zdd = 0, *(r[0] for r in self.rates(t[:1], z[:1]))
         while k < n - 1:
             j = min(n - 1, k + stride)
             if j - k < 4:                      # too fast or too near a singular position
                 z, solved = self._sequential(t, z, k, j + 1)
                 if solved <= j:
-                    return z, solved
+                    end = solved
+                    break
                 k, stride = j, min(base, 4 * stride)
                 zd, zdd = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
                 continue
             h = t[j] - t[k]
             guess = z[k] + h * zd + 0.5 * h * h * zdd
             zj, ok = self.newton(t[j:j + 1], guess[None])
-            zj = zj[0]
-            miss = float(np.max(np.abs(zj - guess) * self.w)) if ok[0] else np.inf
+            miss = float(np.max(np.abs(zj[0] - guess) * self.w)) if ok[0] else np.inf
             if miss > COARSE_MISS:             # a shorter interval
                 stride = max(1, stride // 4)
                 continue
             if miss < COARSE_MISS / 64:
                 stride = min(base, 2 * stride)
-            z[j] = zj
+            z[j] = zj[0]
             zdj, zddj = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
-            inner = np.arange(k + 1, j)
-            u = ((t[inner] - t[k]) / h)[:, None]
-            guess = ((2 * u**3 - 3 * u**2 + 1) * z[k] + (u**3 - 2 * u**2 + u) * h * zd
-                     + (-2 * u**3 + 3 * u**2) * zj + (u**3 - u**2) * h * zdj)
-            good = True
-            for a in range(0, len(inner), rows_per_chunk):
-                part = inner[a:a + rows_per_chunk]
-                zi, ok = self.newton(t[part], guess[a:a + rows_per_chunk])
-                far = np.max(np.abs(zi - guess[a:a + rows_per_chunk]) * self.w, axis=1) > \
-                    max(10 * miss, 1e-6)
-                if not ok.all() or far.any():
-                    good = False
+            intervals.append((k, j, zd, zdj, miss))
+            k, zd, zdd = j, zdj, zddj
+        bad = self._fill(t, z, intervals)
+        for number in bad:                     # another branch, or no convergence
+            k, j = intervals[number][:2]
+            self.own_rates[k:j + 1] = False
+            z, solved = self._sequential(t, z, k, j + 1)
+            if solved <= j:
+                return z, solved
+        return z, end
+
+    def _fill(self, t, z, intervals) -> list[int]:
+        """Solve the steps inside every interval at once from cubic Hermite guesses; the
+        numbers of the intervals where some step failed or left its guess far behind."""
+        if not intervals:
+            return []
+        k, j = (np.array([iv[i] for iv in intervals]) for i in (0, 1))
+        zdk, zdj = (np.array([iv[i] for iv in intervals]) for i in (2, 3))
+        allowed = np.maximum(10 * np.array([iv[4] for iv in intervals]), 1e-6)
+        counts = j - k - 1
+        owner = np.repeat(np.arange(len(intervals)), counts)
+        steps = np.concatenate([np.arange(a + 1, b) for a, b in zip(k, j)])
+        h = (t[j] - t[k])[owner][:, None]
+        u = (t[steps][:, None] - t[k][owner][:, None]) / h
+        guess = ((2 * u**3 - 3 * u**2 + 1) * z[k][owner] + (u**3 - 2 * u**2 + u) * h * zdk[owner]
+                 + (-2 * u**3 + 3 * u**2) * z[j][owner] + (u**3 - u**2) * h * zdj[owner])
+        rows = max(1, CHUNK_BYTES // (8 * max(1, self.terms.m) * self.terms.nz))
+        failed = np.zeros(len(intervals), dtype=bool)
+        for a in range(0, len(steps), rows):
+            part = slice(a, a + rows)
+            found = self._bulk(t[steps[part]], guess[part])
+            if found is None:
+                zi, ok = self.newton(t[steps[part]], guess[part])
+            else:
+                zi, ok, zd, zdd = found
+                self.own_rates[steps[part]] = True
+                self.zd[steps[part]], self.zdd[steps[part]] = zd, zdd
+            far = np.max(np.abs(zi - guess[part]) * self.w, axis=1) > allowed[owner[part]]
+            z[steps[part]] = zi
+            failed[owner[part][~ok | far]] = True
+        return list(np.nonzero(failed)[0])
+
+    def _bulk(self, t, z, iterations: int = 4):
+        """(z, ok, ż, z̈) for many steps of a small square system from good guesses: each
+        Newton solve also solves Φ_z ż = g' (two right-hand sides, one factorisation), and
+        the last one's Jacobian (at z within the tolerance) gives z̈; None where that does
+        not apply (large, redundant or singular systems)."""
+        terms, tol = self.terms, self.settings.tolerance
+        if self.least_squares or terms.nz >= SPARSE_FROM or not len(t):
+            return None
+        z = np.array(z, dtype=float)
+        rhs = np.empty((len(t), terms.m, 2))
+        rhs[:, :, 1] = terms.velocity_rhs(t)
+        with np.errstate(all="ignore"):
+            for _ in range(iterations):
+                J = terms.dense(terms.jacobian(z))
+                rhs[:, :, 0] = -terms.residual(t, z)
+                try:
+                    x = np.linalg.solve(J, rhs)
+                except np.linalg.LinAlgError:
+                    return None
+                self.iterations += len(t)
+                z += x[:, :, 0]
+                step = np.max(np.abs(x[:, :, 0]) * self.w, axis=1, initial=0.0)
+                if np.all(step <= tol):
                     break
-                z[part] = zi
-            if not good:                       # another branch, or no convergence
+            zd = x[:, :, 1]
+            try:
+                zdd = np.linalg.solve(J, terms.gamma(t, z, zd)[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                return None
+        return z, step <= tol, zd, zdd
+
+    def run_rates(self, t, z):
+        """(ż, z̈) at the steps of the last ``run`` (z its answer, solved rows only): those
+        found with the positions, the others solved now."""
+        n = len(t)
+        zd, zdd = self.zd[:n].copy(), self.zdd[:n].copy()
+        missing = np.nonzero(~self.own_rates[:n])[0]
+        if missing.size:
+            zd[missing], zdd[missing] = self.rates(t[missing], z[missing])
+        return zd, zdd
+
+    def rates(self, t, z):
+        """(ż, z̈) at the steps (z solved): Φ_z ż = g', Φ_z z̈ = γ; in chunks that bound
+        the memory of the Jacobians."""
+        terms = self.terms
+        zd, zdd = np.empty_like(z), np.empty_like(z)
+        rows = max(1, CHUNK_BYTES // (8 * max(1, terms.m) * max(1, terms.nz)))
+        for a in range(0, len(t), rows):
+            s = slice(a, a + rows)
+            data = terms.jacobian(z[s])
+            zd[s] = self.solve(data, terms.velocity_rhs(t[s]))
+            zdd[s] = self.solve(data, terms.gamma(t[s], z[s], zd[s]))
+        return zd, zdd
+
+    # ---- Newton -------------------------------------------------------------------------------
+    def newton(self, t: np.ndarray, z: np.ndarray):
+        """(z, ok) after Newton's iteration from z at every step at once."""
+        terms, tol = self.terms, self.settings.tolerance
+        z = np.array(z, dtype=float)
+        ok = np.zeros(len(t), dtype=bool)
+        active = np.arange(len(t))
+        eps = np.finfo(float).eps
+        last = np.full(len(t), np.inf)        # the previous step's size
+        for _ in range(self.settings.max_iterations):
+            if not active.size:
+                break
+            ta, za = t[active], z[active]
+            with np.errstate(all="ignore"):
+                phi = terms.residual(ta, za)
+                dz = self.solve(terms.jacobian(za), -phi)
+                step = np.max(np.abs(dz) * self.w, axis=1, initial=0.0)
+                small = step <= tol
+                # |Φ| relative to its terms: wanted where the step alone does not decide
+                ask = ~small | self.least_squares
+                size = np.zeros_like(phi)
+                if ask.any():
+                    magnitude = terms.magnitude(ta[ask], za[ask])
+                    size[ask] = np.divide(np.abs(phi[ask]), magnitude,
+                                          out=np.abs(phi[ask]) * np.inf, where=magnitude > 0)
+                    size[phi == 0] = 0.0
+            self.iterations += len(active)
+            finite = np.isfinite(step)
+            z[active[finite]] = za[finite] + dz[finite]
+            if self.least_squares:        # a least-squares step also stops where Φ ≠ 0
+                small &= np.all(size <= max(64 * eps, 100 * tol), axis=1)
+            # at round-off, steps stop shrinking (at a singular position Φ is quadratic in
+            # the error, and a step that still halves is still worth taking)
+            floor = np.all(size <= 64 * eps, axis=1)
+            stalled = floor & (step > 0.7 * last[active])
+            last[active] = step
+            done = finite & (small | stalled)
+            ok[active[done]] = True
+            active = active[finite & ~done]
+        return z, ok
+
+    def damped(self, t: float, z: np.ndarray, iterations: int = 200):
+        """(z, ok): Newton's iteration at one time from a poor guess, each step shortened
+        until it lowers |Φ| (backtracking), then full steps near the solution."""
+        terms = self.terms
+        t = np.array([t])
+
+        def size(x):
+            with np.errstate(all="ignore"):
+                phi = terms.residual(t, x[None])[0]
+                return float(np.sqrt(np.sum((phi / (1.0 + terms.magnitude(t, x[None])[0])) ** 2)))
+
+        now = size(z)
+        for _ in range(iterations):
+            with np.errstate(all="ignore"):
+                dz = self.solve(terms.jacobian(z[None]), -terms.residual(t, z[None]))[0]
+            if not np.isfinite(dz).all():
+                return z, False
+            alpha = 1.0
+            while alpha > 1e-6 and not size(z + alpha * dz) <= (1 - 1e-4 * alpha) * now:
+                alpha *= 0.5
+            z = z + alpha * dz
+            now = size(z)
+            if alpha == 1.0:
+                done, ok = self.newton(t, z[None])
+                if ok[0]:
+                    return done[0], True
+        return z, False
+
+    def step(self, t0: float, z0: np.ndarray, t1: float, guess: np.ndarray | None = None):
+        """z at t1 from z0 at t0 (None if Newton fails even in MAX_SUBSTEPS sub-steps)."""
+        z, ok = self.newton(np.array([t1]), (z0 if guess is None else guess)[None])
+        if ok[0]:
+            return z[0]
+        parts = 2
+        while parts <= MAX_SUBSTEPS:
+            zk = z0
+            for tk in np.linspace(t0, t1, parts + 1)[1:]:
+                z, ok = self.newton(np.array([tk]), zk[None])
+                if not ok[0]:
+                    break
+                zk = z[0]
+            else:
+                return zk
+            parts *= 2
+        return None
+
+    def run(self, t: np.ndarray, z0: np.ndarray):
+        """(z (n, nz), solved): the steps of ``t`` from the solved z0 at t[0] (module doc)."""
+        n = len(t)
+        z = np.full((n, self.terms.nz), np.nan)
+        z[0] = z0
+        #: rates found with the positions (``_bulk``) at the steps marked in own_rates
+        self.zd, self.zdd = np.empty_like(z), np.empty_like(z)
+        self.own_rates = np.zeros(n, dtype=bool)
+        stride = max(1, n // COARSE)
+        if stride < 4:
+            return self._sequential(t, z, 0, n)
+        base, intervals = stride, []      # (k, j, ż_k, ż_j, miss) to fill in the second pass
+        end = n                                # the steps solved (all, unless one fails)
+        k, zd, zdd = 0, *(r[0] for r in self.rates(t[:1], z[:1]))
+        while k < n - 1:
+            j = min(n - 1, k + stride)
+            if j - k < 4:                      # too fast or too near a singular position
                 z, solved = self._sequential(t, z, k, j + 1)
                 if solved <= j:
-                    return z, solved
+                    end = solved
+                    break
+                k, stride = j, min(base, 4 * stride)
+                zd, zdd = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
+                continue
+            h = t[j] - t[k]
+            guess = z[k] + h * zd + 0.5 * h * h * zdd
+            zj, ok = self.newton(t[j:j + 1], guess[None])
+            miss = float(np.max(np.abs(zj[0] - guess) * self.w)) if ok[0] else np.inf
+            if miss > COARSE_MISS:             # a shorter interval
+                stride = max(1, stride // 4)
+                continue
+            if miss < COARSE_MISS / 64:
+                stride = min(base, 2 * stride)
+            z[j] = zj[0]
+            zdj, zddj = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
+            intervals.append((k, j, zd, zdj, miss))
             k, zd, zdd = j, zdj, zddj
-        return z, n
+        bad = self._fill(t, z, intervals)
+        for number in bad:                     # another branch, or no convergence
+            k, j = intervals[number][:2]
+            self.own_rates[k:j + 1] = False
+            z, solved = self._sequential(t, z, k, j + 1)
+            if solved <= j:
+                return z, solved
+        return z, end
+
+    def _fill(self, t, z, intervals) -> list[int]:
+        """Solve the steps inside every interval at once from cubic Hermite guesses; the
+        numbers of the intervals where some step failed or left its guess far behind."""
+        if not intervals:
+            return []
+        k, j = (np.array([iv[i] for iv in intervals]) for i in (0, 1))
+        zdk, zdj = (np.array([iv[i] for iv in intervals]) for i in (2, 3))
+        allowed = np.maximum(10 * np.array([iv[4] for iv in intervals]), 1e-6)
+        counts = j - k - 1
+        owner = np.repeat(np.arange(len(intervals)), counts)
+        steps = np.concatenate([np.arange(a + 1, b) for a, b in zip(k, j)])
+        h = (t[j] - t[k])[owner][:, None]
+        u = (t[steps][:, None] - t[k][owner][:, None]) / h
+        guess = ((2 * u**3 - 3 * u**2 + 1) * z[k][owner] + (u**3 - 2 * u**2 + u) * h * zdk[owner]
+                 + (-2 * u**3 + 3 * u**2) * z[j][owner] + (u**3 - u**2) * h * zdj[owner])
+        rows = max(1, CHUNK_BYTES // (8 * max(1, self.terms.m) * self.terms.nz))
+        failed = np.zeros(len(intervals), dtype=bool)
+        for a in range(0, len(steps), rows):
+            part = slice(a, a + rows)
+            found = self._bulk(t[steps[part]], guess[part])
+            if found is None:
+                zi, ok = self.newton(t[steps[part]], guess[part])
+            else:
+                zi, ok, zd, zdd = found
+                self.own_rates[steps[part]] = True
+                self.zd[steps[part]], self.zdd[steps[part]] = zd, zdd
+            far = np.max(np.abs(zi - guess[part]) * self.w, axis=1) > allowed[owner[part]]
+            z[steps[part]] = zi
+            failed[owner[part][~ok | far]] = True
+        return list(np.nonzero(failed)[0])
+
+    def _bulk(self, t, z, iterations: int = 4):
+        """(z, ok, ż, z̈) for many steps of a small square system from good guesses: Newton
+        with the inverse Jacobian of each iteration, the last one reused for the rates;
+        None where that does not apply (large, redundant or singular systems)."""
+        terms, tol = self.terms, self.settings.tolerance
+        if self.least_squares or terms.nz >= SPARSE_FROM or not len(t):
+            return None
+        z = np.array(z, dtype=float)
+        with np.errstate(all="ignore"):
+            for _ in range(iterations):
+                try:
+                    inverse = np.linalg.inv(terms.dense(terms.jacobian(z)))
+                except np.linalg.LinAlgError:
+                    return None
+                dz = -np.einsum("nij,nj->ni", inverse, terms.residual(t, z))
+                self.iterations += len(t)
+                z += dz
+                step = np.max(np.abs(dz) * self.w, axis=1, initial=0.0)
+                if np.all(step <= tol):
+                    break
+            ok = step <= tol
+            zd = np.einsum("nij,nj->ni", inverse, terms.velocity_rhs(t))
+            zdd = np.einsum("nij,nj->ni", inverse, terms.gamma(t, z, zd))
+        return z, ok, zd, zdd
 
     def _sequential(self, t, z, k: int, end: int):
         """(z, solved): steps k+1 … end−1 one after the other from the solved step k,
-        each from the quadratic extrapolation of the last three."""
+        each from the parabola through the last three solved steps (``_extrapolate``)."""
         for i in range(k + 1, end):
-            if i - k >= 3:
-                guess = 3.0 * (z[i - 1] - z[i - 2]) + z[i - 3]
-            elif i - k == 2:
-                guess = 2.0 * z[i - 1] - z[i - 2]
-            else:
-                guess = None
+            guess = self._extrapolate(t, z, i)
             zi = self.step(t[i - 1], z[i - 1], t[i], guess)
             if zi is None:
                 return z, i
             z[i] = zi
         return z, end
+
+    def _extrapolate(self, t, z, i: int):
+        """z at t_i on the parabola through the last (up to) three solved steps before i
+        (None if there is only one): through a singular position, where the solution
+        itself is a poor start for Newton and its rates are not defined."""
+        known = [j for j in range(i - 1, max(-1, i - 1 - 8 * COARSE_GAP), -1)
+                 if np.isfinite(z[j, 0])][:3]
+        if len(known) < 2:
+            return None
+        ts, zs = t[known], z[known]
+        out = np.zeros_like(zs[0])
+        for a in range(len(known)):          # Lagrange's form
+            weight = np.prod([(t[i] - ts[b]) / (ts[a] - ts[b])
+                              for b in range(len(known)) if b != a])
+            out += weight * zs[a]
+        return out
 
 
 def anchored(terms, t0: float, z: np.ndarray, K: np.ndarray, target: np.ndarray,
