@@ -64,7 +64,8 @@ def results(tmp_path_factory):
 # ---- 1. every script runs from anywhere and writes its figure ---------------------------
 
 def test_the_teaching_scripts_are_there():
-    assert {"coupler_curve.py", "motor_torque.py", "quick_return.py"} <= {p.name for p in SCRIPTS}
+    assert {"coupler_curve.py", "motor_torque.py", "quick_return.py",
+            "natural_jacobian.py"} <= {p.name for p in SCRIPTS}
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.stem)
@@ -131,9 +132,11 @@ def four_bar_reference(t):
                    np.sin(phi3) * p[0] + np.cos(phi3) * p[1]], axis=-1)
     vA = a * dth[:, None] * turn(e(th))
     M = np.stack([b * turn(e(phi3)), -c * turn(e(phi4))], axis=-1)       # (n, 2, 2)
-    dphi3, _ = np.linalg.solve(M, -vA[..., None])[..., 0].T
+    dphi3, dphi4 = np.linalg.solve(M, -vA[..., None])[..., 0].T
     return {"theta": th, "P": A + Rp, "vP": vA + dphi3[:, None] * turn(Rp), "phi4": phi4,
-            "a": a, "b": b, "c": c, "d": np.linalg.norm(O4 - O2)}
+            "a": a, "b": b, "c": c, "d": np.linalg.norm(O4 - O2),
+            "O2": O2, "O4": O4, "A": A, "B": B, "phi3": phi3, "dtheta": dth, "vA": vA,
+            "dphi3": dphi3, "dphi4": dphi4}
 
 
 def test_coupler_curve_against_the_circle_intersection(results):
@@ -281,3 +284,98 @@ def test_quick_return_against_the_closed_form(results):
     assert out["time_ratio"] == pytest.approx((math.pi + alpha) / (math.pi - alpha), rel=RTOL)
     assert out["time_ratio_formula"] == pytest.approx((math.pi + alpha) / (math.pi - alpha),
                                                       rel=1e-15)
+
+
+# ---- 2d. natural Jacobian: the four-bar's constraint gradients in closed form --------------
+
+def _parallel_rows(M, reference, tol=1e-12):
+    """Each row of M is parallel to exactly one row of ``reference``, all of them used."""
+    unit = lambda X: X / np.linalg.norm(X, axis=1, keepdims=True)          # noqa: E731
+    cos = np.abs(unit(np.asarray(M, dtype=float)) @ unit(np.asarray(reference, dtype=float)).T)
+    match = [np.flatnonzero(c > 1 - tol) for c in cos]
+    assert all(len(m) == 1 for m in match), cos
+    assert sorted(int(m[0]) for m in match) == list(range(len(reference)))
+
+
+def test_natural_jacobian_against_the_closed_form(results):
+    """The four-bar at t = 0 from ``four_bar_reference`` (circle intersection: θ = 0, A, B,
+    φ3, φ4 and the rates θ', φ3', φ4'). The script's q0 is x, y, fi of ground (0, 0, 0),
+    crank (O2, θ), coupler (A, φ3: its origin is its point A) and rocker (O4, φ4).
+
+    Reference-point rows (columns x, y, fi of the four solids), each up to a factor:
+    the fixed link, ∂x_g, ∂y_g, ∂fi_g; a revolute joining s_i of solid i and s_j of solid j,
+    the gradients of the two components of r_j − r_i, r = (x, y) + R(fi) s, whose fi entries
+    are ∓(R s)_y, ±(R s)_x; the motor, fi_crank − fi_ground.
+    Natural rows (columns A, B, θ, named by the script after the crank's point (0.1, 0),
+    the coupler's point (0.35, 0) and crank.fi), the gradients of |A − O2|² = a²,
+    (A − O2) × e(θ) = 0 (the crank along θ), |B − A|² = b², |B − O4|² = c², θ = f(t).
+    Both matrices are square and regular (ranks 12 and 5), and the velocities both give are
+    the closed-form ones: ẋ, ẏ of the coupler = v_A = a θ' n(θ), its fi rate φ3', the rocker's
+    φ4', the crank's θ' = C2, the rest 0; ż = (v_A, v_B = c φ4' n(φ4), θ')."""
+    out = results("natural_jacobian")
+    ref = four_bar_reference(np.array([0.0]))
+    th, phi3, phi4 = ref["theta"][0], ref["phi3"][0], ref["phi4"][0]
+    O2, O4, A, B = ref["O2"], ref["O4"], ref["A"][0], ref["B"][0]
+    data = tomllib.loads((EXAMPLES / "four_bar.toml").read_text(encoding="utf-8"))
+    solids = [s["name"] for s in data["solid"]]
+    points = {s["name"]: s["points"] for s in data["solid"]}
+    pose = {"ground": (0.0, 0.0, 0.0), "crank": (*O2, th), "coupler": (*A, phi3),
+            "rocker": (*O4, phi4)}
+    q0 = np.array([v for name in solids for v in pose[name]])
+    assert out["Cq_columns"] == [f"{n}.{v}" for n in solids for v in ("x", "y", "fi")]
+    assert rel_err(out["q0"], q0) < RTOL
+
+    col = {name: k for k, name in enumerate(out["Cq_columns"])}
+    rows = []
+    for el in data["element"]:
+        if el["type"] == "fixed":
+            for v in ("x", "y", "fi"):
+                rows.append(np.eye(12)[col[f"{el['anc1']}.{v}"]])
+        elif el["type"] == "revolute":
+            for k in (0, 1):
+                row = np.zeros(12)
+                for sign, anchor in ((-1, el["anc1"]), (1, el["anc2"])):
+                    solid, point = anchor.split(".")
+                    fi = pose[solid][2]
+                    s = points[solid][point]
+                    Rs = np.array([np.cos(fi) * s[0] - np.sin(fi) * s[1],
+                                   np.sin(fi) * s[0] + np.cos(fi) * s[1]])
+                    row[col[f"{solid}.{'xy'[k]}"]] += sign
+                    row[col[f"{solid}.fi"]] += sign * (-Rs[1] if k == 0 else Rs[0])
+                rows.append(row)
+        elif el["type"] == "angular_actuator":
+            row = np.zeros(12)
+            row[col[f"{el['anc2']}.fi"]], row[col[f"{el['anc1']}.fi"]] = 1.0, -1.0
+            rows.append(row)
+    assert np.shape(out["Cq"]) == (12, 12) and len(out["Cq_rows"]) == 12
+    _parallel_rows(out["Cq"], rows)
+
+    # the natural columns: A, B by the local point each names, θ
+    where = {"crank(0.1,0)": "A", "coupler(0.35,0)": "B"}
+    assert sorted(out["Phi_columns"]) == sorted(
+        [f"{p}.{v}" for p in where for v in "xy"] + ["crank.fi"])
+    assert points["crank"]["A"] == [0.1, 0.0] and points["coupler"]["B"] == [0.35, 0.0]
+    order = {"A.x": 0, "A.y": 1, "B.x": 2, "B.y": 3, "crank.fi": 4}
+    perm = [order[where[c[:-2]] + c[-2:] if c != "crank.fi" else c] for c in out["Phi_columns"]]
+    e = np.array([np.cos(th), np.sin(th)])
+    reference = np.array([
+        [*2 * (A - O2), 0, 0, 0],
+        [e[1], -e[0], 0, 0, (A - O2) @ e],
+        [*-2 * (B - A), *2 * (B - A), 0],
+        [0, 0, *2 * (B - O4), 0],
+        [0, 0, 0, 0, 1],
+    ])[:, perm]
+    assert np.shape(out["Phi_z"]) == (5, 5) and len(out["Phi_rows"]) == 5
+    _parallel_rows(out["Phi_z"], reference)
+    assert out["ranks"] == (12, 5)
+
+    qd = {"ground": (0.0, 0.0, 0.0), "crank": (0.0, 0.0, ref["dtheta"][0]),
+          "coupler": (*ref["vA"][0], ref["dphi3"][0]), "rocker": (0.0, 0.0, ref["dphi4"][0])}
+    qd = np.array([v for name in solids for v in qd[name]])
+    assert rel_err(out["qd_reference"], qd) < RTOL
+    assert rel_err(out["qd_natural"], qd) < RTOL
+    assert out["velocity_difference"] < RTOL * np.max(np.abs(qd))
+    turn = lambda v: np.array([-v[1], v[0]])                              # noqa: E731
+    vB = ref["c"] * ref["dphi4"][0] * turn(np.array([np.cos(phi4), np.sin(phi4)]))
+    zd = np.array([*ref["vA"][0], *vB, ref["dtheta"][0]])[perm]
+    assert rel_err(out["zd"], zd) < RTOL
