@@ -228,3 +228,43 @@ def test_cli_bad_input_exits_2(capsys, tmp_path):
 def test_cli_solver_failure_exits_1(capsys):
     assert main(["verify", str(ROOT / "tests/data/every_element.toml")]) == 1
     assert "solver failure: exudyn backend: " in capsys.readouterr().err
+
+
+# ---- a mistranslation on the natural side: its own velocity terms ------------------------
+
+#: the natural translation of the motor's law with f' off by this (relative): positions
+#: and every position check are untouched, the rates the natural backend computes are not
+SKEW = 1e-6
+
+
+class SkewedLaw(pam2exu.Law):
+    """The law with its first derivative scaled by 1 + SKEW (f and f'' exact)."""
+
+    def __call__(self, t, xp=np):
+        f, df, ddf = super().__call__(t, xp)
+        return f, df * (1 + SKEW), ddf
+
+
+@pytest.fixture
+def natural_rates_off(monkeypatch):
+    """AngularActuator.natural declares its law as SkewedLaw: the natural backend's Φ_z ż = g'
+    sees ḟ·(1 + SKEW); its positions (f exact) and pam2exu's residual check still hold."""
+    def skewed(self, nc):
+        law = self.time_law()
+        nc.equation(self, [nc.angle(self.ref2.solid) - nc.angle(self.ref1.solid)],
+                    SkewedLaw(law.name, law.C))
+    monkeypatch.setattr(AngularActuator, "natural", skewed)
+    return ROOT / "examples" / "four_bar.toml"
+
+
+@pytest.mark.skipif("natural" not in BACKENDS, reason="needs the natural backend")
+def test_verify_finds_a_natural_side_mistranslation_in_the_rates(natural_rates_off, capsys):
+    """The crank's Dfi is 2π·SKEW off (the motor turns at 2π rad/s), the other solids' rates
+    in proportion; positions agree. verify exits 1 and names the rate columns, not x, y, fi."""
+    found = quiet_verify(natural_rates_off, analysis="kinematic", steps=40)
+    assert not found.ok
+    assert "crank.Dfi" in found.differing
+    assert not any(name.split(".")[1] in ("x", "y", "fi") for name in found.differing)
+    assert main(["verify", str(natural_rates_off), "-a", "kinematic", "--steps", "40"]) == 1
+    last = capsys.readouterr().out.rstrip().splitlines()[-1]
+    assert last.startswith("DISAGREE") and "crank.Dfi" in last

@@ -125,7 +125,11 @@ class Natural:
         kind = self._angle_kinds(form)
         fi = q[:, ANGLES]
         fi[:, kind.fixed] = kind.fixed_values
-        fi[:, kind.coordinate] = z[:, kind.columns]
+        # fi is the direction of the solid's vector; the angle coordinate only numbers its
+        # turns (the tie v × e(fi) = 0 also holds π away: the residual check then sees it)
+        theta, c = z[:, kind.columns], kind.coordinate
+        gap = np.arctan2(pose[:, 4 * c + 3], pose[:, 4 * c + 2]) - theta
+        fi[:, c] = theta + gap - 2 * np.pi * np.rint(gap / (2 * np.pi))
         free = kind.free
         if free.size:
             raw = np.unwrap(np.arctan2(pose[:, 4 * free + 3], pose[:, 4 * free + 2]), axis=0)

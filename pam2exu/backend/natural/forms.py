@@ -41,6 +41,11 @@ class Expr:
         return Expr({(index, ONE): 1.0})
 
     @property
+    def is_constant(self) -> bool:
+        """No coordinate in it."""
+        return not self.sines and all(k == (ONE, ONE) for k in self.products)
+
+    @property
     def is_linear(self) -> bool:
         return not self.sines and all(ONE in k for k in self.products)
 

@@ -237,7 +237,8 @@ class Formulation:
             if i in self.grounds:
                 continue
             label = f"rigid '{self.mech.solids[i].name}'"
-            self._rows.append((label, f.v.dot(f.v), f.d[0] ** 2 + f.d[1] ** 2, 1))
+            if not f.v.x.is_constant or not f.v.y.is_constant:   # else held by two ground pins
+                self._rows.append((label, f.v.dot(f.v), f.d[0] ** 2 + f.d[1] ** 2, 1))
             base = {f.sp, (f.sp[0] + f.d[0], f.sp[1] + f.d[1])}
             for loc, vec in self.own.get(i, []):
                 if loc not in base:
@@ -278,7 +279,7 @@ class Formulation:
         enters as f(t) (power 1) or f(t)² (power 2)."""
         label = f"'{element.name}' ({element.type})" if element is not None else "revolute"
         for e in expressions:
-            if any(k != (ONE, ONE) for k in e.products) or e.sines:
+            if not e.is_constant:
                 self._rows.append((label, e, target, power))
             # else: between ground solids only: nothing to solve (the native residual check
             # still reports the model if they disagree)
