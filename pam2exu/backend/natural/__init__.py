@@ -125,11 +125,13 @@ class Natural:
         kind = self._angle_kinds(form)
         fi = q[:, ANGLES]
         fi[:, kind.fixed] = kind.fixed_values
-        # fi is the direction of the solid's vector; the angle coordinate only numbers its
-        # turns (the tie v × e(fi) = 0 also holds π away: the residual check then sees it)
+        # fi is the angle coordinate where the solid's vector points that way (to round-off),
+        # else the vector's direction: the tie v × e(fi) = 0 also holds π away, and the
+        # residual check then sees the actuator violated instead of a crank half a turn off
         theta, c = z[:, kind.columns], kind.coordinate
         gap = np.arctan2(pose[:, 4 * c + 3], pose[:, 4 * c + 2]) - theta
-        fi[:, c] = theta + gap - 2 * np.pi * np.rint(gap / (2 * np.pi))
+        gap -= 2 * np.pi * np.rint(gap / (2 * np.pi))
+        fi[:, c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
         free = kind.free
         if free.size:
             raw = np.unwrap(np.arctan2(pose[:, 4 * free + 3], pose[:, 4 * free + 2]), axis=0)
