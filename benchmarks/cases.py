@@ -1,7 +1,8 @@
 """The benchmark's mechanisms, each with its references (nothing from pam2exu).
 
 Each ``*_case`` returns a pam2exu model, a function ``reference(t)`` giving
-({kinematic column: array}, {reaction column: array} or None) at the times t, and the
+({kinematic column: array}, {reaction column: array} or None) at the times t (the
+four-bar's also ``reference(t, forces=False)``: the kinematics alone), and the
 natural scales L [m] and w [rad/s] of the error measure (``references.closed_form.errors``).
 
 - ``four_bar_case``: examples/four_bar.toml; kinematics ``four_bar``, reactions
@@ -43,7 +44,7 @@ def four_bar_case(t_end=1.0, C=None):
     if C is not None:
         model["motor"].C = list(C)
 
-    def reference(t):
+    def reference(t, forces=True):
         a, b, c, d = (FOUR_BAR[key] for key in "abcd")
         th, dth, ddth = actuator_law(model, "motor", t)
         (phi, dphi, ddphi), (psi, dpsi, ddpsi) = four_bar(a, b, c, d, th, dth, ddth)
@@ -60,9 +61,13 @@ def four_bar_case(t_end=1.0, C=None):
         bodies = {}
         for name, r in origin.items():
             kin.update(solid_columns(name, r, angle[name]))
+            if not forces:
+                continue
             s = model[name]
             bodies[name] = body(float(s.mass), float(s.inertia), [float(v) for v in s.cog],
                                 r, angle[name])
+        if not forces:
+            return kin, None
         A = origin["coupler"][0]
         B = A + b * e(phi)
         links = [("fixed", "base", "ground"),

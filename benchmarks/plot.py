@@ -1,22 +1,26 @@
-"""docs/img/work_precision.png: work against precision (section 1) and the chain's time per
-step against its size (section 4)."""
+"""docs/img/work_precision.png: work against precision (section 1), the chain's time per
+step against its size (section 4), and the same for both backends (section 6)."""
 from __future__ import annotations
 
 import numpy as np
 
 from pam2exu.backend.system import DENSE_UP_TO
 
+from .backends import Failure
+from .backends import label as backend_label
 from .measure import fit_exponent
 
 
-def plot(path, grid, chain_rows):
-    """Write the figure to ``path`` (matplotlib's Agg backend, chosen here: no display)."""
+def plot(path, grid, chain_rows, side=None):
+    """Write the figure to ``path`` (matplotlib's Agg backend, chosen here: no display);
+    ``side``: section 6's runs, a fourth panel."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.ticker import FormatStrFormatter
 
-    fig, axes = plt.subplots(1, 3, figsize=(16, 5))
+    fig, axes = plt.subplots(2, 2, figsize=(14, 10))
+    axes = axes.ravel()
     markers = {t: m for t, m in zip(sorted({r.tolerance for r in grid}), "o^sD")}
     colours = {}
     for ax, kinds, title in ((axes[0], ("positions", "velocities"), "positions and velocities"),
@@ -71,7 +75,40 @@ def plot(path, grid, chain_rows):
     ax.set_title("chain of N four-bar loops")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
+    if side is not None:
+        backends_panel(axes[3], side)
+    else:
+        axes[3].axis("off")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def backends_panel(ax, side):
+    """Section 6: the chain's time per step against N on each backend."""
+    styles = {"kinematic": "o-", "kinetostatic": "s--"}
+    backends = list(dict.fromkeys(b for c in side["chain"] for b in c.runs))
+    N_all = sorted({c.N for c in side["chain"]})
+    for i, b in enumerate(backends):
+        for analysis, style in styles.items():
+            pts = [(c.N, c.runs[b].us) for c in side["chain"]
+                   if c.analysis == analysis and not isinstance(c.runs.get(b), Failure)]
+            if len(pts) < 2:
+                continue
+            N, y = (np.array(v, dtype=float) for v in zip(*pts))
+            ax.loglog(N, y, style, color=f"C{i}",
+                      label=f"{backend_label(b)}, {analysis} (N^{fit_exponent(N, y):.2f})")
+    first = next((c.runs[b].us for c in side["chain"] for b in backends
+                  if c.N == N_all[0] and not isinstance(c.runs.get(b), Failure)), None)
+    if first:
+        N = np.array(N_all, dtype=float)
+        ax.loglog(N, first * N, "k-", alpha=0.25, lw=4, label="∝ N")
+    ax.set_xticks(N_all)
+    ax.set_xticklabels([str(n) for n in N_all])
+    ax.minorticks_off()
+    ax.set_xlabel("loops N")
+    ax.set_ylabel("wall time per step [µs], end to end")
+    ax.set_title("chain of N four-bar loops: the two backends")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)

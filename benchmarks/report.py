@@ -12,6 +12,7 @@ from pam2exu.backend.system import DENSE_UP_TO
 
 from .cases import CHAIN, CHAIN_LAW, TWO_PI
 from .measure import DEFAULT_TOLERANCE, KINDS, fit_exponent, warning_summary
+from .report_backends import backends_section
 
 
 def fmt_err(e):
@@ -71,7 +72,9 @@ def chain_fits(chain_rows):
 
 
 def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows, newton,
-                 profiles, sections, elapsed):
+                 profiles, sections, elapsed, side=None, memory=None):
+    """Write performance.md; ``side`` and ``memory``: section 6 (backends.py), left out
+    when None."""
     lines = []
     add = lines.append
     add("# Performance: speed against error")
@@ -103,6 +106,9 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
     add("python benchmarks/speed_vs_error.py --quick   # smoke test, under a minute, "
         "written to a temporary directory")
     add("```")
+    add("")
+    add("`--no-memory` leaves out the runs of a million steps in section 6 (about half a "
+        "minute).")
     add("")
     add("Time per step is the wall time of `pam2exu.run(model, analysis=..., steps=..., "
         "solver=SolveSettings(tolerance=...))` (a loaded `Model`, so without parsing the "
@@ -174,6 +180,10 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
                   verdict(qs_us / kin_us, 1.2)])
     add(table(["target", "goal", "measured", "verdict"], trows))
     add("")
+    if side is not None:
+        add("The natural-coordinate backend's targets (issue 12), beside the Exudyn "
+            "backend's numbers on the same runs: section 6.")
+        add("")
 
     # why
     it10 = cmp10["iterations"]
@@ -485,4 +495,6 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
           f"{sum(v for k, v in sections.items() if '(rounds' in k):.0f} s"
         + f"; {elapsed / 60:.1f} minutes in all.")
     add("")
+    if side is not None:
+        lines += backends_section(plan, quick, side, memory)
     (out_dir / "performance.md").write_text("\n".join(lines) + "\n", encoding="utf-8")

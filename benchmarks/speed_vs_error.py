@@ -3,6 +3,7 @@
     python benchmarks/speed_vs_error.py            # full run (about 5 minutes on 2 cores)
     python benchmarks/speed_vs_error.py --quick    # smoke test (under a minute), written to
                                                    # a temporary directory, not to docs/
+    python benchmarks/speed_vs_error.py --no-memory   # without section 6's million-step runs
 
 What it measures (each section of docs/performance.md is one of these):
 
@@ -19,6 +20,10 @@ What it measures (each section of docs/performance.md is one of these):
    link, one motor drives them all), N = 1 … 64; time per step against N and the fitted
    exponent; errors against the chained closed form and a Newton–Euler solution.
 5. Where the time goes: a cProfile of three runs.
+6. The two backends (Exudyn, natural coordinates) side by side on the same runs, against
+   issue 12's targets: the four-bar, kinematic and kinetostatic, 100,000 steps; the chain,
+   N = 1 … 64, and the exponent of its cost; the peak memory of 1,000,000 steps of the
+   kinematic four-bar, each backend in its own process; the largest position error.
 
 References (the top-level ``references`` package, shared with the tests; nothing comes from
 pam2exu). Kinematics: the closed forms of references/closed_form.py (``four_bar``, chained
@@ -31,8 +36,8 @@ solved at every step), which checks itself by the power balance before it is use
 Layout: this file is the command line and the order of the run. Measuring:
 cases.py (the mechanisms and their references), plain_exudyn.py (the hand-written Exudyn
 four-bar), measure.py (grids, timing, errors of one configuration), sections.py (the
-sections above). Reporting: report.py (docs/performance.md), plot.py
-(docs/img/work_precision.png). The file puts the repository root on ``sys.path`` so that
+sections 1–5 above), backends.py (section 6). Reporting: report.py (docs/performance.md),
+report_backends.py (its section 6), plot.py (docs/img/work_precision.png). The file puts the repository root on ``sys.path`` so that
 ``benchmarks`` and ``references`` import from a clone (``python -m benchmarks.speed_vs_error``
 from the root does the same).
 """
@@ -47,6 +52,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))          # this clone's benchmarks, references (and pam2exu)
 
+from benchmarks.backends import memory, run_backend, side_by_side  # noqa: E402
 from benchmarks.cases import chain_model, four_bar_case  # noqa: E402
 from benchmarks.measure import DEFAULT_TOLERANCE, FULL, QUICK, log, machine, run_pam  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
@@ -63,6 +69,9 @@ def main(argv=None):
     parser.add_argument("--out", type=Path, default=None,
                         help="directory for performance.md and img/ (default: docs/, or a "
                              "temporary directory with --quick)")
+    parser.add_argument("--no-memory", action="store_true",
+                        help="leave out section 6's peak-memory runs (1,000,000 steps per "
+                             "backend, about half a minute)")
     args = parser.parse_args(argv)
     plan = QUICK if args.quick else FULL
     out_dir = args.out or (Path(tempfile.mkdtemp(prefix="pam2exu-bench-")) if args.quick
@@ -71,6 +80,11 @@ def main(argv=None):
     info = machine()                     # before the run: the commit that is measured
     run_pam(four_bar_case()[0], "kinetostatic", 200, 1.0, DEFAULT_TOLERANCE, 1)   # warm-up
     plain_exudyn_four_bar(200, DEFAULT_TOLERANCE, "symbolic")
+    for backend in plan.backends:
+        try:
+            run_backend(four_bar_case()[0], "kinetostatic", 200, backend)
+        except Exception as exc:  # section 6 records it
+            log(f"warm-up on the {backend} backend failed: {type(exc).__name__}: {exc}")
     sections = {}
 
     def section(title, fn, *args):
@@ -96,6 +110,7 @@ def main(argv=None):
     section("2. pam2exu against plain Exudyn (rounds 3)", compare_rounds, 2)
     chain_rows = section("4. chain", chain, plan)
     section("2. pam2exu against plain Exudyn (rounds 4)", compare_rounds, 3)
+    side = section("6. two backends side by side", side_by_side, plan)
     section("2. pam2exu against plain Exudyn (rounds 5)", compare_rounds, 4)
     plain_rows = section("2c. plain solve: Newton iterations and error", comparison.rows)
     compare = max(plan.compare_steps, key=lambda n: (n <= 10000, n))
@@ -106,11 +121,13 @@ def main(argv=None):
             profile(four_bar_case()[0], "kinetostatic", compare),
         f"chain N = {plan.chain_sizes[-1]}, kinematic, {plan.chain_steps:,} steps":
             profile(chain_model(plan.chain_sizes[-1]), "kinematic", plan.chain_steps)})
+    peaks = None if args.no_memory else section("6b. peak memory, one process per run",
+                                                 memory, plan)
     elapsed = time.perf_counter() - start
     out_dir.mkdir(parents=True, exist_ok=True)
-    plot(out_dir / "img" / "work_precision.png", grid, chain_rows)
+    plot(out_dir / "img" / "work_precision.png", grid, chain_rows, side)
     write_report(out_dir, info, plan, args.quick, grid, hard, chain_rows, plain_rows, newton,
-                 profiles, sections, elapsed)
+                 profiles, sections, elapsed, side, peaks)
     log(f"wrote {out_dir / 'performance.md'} and {out_dir / 'img' / 'work_precision.png'} "
         f"({elapsed / 60:.1f} minutes)")
 
