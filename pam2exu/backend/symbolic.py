@@ -10,6 +10,11 @@ import exudyn as exu
 
 esym = exu.symbolic
 
+#: a load step's time is on the grid when within this fraction of a step of a grid time:
+#: Exudyn adds up its step times, which drift by round-off (past 1e-6 of a step after
+#: ~240,000 steps), while a step it cut short is at least 1/64 of a step off the grid
+ON_GRID = 1e-3
+
 
 def _real(v):
     """A symbolic Real from a number or an expression."""
@@ -31,7 +36,7 @@ class SymbolicNamespace:
 def grid_time(t, dt: float):
     """τ = (k − 1)·dt at load step k (t ≈ k·dt, up to Exudyn's accumulated round-off), else t − dt."""
     k = esym.round(t / dt)
-    return esym.IfThenElse(esym.abs(t / dt - k) < 1e-6, (k - 1.0) * dt, t - dt)
+    return esym.IfThenElse(esym.abs(t / dt - k) < ON_GRID, (k - 1.0) * dt, t - dt)
 
 
 def offset_function(mbs, obj, law, shift: float, dt: float):

@@ -21,7 +21,7 @@ import exudyn as exu
 from exudyn import itemInterface as items
 
 from ..kinematics import State, column, pose
-from .symbolic import offset_function
+from .symbolic import ON_GRID, offset_function
 
 log = logging.getLogger("pam2exu")
 
@@ -31,6 +31,8 @@ DENSE_UP_TO = 40
 #: Exudyn's static solver may cut a load step that fails into smaller ones: not below this
 #: fraction of a step (bounds the work of a step that cannot be solved)
 MIN_STEP_FRACTION = 1.0 / 64
+#: ``symbolic.ON_GRID``: a load step's time is on the grid when within this fraction of a
+#: step of a grid time (MIN_STEP_FRACTION is far larger: a cut step is never on it)
 
 
 @dataclass
@@ -385,7 +387,7 @@ class ExudynSystem:
         def pre_step(mbs, t):
             tau = t - dt
             k = int(round(tau / dt)) - k0
-            on_grid = 0 <= k < n and abs(tau - (k + k0) * dt) <= 1e-6 * dt
+            on_grid = 0 <= k < n and abs(tau - (k + k0) * dt) <= ON_GRID * dt
             for obj, par, law, shift, values in self.stepped:
                 mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid
                                        else law.value(tau) + shift)
@@ -429,7 +431,7 @@ class ExudynSystem:
         if first is not None and len(first) > 1:
             t_rows = first[1:, 0] - dt          # row 0 is the unsolved initial state
             k_rows = np.rint(t_rows / dt).astype(int)
-            on_grid = np.abs(t_rows - k_rows * dt) <= 1e-6 * dt
+            on_grid = np.abs(t_rows - k_rows * dt) <= ON_GRID * dt
             k_rows -= k0
             on_grid &= (k_rows >= 0) & (k_rows < n)
             for i, d in data.items():

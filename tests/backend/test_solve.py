@@ -99,3 +99,18 @@ def test_a_law_that_cannot_be_compiled_is_logged_and_stepped(four_bar, monkeypat
 def test_quasi_static_checks_exudyns_multipliers_at_first_middle_last(n, rows):
     """(the wrong-translation check itself: tests/analyses/test_forces.py, flipped spring)"""
     assert checked_steps(n) == rows
+
+
+def test_long_runs_stay_on_the_grid(request):
+    """Exudyn adds up its load-step times: after ~240,000 steps their round-off passed the
+    1e-6 of a step the grid matching allowed, and a 300,000-step run stopped there ("the
+    static solver stopped early", found by the benchmark's million-step run). Reference:
+    the crank's law, fi = C1 + C2 t exactly, at every one of the 300,001 times."""
+    path = request.config.rootpath / "examples/pam_crank.toml"
+    model = pam2exu.load(path)
+    res = pam2exu.run(model, analysis="kinematic", steps=300_000, outputs=["Solid1.fi"])
+    assert len(res.t) == 300_001 and np.isfinite(res["Solid1.fi"]).all()
+    driver = next(e for e in model.elements if e.type == "angular_actuator")
+    expected = driver.time_law()(res.t)[0]
+    assert np.max(np.abs(res["Solid1.fi"] - expected)) < 1e-12 * max(1.0, np.max(np.abs(expected)))
+    assert system.ON_GRID * 64 < 1.0     # a cut step (≥ 1/64 of a step off the grid) never is
