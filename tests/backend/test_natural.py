@@ -185,3 +185,22 @@ def test_a_solid_held_by_two_ground_pins_adds_no_equation():
     natural = quietly(pam2exu.run, model, analysis="kinematic", steps=50, backend="natural")
     difference, where = relative_difference(exudyn, natural)
     assert difference < 1e-9, (where, difference)
+
+
+def test_chunked_solves_and_conversions_give_the_same_run(monkeypatch):
+    """Memory is bounded by solving and converting the steps in chunks (1,000,000 steps of
+    the four-bar: 985 MB peak, docs/performance.md): chunks of a few hundred steps give the
+    run of one chunk, bit for bit."""
+    import pam2exu.backend.natural as natural
+    from pam2exu.backend.natural import solver
+    path = ROOT / "examples" / "four_bar.toml"
+    whole = pam2exu.run(path, analysis="kinematic", steps=5000, backend="natural")
+    monkeypatch.setattr(solver, "CHUNK_BYTES", 200_000)
+    monkeypatch.setattr(natural, "CONVERT_ROWS", 333)
+    job = prepare(path, analysis="kinematic", steps=5000)
+    assert Natural().formulation(job.mech) is not None
+    assert solver.Solver(Natural().formulation(job.mech).terms, np.ones(5), None,
+                         False).rows_per_chunk() < 1000
+    chunked = pam2exu.run(path, analysis="kinematic", steps=5000, backend="natural")
+    for c in whole.columns:
+        np.testing.assert_array_equal(chunked[c], whole[c], err_msg=c)

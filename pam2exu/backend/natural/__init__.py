@@ -81,9 +81,11 @@ class Natural:
         found = Positions(q, solved, error, q[solved - 1], iterations=solver.iterations)
         if rates and solved:
             zd, zdd = solver.run_rates(times[:solved], z[:solved])
-            found.qd, found.qdd = (np.full_like(q, np.nan) for _ in range(2))
-            found.qd[:solved], found.qdd[:solved] = self.to_rates(form, mech, z[:solved],
-                                                                  zd, zdd)
+            qd, qdd = self.to_rates(form, mech, z[:solved], zd, zdd)
+            del zd, zdd
+            if solved < n:                     # NaN after the last solved step, as q
+                qd, qdd = (np.r_[x, np.full((n - solved, mech.nq), np.nan)] for x in (qd, qdd))
+            found.qd, found.qdd = qd, qdd
         if forces and solved:
             found.multipliers = multipliers(form, times[:solved], z[:solved], q[:solved])
         return found
@@ -118,26 +120,30 @@ class Natural:
     # ---- back to x, y, fi ---------------------------------------------------------------------
     def to_q(self, form: Formulation, mech, z: np.ndarray, start: np.ndarray) -> np.ndarray:
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
-        value in the whole turn nearest ``start``."""
-        pose = np.c_[z, np.ones(len(z))] @ form.pose_forms().T   # x, y, cos, sin per solid
-        q = np.empty((len(z), mech.nq))
-        q[:, 0::PER_SOLID], q[:, 1::PER_SOLID] = pose[:, 0::4], pose[:, 1::4]
+        value in the whole turn nearest ``start`` (in chunks of steps: bounded memory)."""
+        K = form.pose_forms()
         kind = self._angle_kinds(form)
-        fi = q[:, ANGLES]
-        fi[:, kind.fixed] = kind.fixed_values
-        # fi is the angle coordinate where the solid's vector points that way (to round-off),
-        # else the vector's direction: the tie v × e(fi) = 0 also holds π away, and the
-        # residual check then sees the actuator violated instead of a crank half a turn off
-        theta, c = z[:, kind.columns], kind.coordinate
-        gap = np.arctan2(pose[:, 4 * c + 3], pose[:, 4 * c + 2]) - theta
-        gap -= 2 * np.pi * np.rint(gap / (2 * np.pi))
-        fi[:, c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
-        free = kind.free
+        q = np.empty((len(z), mech.nq))
+        free, c = kind.free, kind.coordinate
+        raw = np.empty((len(z), free.size))
+        for s in _chunks(len(z)):
+            pose = np.c_[z[s], np.ones(len(z[s]))] @ K.T      # x, y, cos, sin per solid
+            q[s, 0::PER_SOLID], q[s, 1::PER_SOLID] = pose[:, 0::4], pose[:, 1::4]
+            fi = np.empty((len(pose), len(form.frames)))
+            fi[:, kind.fixed] = kind.fixed_values
+            # fi is the angle coordinate where the solid's vector points that way (to
+            # round-off), else the vector's direction: the tie v × e(fi) = 0 also holds π
+            # away, and the residual check then sees the actuator violated instead
+            theta = z[s][:, kind.columns]
+            gap = np.arctan2(pose[:, 4 * c + 3], pose[:, 4 * c + 2]) - theta
+            gap -= 2 * np.pi * np.rint(gap / (2 * np.pi))
+            fi[:, c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
+            raw[s] = np.arctan2(pose[:, 4 * free + 3], pose[:, 4 * free + 2])
+            q[s, ANGLES] = fi
         if free.size:
-            raw = np.unwrap(np.arctan2(pose[:, 4 * free + 3], pose[:, 4 * free + 2]), axis=0)
+            raw = np.unwrap(raw, axis=0)
             raw += 2 * np.pi * np.rint((start[ANGLES][free] - raw[0]) / (2 * np.pi))
-            fi[:, free] = raw
-        q[:, ANGLES] = fi
+            q[:, column(free, 2)] = raw
         return q
 
     def _angle_kinds(self, form: Formulation):
@@ -155,22 +161,34 @@ class Natural:
             free=np.array(free, dtype=int))
 
     def to_rates(self, form: Formulation, mech, z, zd, zdd):
-        """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)."""
+        """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
+        (in chunks of steps: bounded memory)."""
         K = form.pose_forms()
-        pose = np.c_[z, np.ones(len(z))] @ K.T
-        d1, d2 = zd @ K[:, :form.nz].T, zdd @ K[:, :form.nz].T
-        qd, qdd = np.empty((len(z), mech.nq)), np.empty((len(z), mech.nq))
-        for out, d in ((qd, d1), (qdd, d2)):
-            out[:, 0::PER_SOLID], out[:, 1::PER_SOLID] = d[:, 0::4], d[:, 1::4]
         kind = self._angle_kinds(form)
-        w, a = np.zeros((len(z), len(form.frames))), np.zeros((len(z), len(form.frames)))
-        w[:, kind.coordinate], a[:, kind.coordinate] = zd[:, kind.columns], zdd[:, kind.columns]
-        f = kind.free
-        if f.size:
-            c, s = pose[:, 4 * f + 2], pose[:, 4 * f + 3]
-            dc, ds, ddc, dds = d1[:, 4 * f + 2], d1[:, 4 * f + 3], d2[:, 4 * f + 2], d2[:, 4 * f + 3]
-            r2 = c * c + s * s
-            w[:, f] = (c * ds - s * dc) / r2
-            a[:, f] = (c * dds - s * ddc) / r2 - 2 * (c * dc + s * ds) * w[:, f] / r2
-        qd[:, ANGLES], qdd[:, ANGLES] = w, a
+        qd, qdd = np.empty((len(z), mech.nq)), np.empty((len(z), mech.nq))
+        f, c = kind.free, kind.coordinate
+        for s in _chunks(len(z)):
+            pose = np.c_[z[s], np.ones(len(z[s]))] @ K.T
+            d1, d2 = zd[s] @ K[:, :form.nz].T, zdd[s] @ K[:, :form.nz].T
+            for out, d in ((qd, d1), (qdd, d2)):
+                out[s, 0::PER_SOLID], out[s, 1::PER_SOLID] = d[:, 0::4], d[:, 1::4]
+            w, a = np.zeros((len(pose), len(form.frames))), np.zeros((len(pose), len(form.frames)))
+            w[:, c], a[:, c] = zd[s][:, kind.columns], zdd[s][:, kind.columns]
+            if f.size:
+                cs, sn = pose[:, 4 * f + 2], pose[:, 4 * f + 3]
+                dc, ds = d1[:, 4 * f + 2], d1[:, 4 * f + 3]
+                ddc, dds = d2[:, 4 * f + 2], d2[:, 4 * f + 3]
+                r2 = cs * cs + sn * sn
+                w[:, f] = (cs * ds - sn * dc) / r2
+                a[:, f] = (cs * dds - sn * ddc) / r2 - 2 * (cs * dc + sn * ds) * w[:, f] / r2
+            qd[s, ANGLES], qdd[s, ANGLES] = w, a
         return qd, qdd
+
+
+#: steps converted to x, y, fi at a time
+CONVERT_ROWS = 1 << 16
+
+
+def _chunks(n: int):
+    """Slices of n steps, CONVERT_ROWS at a time."""
+    return (slice(a, min(n, a + CONVERT_ROWS)) for a in range(0, n, CONVERT_ROWS))

@@ -67,6 +67,13 @@ class Solver:
         self.least_squares = least_squares or terms.m != terms.nz
         self.iterations = 0
 
+    def rows_per_chunk(self) -> int:
+        """Steps solved at once: the Jacobians, their terms and the solves' copies of a
+        chunk take about CHUNK_BYTES."""
+        t = self.terms
+        per_step = 8 * (3 * t.m * t.nz + 3 * len(t.rows) + 3 * (len(t.pr) + len(t.sr)) + 8 * t.nz)
+        return max(1, CHUNK_BYTES // per_step)
+
     # ---- linear algebra -------------------------------------------------------------------
     def solve(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
         """x with Φ_z x = b per step (data: ``Terms.jacobian``); minimum-norm least squares
@@ -128,7 +135,7 @@ class Solver:
         the memory of the Jacobians."""
         terms = self.terms
         zd, zdd = np.empty_like(z), np.empty_like(z)
-        rows = max(1, CHUNK_BYTES // (8 * max(1, terms.m) * max(1, terms.nz)))
+        rows = self.rows_per_chunk()
         for a in range(0, len(t), rows):
             s = slice(a, a + rows)
             data = terms.jacobian(z[s])
@@ -280,24 +287,24 @@ class Solver:
         counts = j - k - 1
         owner = np.repeat(np.arange(len(intervals)), counts)
         steps = np.concatenate([np.arange(a + 1, b) for a, b in zip(k, j)])
-        h = (t[j] - t[k])[owner][:, None]
-        u = (t[steps][:, None] - t[k][owner][:, None]) / h
-        guess = ((2 * u**3 - 3 * u**2 + 1) * z[k][owner] + (u**3 - 2 * u**2 + u) * h * zdk[owner]
-                 + (-2 * u**3 + 3 * u**2) * z[j][owner] + (u**3 - u**2) * h * zdj[owner])
-        rows = max(1, CHUNK_BYTES // (8 * max(1, self.terms.m) * self.terms.nz))
+        rows = self.rows_per_chunk()
         failed = np.zeros(len(intervals), dtype=bool)
-        for a in range(0, len(steps), rows):
-            part = slice(a, a + rows)
-            found = self._bulk(t[steps[part]], guess[part])
+        for a in range(0, len(steps), rows):    # chunks: memory bounded, whatever the run
+            part, at = steps[a:a + rows], owner[a:a + rows]
+            h = (t[j] - t[k])[at][:, None]
+            u = (t[part][:, None] - t[k][at][:, None]) / h
+            guess = ((2 * u**3 - 3 * u**2 + 1) * z[k][at] + (u**3 - 2 * u**2 + u) * h * zdk[at]
+                     + (-2 * u**3 + 3 * u**2) * z[j][at] + (u**3 - u**2) * h * zdj[at])
+            found = self._bulk(t[part], guess)
             if found is None:
-                zi, ok = self.newton(t[steps[part]], guess[part])
+                zi, ok = self.newton(t[part], guess)
             else:
                 zi, ok, zd, zdd = found
-                self.own_rates[steps[part]] = True
-                self.zd[steps[part]], self.zdd[steps[part]] = zd, zdd
-            far = np.max(np.abs(zi - guess[part]) * self.w, axis=1) > allowed[owner[part]]
-            z[steps[part]] = zi
-            failed[owner[part][~ok | far]] = True
+                self.own_rates[part] = True
+                self.zd[part], self.zdd[part] = zd, zdd
+            far = np.max(np.abs(zi - guess) * self.w, axis=1) > allowed[at]
+            z[part] = zi
+            failed[at[~ok | far]] = True
         return list(np.nonzero(failed)[0])
 
     def _bulk(self, t, z, iterations: int = 4):
