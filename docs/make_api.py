@@ -21,10 +21,12 @@ import types
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:          # run from a clone without installing
-    sys.path.insert(0, str(ROOT))
+for path in (ROOT, ROOT / "docs"):     # run from a clone without installing; docs/page.py
+    if str(path) not in sys.path:
+        sys.path.insert(0, str(path))
 
 import pam2exu
+from page import write_or_check  # noqa: E402  (docs/page.py)
 from pam2exu.elements import ACCELERATION, ELEMENTS, FORCE, POSITION, VELOCITY
 
 OUTPUT = ROOT / "docs" / "api.md"
@@ -550,24 +552,8 @@ def main(argv=None) -> int:
     p.add_argument("--check", action="store_true",
                    help="exit 1 when docs/api.md is not what this script writes")
     args = p.parse_args(argv)
-    new = render()
-    if args.check:
-        old = OUTPUT.read_text(encoding="utf-8") if OUTPUT.exists() else None
-        if old == new:
-            print(f"{OUTPUT.relative_to(ROOT)} is up to date")
-            return 0
-        if old is None:
-            where = "it does not exist"
-        else:
-            a, b = old.splitlines(), new.splitlines()
-            line = next((k for k, (x, y) in enumerate(zip(a, b)) if x != y), min(len(a), len(b)))
-            where = f"first difference at line {line + 1}"
-        print(f"{OUTPUT.relative_to(ROOT)} is stale ({where}): it is not what the "
-              "docstrings give. Run: python docs/make_api.py", file=sys.stderr)
-        return 1
-    OUTPUT.write_text(new, encoding="utf-8")
-    print(f"wrote {OUTPUT.relative_to(ROOT)} ({len(new.splitlines())} lines)")
-    return 0
+    return write_or_check(OUTPUT, render(), args.check, str(OUTPUT.relative_to(ROOT)),
+                          "it is not what the docstrings give", "python docs/make_api.py")
 
 
 if __name__ == "__main__":

@@ -28,10 +28,12 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:          # run from a clone without installing
-    sys.path.insert(0, str(ROOT))
+for path in (ROOT, ROOT / "docs"):     # run from a clone without installing; docs/page.py
+    if str(path) not in sys.path:
+        sys.path.insert(0, str(path))
 
 import pam2exu  # noqa: E402
+from page import write_or_check  # noqa: E402  (docs/page.py)
 from pam2exu.backend.natural import Formulation  # noqa: E402
 from pam2exu.backend.natural import terms as terms_module  # noqa: E402
 from pam2exu.backend.natural.forms import ONE, Expr, Vec  # noqa: E402
@@ -923,25 +925,8 @@ def main(argv=None) -> int:
     p.add_argument("--check", action="store_true",
                    help="exit 1 when docs/natural-coordinates.md is not what this script writes")
     args = p.parse_args(argv)
-    new = render()
-    name = OUTPUT.name
-    if args.check:
-        old = OUTPUT.read_text(encoding="utf-8") if OUTPUT.exists() else None
-        if old == new:
-            print(f"{name} is up to date")
-            return 0
-        if old is None:
-            where = "it does not exist"
-        else:
-            a, b = old.splitlines(), new.splitlines()
-            line = next((k for k, (x, y) in enumerate(zip(a, b)) if x != y), min(len(a), len(b)))
-            where = f"first difference at line {line + 1}"
-        print(f"{name} is stale ({where}): it is not what the code gives. "
-              "Run: python docs/make_natural.py", file=sys.stderr)
-        return 1
-    OUTPUT.write_text(new, encoding="utf-8")
-    print(f"wrote {name} ({len(new.splitlines())} lines)")
-    return 0
+    return write_or_check(OUTPUT, render(), args.check, OUTPUT.name,
+                          "it is not what the code gives", "python docs/make_natural.py")
 
 
 if __name__ == "__main__":

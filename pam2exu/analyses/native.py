@@ -25,10 +25,6 @@ CHUNK_BYTES = 64 * 2**20
 SPARSE_FROM = 40
 #: unknowns per sparse chunk
 SPARSE_CHUNK = 200_000
-#: a configuration whose condition number (``condition_numbers``) is above this is taken as
-#: lying on a singular position: Newton converges there only to ~√(tolerance), so the
-#: condition number of a solver's configuration is ~1e6 there, not 1e16
-SINGULAR_CONDITION = 1e4
 
 
 @dataclass

@@ -81,14 +81,13 @@ def rates(job: Job, t, q, redundant: bool, found: Positions | None = None,
         return native.rates(job.mech, t, q, accelerations, redundant)
 
 
-def velocities(job: Job, q: np.ndarray, redundant: bool, found: Positions | None = None):
-    """(qd, qdd) from the backend or the native pass (``rates``), after the residual check of
-    the backend's positions; SolverError at a singular position (``branch.motion`` follows
-    the branch instead)."""
+def velocities(job: Job, q: np.ndarray, redundant: bool):
+    """(qd, qdd) from the native pass, after the residual check of the backend's positions;
+    SolverError at a singular position (``branch.motion`` follows the branch instead)."""
     mech, t = job.mech, job.times
     accelerations = ACCELERATION in job.levels
     job.stage = "computing velocities and accelerations"
-    qd, qdd, residual = rates(job, t, q, redundant, found, accelerations)
+    qd, qdd, residual = rates(job, t, q, redundant, accelerations=accelerations)
     check_residual(mech, t, q, job, residual)
     bad = ~np.isfinite(qd).all(axis=1)
     if qdd is not None:

@@ -31,8 +31,6 @@ DENSE_UP_TO = 40
 #: Exudyn's static solver may cut a load step that fails into smaller ones: not below this
 #: fraction of a step (bounds the work of a step that cannot be solved)
 MIN_STEP_FRACTION = 1.0 / 64
-#: ``symbolic.ON_GRID``: a load step's time is on the grid when within this fraction of a
-#: step of a grid time (MIN_STEP_FRACTION is far larger: a cut step is never on it)
 
 
 @dataclass

@@ -9,6 +9,8 @@ velocities and accelerations from the formulation's own linear solves.
 """
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from ...errors import SolverError
@@ -61,17 +63,16 @@ class Natural:
             if anchor_stiffness > 0:
                 z0 = self._anchored(form, mech, times[0], z_start, settings, w)
             else:
-                z1, ok = solver.newton(times[:1], z_start[None])
-                if not ok[0]:                  # a poor guess: shorter steps
-                    z1, ok = (np.array(x) for x in solver.damped(times[0], z_start))
-                    z1 = z1[None]
-                    ok = np.atleast_1d(ok)
-                z0 = z1[0] if ok[0] else None
+                found, ok = solver.newton(times[:1], z_start[None])
+                z1, ok = found[0], ok[0]
+                if not ok:                     # a poor guess: shorter steps
+                    z1, ok = solver.damped(times[0], z_start)
+                z0 = z1 if ok else None
         except SolverError as exc:
             return Positions(q, 0, str(exc), start)
         if z0 is None:                   # where Newton stopped: the diagnosis starts there
-            last = self.to_q(form, mech, z1[:1], start)[0]
-            return Positions(q, 0, self._failed(form, solver, times[0], z1[0], settings),
+            last = self.to_q(form, mech, z1[None], start)[0]
+            return Positions(q, 0, self._failed(form, solver, times[0], z1, settings),
                              last if np.isfinite(last).all() else start)
         z, solved = solver.run(times, z0)
         error = None
@@ -148,7 +149,6 @@ class Natural:
 
     def _angle_kinds(self, form: Formulation):
         """Which solids' fi are constant (ground), an angle coordinate, or atan2 of the vector."""
-        from types import SimpleNamespace
         fixed = [i for i, f in enumerate(form.frames) if f.fixed_angle is not None]
         coordinate = [i for i, f in enumerate(form.frames)
                       if f.fixed_angle is None and f.angle is not None]

@@ -128,10 +128,6 @@ class Vec:
         """a · b."""
         return self.x * o.x + self.y * o.y
 
-    def cross(self, o: "Vec") -> Expr:
-        """a × b = a_x b_y − a_y b_x."""
-        return self.x * o.y - self.y * o.x
-
     def aligned(self, angle: int, alpha: float) -> Expr:
         """v × e(z_angle + α) = v_x sin(z_angle + α) − v_y cos(z_angle + α): zero when the
         angle coordinate plus α is the direction of v (or its opposite, π away)."""
