@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import SolverError
+from .batched import lu_factor, lu_solve
 
 #: from this many coordinates on, a chunk of steps is solved as one sparse block-diagonal
 #: system (cost linear in the mechanism's size) instead of dense batched solves
@@ -32,6 +33,17 @@ COARSE = 100
 COARSE_MISS = 2e-2
 #: bytes of Jacobians kept at once (the steps are solved in chunks)
 CHUNK_BYTES = 64 * 2**20
+#: a row's magnitude (what its residual is measured against) is at least this fraction of
+#: its terms with the coordinates at their scales: a coordinate whose answer is 0 otherwise
+#: leaves a round-off residual as large as the row's terms, and no residual is ever small
+MAGNITUDE_FLOOR = 1e-6
+#: steps solved together by ``_bulk``: small enough for their arrays to stay in the cache
+BLOCK = 8192
+#: below this many steps, the dense solves are numpy's (LAPACK per step) rather than ``batched``
+BATCHED_FROM = 64
+#: rows are exchanged in the batched solves where a pivot is below this fraction of the
+#: largest in its column (``batched.lu_factor``)
+PIVOT_THRESHOLD = 0.5
 #: a step that failed is cut into at most this many sub-steps
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
@@ -66,6 +78,9 @@ class Solver:
         self.terms, self.w, self.settings = terms, weights, settings
         self.least_squares = least_squares or terms.m != terms.nz
         self.iterations = 0
+        self.floor = MAGNITUDE_FLOOR * terms.magnitude_at(1.0 / weights)[:, None]
+        #: the equations in the order of the pivots at the run's start (``pivot_order``)
+        self.order = np.arange(terms.m)
 
     def rows_per_chunk(self) -> int:
         """Steps solved at once: the Jacobians, their terms and the solves' copies of a
@@ -93,12 +108,24 @@ class Solver:
                 x = self._sparse(data, b)
                 if x is not None:
                     return x
+            elif n >= BATCHED_FROM:
+                A = terms.dense_cols(data.T)[self.order]
+                swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
+                x = lu_solve(A, swaps, b.T[self.order]).T
+                if not regular.all():              # singular: NaN (``_least_squares``)
+                    x[~regular] = self._least_squares(data[~regular], b[~regular])
+                return x
             else:
                 try:
                     return np.linalg.solve(terms.dense(data), b[..., None])[..., 0]
                 except np.linalg.LinAlgError:
                     pass
-        U, s, Vt = np.linalg.svd(terms.dense(data), full_matrices=False)
+        return self._least_squares(data, b)
+
+    def _least_squares(self, data, b):
+        """The minimum-norm least-squares x of Φ_z x = b per step (SVD); NaN where a square
+        system is singular."""
+        U, s, Vt = np.linalg.svd(self.terms.dense(data), full_matrices=False)
         keep = s > 1e-12 * s[:, :1]
         with np.errstate(divide="ignore", invalid="ignore"):
             coef = np.where(keep, np.einsum("nmk,nm->nk", U, b) / s, 0.0)
@@ -119,6 +146,20 @@ class Solver:
             return splu(A).solve(np.ascontiguousarray(b).ravel()).reshape(n, nz)
         except RuntimeError:
             return None
+
+    def pivot_order(self, t0: float, z0: np.ndarray):
+        """Order the equations as partial pivoting would at (t0, z0), so that the batched
+        solves (``batched.lu_factor`` with PIVOT_THRESHOLD) rarely exchange rows; the order
+        depends on the run's start only (not on how the steps are chunked)."""
+        if self.least_squares or not self.terms.m:
+            return
+        A = self.terms.dense_cols(self.terms.jacobian_cols(z0[:, None]))
+        swaps, regular = lu_factor(A)
+        if regular.all():
+            order = np.arange(self.terms.m)
+            for k, p in enumerate(swaps[:, 0]):
+                order[[k, p]] = order[[p, k]]
+            self.order = order
 
     def run_rates(self, t, z):
         """(ż, z̈) at the steps of the last ``run`` (z its answer, solved rows only): those
@@ -165,19 +206,21 @@ class Solver:
                 ask = ~small | self.least_squares
                 size = np.zeros_like(phi)
                 if ask.any():
-                    magnitude = terms.magnitude(ta[ask], za[ask])
+                    magnitude = np.maximum(terms.magnitude(ta[ask], za[ask]), self.floor.T)
                     size[ask] = np.divide(np.abs(phi[ask]), magnitude,
                                           out=np.abs(phi[ask]) * np.inf, where=magnitude > 0)
                     size[phi == 0] = 0.0
             self.iterations += len(active)
             finite = np.isfinite(step)
-            z[active[finite]] = za[finite] + dz[finite]
             if self.least_squares:        # a least-squares step also stops where Φ ≠ 0
                 small &= np.all(size <= max(64 * eps, 100 * tol), axis=1)
             # at round-off, steps stop shrinking (at a singular position Φ is quadratic in
-            # the error, and a step that still halves is still worth taking)
+            # the error, and a step that still halves is still worth taking); such a step
+            # is round-off amplified by a nearly singular Φ_z, and is not taken
             floor = np.all(size <= 64 * eps, axis=1)
             stalled = floor & (step > 0.7 * last[active])
+            take = finite & ~stalled
+            z[active[take]] = za[take] + dz[take]
             last[active] = step
             done = finite & (small | stalled)
             ok[active[done]] = True
@@ -238,6 +281,7 @@ class Solver:
         #: rates found with the positions (``_bulk``) at the steps marked in own_rates
         self.zd, self.zdd = np.empty_like(z), np.empty_like(z)
         self.own_rates = np.zeros(n, dtype=bool)
+        self.pivot_order(t[0], z0)
         stride = max(1, n // COARSE)
         if stride < 4:
             return self._sequential(t, z, 0, n)
@@ -311,32 +355,44 @@ class Solver:
         """(z, ok, ż, z̈) for many steps of a small square system from good guesses: each
         Newton solve also solves Φ_z ż = g' (two right-hand sides, one factorisation), and
         the last one's Jacobian (at z within the tolerance) gives z̈; None where that does
-        not apply (large, redundant or singular systems)."""
-        terms, tol = self.terms, self.settings.tolerance
-        if self.least_squares or terms.nz >= SPARSE_FROM or not len(t):
+        not apply (large, redundant or singular systems). In blocks of BLOCK steps, one
+        column per step (``batched``)."""
+        if self.least_squares or self.terms.nz >= SPARSE_FROM or not len(t):
             return None
+        out = np.empty((3, self.terms.nz, len(t)))
+        ok = np.empty(len(t), dtype=bool)
+        for a in range(0, len(t), BLOCK):
+            s = slice(a, a + BLOCK)
+            found = self._bulk_block(t[s], z[s].T, iterations)
+            if found is None:
+                return None
+            out[:, :, s], ok[s] = found
+        return out[0].T, ok, out[1].T, out[2].T
+
+    def _bulk_block(self, t, z, iterations):
+        """((z, ż, z̈) (3, nz, n), ok) of ``_bulk`` for one block, z (nz, n)."""
+        terms, tol = self.terms, self.settings.tolerance
         z = np.array(z, dtype=float)
-        rhs = np.empty((len(t), terms.m, 2))
-        rhs[:, :, 1] = terms.velocity_rhs(t)
+        rhs = np.empty((terms.m, 2, len(t)))
+        rhs[:, 1] = terms.velocity_rhs_cols(t)[self.order]
+        w = self.w[:, None]
+        order = self.order
         with np.errstate(all="ignore"):
             for _ in range(iterations):
-                J = terms.dense(terms.jacobian(z))
-                rhs[:, :, 0] = -terms.residual(t, z)
-                try:
-                    x = np.linalg.solve(J, rhs)
-                except np.linalg.LinAlgError:
+                A = terms.dense_cols(terms.jacobian_cols(z))[order]
+                rhs[:, 0] = -terms.residual_cols(t, z)[order]
+                swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
+                if not regular.all():
                     return None
+                x = lu_solve(A, swaps, rhs)
                 self.iterations += len(t)
-                z += x[:, :, 0]
-                step = np.max(np.abs(x[:, :, 0]) * self.w, axis=1, initial=0.0)
+                z += x[:, 0]
+                step = np.max(np.abs(x[:, 0]) * w, axis=0, initial=0.0)
                 if np.all(step <= tol):
                     break
-            zd = x[:, :, 1]
-            try:
-                zdd = np.linalg.solve(J, terms.gamma(t, z, zd)[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                return None
-        return z, step <= tol, zd, zdd
+            zd = x[:, 1]
+            zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
+        return np.stack([z, zd, zdd]), step <= tol
 
     def _sequential(self, t, z, k: int, end: int):
         """(z, solved): steps k+1 … end−1 one after the other from the solved step k,

@@ -18,25 +18,12 @@ from scipy import sparse
 from ...laws import Law
 from .forms import ONE
 
-#: sums over terms use a dense matrix up to this many (terms × rows) entries
-DENSE_SUM = 20_000
-
-
-def _summer(index: np.ndarray, size: int):
-    """S (len(index), size) with S[k, index[k]] = 1: values @ S sums values per index."""
-    if len(index) * size <= DENSE_SUM:
-        S = np.zeros((len(index), size))
-        np.add.at(S, (np.arange(len(index)), index), 1.0)
-        return S
-    return sparse.csr_matrix((np.ones(len(index)), (np.arange(len(index)), index)),
-                             shape=(len(index), size))
-
-
-def _sum(values: np.ndarray, S) -> np.ndarray:
-    """values (n, k) @ S (k, size), S dense or sparse."""
-    if isinstance(S, np.ndarray):
-        return values @ S
-    return np.asarray((S.T @ values.T).T)
+def _summer(index: np.ndarray, size: int) -> sparse.csr_matrix:
+    """S (size, len(index)) with S[index[k], k] = 1: S @ values (k, n) sums the values per
+    index, term after term (sparse: the same sum in the same order whatever n, so that a
+    run's results do not depend on how its steps are chunked)."""
+    return sparse.csr_matrix((np.ones(len(index)), (index, np.arange(len(index)))),
+                             shape=(size, len(index)))
 
 
 class Terms:
@@ -89,13 +76,21 @@ class Terms:
         self.rows, self.cols = pattern // max(nz, 1), pattern % max(nz, 1)
         self.entry_sum = _summer(where, len(pattern))
 
-    # ---- evaluation -----------------------------------------------------------------------
+    # ---- evaluation: one column per step --------------------------------------------------
+    # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
+    # step, so that every term is a contiguous row and the sums over terms are one product
+    # with a small matrix. The methods without the suffix take and return one row per step.
     def _ext(self, z: np.ndarray) -> np.ndarray:
-        """[z, 1] (n, nz + 1)."""
-        out = np.empty((z.shape[0], self.nz + 1))
-        out[:, :self.nz] = z
-        out[:, self.nz] = 1.0
+        """[z; 1] (nz + 1, n)."""
+        out = np.empty((self.nz + 1, z.shape[1]))
+        out[:self.nz] = z
+        out[self.nz] = 1.0
         return out
+
+    @staticmethod
+    def _sum(values: np.ndarray, S) -> np.ndarray:
+        """S values: the terms' values (k, n) summed per row or entry (``_summer``)."""
+        return np.asarray(S @ values)
 
     def _targets(self, t: np.ndarray, order: int) -> list:
         """[(row, g^(order)(t))] of the rows with a law: g = f or f²."""
@@ -109,64 +104,97 @@ class Terms:
             out.append((r, g))
         return out
 
-    def residual(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """Φ(z, t) (n, m)."""
+    def residual_cols(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """Φ(z, t) (m, n)."""
         x = self._ext(z)
-        values = np.concatenate([self.pc * x[:, self.pa] * x[:, self.pb],
-                                 self.sc * x[:, self.sa] * np.sin(x[:, self.sb] + self.salpha)],
-                                axis=1)
-        out = _sum(values, self.row_sum)
+        values = np.concatenate([self.pc[:, None] * x[self.pa] * x[self.pb],
+                                 self.sc[:, None] * x[self.sa]
+                                 * np.sin(x[self.sb] + self.salpha[:, None])])
+        out = self._sum(values, self.row_sum)
         for r, g in self._targets(t, 0):
-            out[:, r] -= g
+            out[r] -= g
         return out
 
-    def magnitude(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """Σ |terms| per row (n, m): the size round-off errors of Φ scale with."""
+    def magnitude_cols(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """Σ |terms| per row (m, n): the size round-off errors of Φ scale with."""
         x = np.abs(self._ext(z))
-        values = np.concatenate([np.abs(self.pc) * x[:, self.pa] * x[:, self.pb],
-                                 np.abs(self.sc) * x[:, self.sa]], axis=1)
-        out = _sum(values, self.row_sum)
+        values = np.concatenate([np.abs(self.pc)[:, None] * x[self.pa] * x[self.pb],
+                                 np.abs(self.sc)[:, None] * x[self.sa]])
+        out = self._sum(values, self.row_sum)
         for r, g in self._targets(t, 0):
-            out[:, r] += np.abs(g)
+            out[r] += np.abs(g)
         return out
+
+    def magnitude_at(self, scales: np.ndarray) -> np.ndarray:
+        """Σ |terms| per row (m,) with every coordinate at its scale (nz,)."""
+        x = np.r_[scales, 1.0][:, None]
+        values = np.concatenate([np.abs(self.pc)[:, None] * x[self.pa] * x[self.pb],
+                                 np.abs(self.sc)[:, None] * x[self.sa]])
+        return self._sum(values, self.row_sum)[:, 0]
+
+    def jacobian_cols(self, z: np.ndarray) -> np.ndarray:
+        """Φ_z as data (nnz, n) on the pattern (``rows``, ``cols``)."""
+        x = self._ext(z)
+        arg = x[self.sb] + self.salpha[:, None]
+        pc, sc = self.pc[:, None], self.sc[:, None]
+        parts = {"p_b": pc * x[self.pb], "p_a": pc * x[self.pa],
+                 "s_sin": sc * np.sin(arg), "s_cos": sc * x[self.sa] * np.cos(arg)}
+        values = np.concatenate([parts[kind][keep] for kind, keep in self._entry_kinds])
+        return self._sum(values, self.entry_sum)
+
+    def dense_cols(self, data: np.ndarray) -> np.ndarray:
+        """Φ_z (m, nz, n) from its data (nnz, n)."""
+        J = np.zeros((self.m, self.nz, data.shape[1]))
+        J[self.rows, self.cols] = data
+        return J
+
+    def velocity_rhs_cols(self, t: np.ndarray) -> np.ndarray:
+        """g'(t) (m, n): Φ_z ż = g' (−Φ_t)."""
+        out = np.zeros((self.m, len(t)))
+        for r, g in self._targets(t, 1):
+            out[r] = g
+        return out
+
+    def gamma_cols(self, t: np.ndarray, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
+        """γ (m, n): Φ_z z̈ = γ = g'' − (d/dt Φ_z) ż."""
+        x, v = self._ext(z), np.zeros((self.nz + 1, z.shape[1]))
+        v[:self.nz] = zd
+        arg = x[self.sb] + self.salpha[:, None]
+        wb = v[self.sb]
+        values = np.concatenate([
+            2.0 * self.pc[:, None] * v[self.pa] * v[self.pb],
+            self.sc[:, None] * wb * (2.0 * v[self.sa] * np.cos(arg) - x[self.sa] * wb * np.sin(arg))])
+        out = -self._sum(values, self.row_sum)
+        for r, g in self._targets(t, 2):
+            out[r] += g
+        return out
+
+    # ---- evaluation: one row per step -------------------------------------------------------
+    def residual(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """Φ(z, t) (n, m)."""
+        return self.residual_cols(t, z.T).T
+
+    def magnitude(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """Σ |terms| per row (n, m)."""
+        return self.magnitude_cols(t, z.T).T
 
     def jacobian(self, z: np.ndarray) -> np.ndarray:
         """Φ_z as data (n, nnz) on the pattern (``rows``, ``cols``)."""
-        x = self._ext(z)
-        arg = x[:, self.sb] + self.salpha
-        parts = {"p_b": self.pc * x[:, self.pb], "p_a": self.pc * x[:, self.pa],
-                 "s_sin": self.sc * np.sin(arg), "s_cos": self.sc * x[:, self.sa] * np.cos(arg)}
-        values = np.concatenate([parts[kind][:, keep] for kind, keep in self._entry_kinds],
-                                axis=1)
-        return _sum(values, self.entry_sum)
+        return self.jacobian_cols(z.T).T
 
     def dense(self, data: np.ndarray) -> np.ndarray:
-        """Φ_z (n, m, nz) from its data."""
+        """Φ_z (n, m, nz) from its data (n, nnz)."""
         J = np.zeros((data.shape[0], self.m, self.nz))
         J[:, self.rows, self.cols] = data
         return J
 
     def velocity_rhs(self, t: np.ndarray) -> np.ndarray:
-        """g'(t) (n, m): Φ_z ż = g' (−Φ_t)."""
-        out = np.zeros((len(t), self.m))
-        for r, g in self._targets(t, 1):
-            out[:, r] = g
-        return out
+        """g'(t) (n, m)."""
+        return self.velocity_rhs_cols(t).T
 
     def gamma(self, t: np.ndarray, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
-        """γ (n, m): Φ_z z̈ = γ = g'' − (d/dt Φ_z) ż."""
-        x, v = self._ext(z), np.zeros((z.shape[0], self.nz + 1))
-        v[:, :self.nz] = zd
-        arg = x[:, self.sb] + self.salpha
-        wb = v[:, self.sb]
-        values = np.concatenate([
-            2.0 * self.pc * v[:, self.pa] * v[:, self.pb],
-            self.sc * wb * (2.0 * v[:, self.sa] * np.cos(arg) - x[:, self.sa] * wb * np.sin(arg))],
-            axis=1)
-        out = -_sum(values, self.row_sum)
-        for r, g in self._targets(t, 2):
-            out[:, r] += g
-        return out
+        """γ (n, m): Φ_z z̈ = γ."""
+        return self.gamma_cols(t, z.T, zd.T).T
 
     def hessian(self, z: np.ndarray, mu: np.ndarray) -> np.ndarray:
         """Σ_r μ_r ∂²Φ_r/∂z² (nz, nz) at one configuration z (nz,)."""
