@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import SolverError
-from .batched import lu_factor, lu_solve
+from ...batched import lu_factor, lu_solve
 
 #: from this many coordinates on, a chunk of steps is solved as one sparse block-diagonal
 #: system (cost linear in the mechanism's size) instead of dense batched solves

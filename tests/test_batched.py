@@ -6,7 +6,7 @@ systems; the backward error |A x − b| / (|A| |x|) of both is at round-off.
 import numpy as np
 import pytest
 
-from pam2exu.backend.natural.batched import lu_factor, lu_solve
+from pam2exu.batched import lu_factor, lu_solve
 
 
 def _systems(m, n, seed=0):
