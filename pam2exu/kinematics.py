@@ -41,7 +41,11 @@ def column(solid: int, k: int) -> int:
 
 def rotate(fi, v):
     """A(fi) v = (vx cos fi − vy sin fi, vx sin fi + vy cos fi), for arrays fi (n,) and v (2,)."""
-    c, s = np.cos(fi), np.sin(fi)
+    return _rotate(np.cos(fi), np.sin(fi), v)
+
+
+def _rotate(c, s, v):
+    """A v with A = [[c, −s], [s, c]]: ``rotate`` with cos fi and sin fi given."""
     return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1]], axis=-1)
 
 
@@ -66,7 +70,11 @@ class Quantity:
 
     def __sub__(self, other: "Quantity") -> "Quantity":
         """v = a − b."""
-        return self + other * -1.0
+        jac = dict(self.jac)
+        for solid, block in other.jac.items():
+            jac[solid] = jac[solid] - block if solid in jac else -block
+        return Quantity(self.value - other.value, jac, _sub(self.rate, other.rate),
+                        _sub(self.conv, other.conv))
 
     def __add__(self, other: "Quantity") -> "Quantity":
         """v = a + b."""
@@ -118,6 +126,10 @@ def _add(a, b):
     return None if a is None else a + b
 
 
+def _sub(a, b):
+    return None if a is None else a - b
+
+
 def stack(*quantities: Quantity) -> Quantity:
     """The rows of several quantities, one after the other."""
     n = quantities[0].value.shape[0]
@@ -136,35 +148,63 @@ def stack(*quantities: Quantity) -> Quantity:
 
 
 class State:
-    """Coordinates q (n, 3·solids) at times t (n,), and optionally velocities qd."""
+    """Coordinates q (n, 3·solids) at times t (n,), and optionally velocities qd.
 
-    def __init__(self, t, q, qd=None):
+    ``jacobians=False``: the quantities built from it carry no dv/dq (``Quantity.jac`` is
+    empty), for passes that need only values, rates and conv (residuals, γ).
+    """
+
+    def __init__(self, t, q, qd=None, jacobians: bool = True):
         self.t = np.atleast_1d(np.asarray(t, dtype=float))
         self.q = np.atleast_2d(np.asarray(q, dtype=float))
         self.qd = None if qd is None else np.atleast_2d(np.asarray(qd, dtype=float))
         self.n = self.q.shape[0]
+        self.jacobians = jacobians
+        # what is evaluated once per State: (cos fi, sin fi) per solid, points and directions
+        self._trig: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._rotated_memo: dict[tuple, Quantity] = {}
 
     def coordinate(self, solid: int, k: int) -> Quantity:
         """v = q[column(solid, k)]: x (k=0), y (k=1) or fi (k=2) of a solid."""
         col = column(solid, k)
-        block = np.zeros((self.n, 1, 3))
-        block[:, 0, k] = 1.0
+        jac = {}
+        if self.jacobians:
+            jac[solid] = np.zeros((self.n, 1, 3))
+            jac[solid][:, 0, k] = 1.0
         rate = conv = None
         if self.qd is not None:
             rate, conv = self.qd[:, col:col + 1], np.zeros((self.n, 1))
-        return Quantity(self.q[:, col:col + 1], {solid: block}, rate, conv)
+        return Quantity(self.q[:, col:col + 1], jac, rate, conv)
 
     def angle(self, solid: int) -> Quantity:
         """v = fi of a solid."""
         return self.coordinate(solid, 2)
 
+    def trig(self, solid: int) -> tuple[np.ndarray, np.ndarray]:
+        """(cos fi, sin fi) of a solid at every state, evaluated once per State."""
+        if solid not in self._trig:
+            fi = self.q[:, column(solid, 2)]
+            self._trig[solid] = np.cos(fi), np.sin(fi)
+        return self._trig[solid]
+
     def _rotated(self, solid: int, local, translate: bool) -> Quantity:
+        """A point (``translate``) or a direction of a solid, built once per State (the
+        Quantity is shared: never changed in place)."""
+        local = np.asarray(local, dtype=float)
+        key = (solid, local.tobytes(), translate)
+        if key not in self._rotated_memo:
+            self._rotated_memo[key] = self._build_rotated(solid, local, translate)
+        return self._rotated_memo[key]
+
+    def _build_rotated(self, solid: int, local: np.ndarray, translate: bool) -> Quantity:
         x, y, fi = (column(solid, k) for k in range(PER_SOLID))
-        As = rotate(self.q[:, fi], np.asarray(local, dtype=float))
-        block = np.zeros((self.n, 2, 3))
-        if translate:
-            block[:, 0, 0] = block[:, 1, 1] = 1.0
-        block[:, :, 2] = perp(As)
+        As = _rotate(*self.trig(solid), local)
+        jac = {}
+        if self.jacobians:
+            block = jac[solid] = np.zeros((self.n, 2, 3))
+            if translate:
+                block[:, 0, 0] = block[:, 1, 1] = 1.0
+            block[:, :, 2] = perp(As)
         value = As + self.q[:, x:y + 1] if translate else As
         rate = conv = None
         if self.qd is not None:
@@ -173,7 +213,7 @@ class State:
             if translate:
                 rate = rate + self.qd[:, x:y + 1]
             conv = -(w * w) * As
-        return Quantity(value, {solid: block}, rate, conv)
+        return Quantity(value, jac, rate, conv)
 
     def point(self, solid: int, local) -> Quantity:
         """v = R + A(fi) s: global position of the point s of a solid."""

@@ -170,11 +170,11 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
                 if var in names:
                     values[f"{el.name}.{var}"] = v
     values.update(extra)
-    for k, v in values.items():          # no negative zeros in tables; in place: no copies
-        if v.flags.writeable and v.dtype == float:
-            np.add(v, 0.0, out=v)
-        else:
-            values[k] = v + 0.0
-    check_finite(job, t, values)
-    return Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
-                   mech.name, job.warnings, job.info)
+    res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
+                  mech.name, job.warnings, job.info)
+    table = res.to_numpy()[:, 1:]        # a view of the table's storage: no copies
+    np.add(table, 0.0, out=table)        # no negative zeros in tables
+    if not (np.isfinite(table).all()
+            and all(np.isfinite(v).all() for k, v in values.items() if k not in wanted)):
+        check_finite(job, t, values)
+    return res

@@ -25,16 +25,22 @@ CHUNK_BYTES = 64 * 2**20
 SPARSE_FROM = 40
 #: unknowns per sparse chunk
 SPARSE_CHUNK = 200_000
+#: steps per chunk of the residuals and the continuity defect: their arrays then stay in
+#: the cache
+RESIDUAL_CHUNK = 8192
 
 
 @dataclass
 class Equations:
-    """C (n, m), Cq (n, m, nq), C_t (n, m) and γ (n, m; None without velocities)."""
+    """C (n, m), Cq (n, m, nq), C_t (n, m), γ (n, m; None without velocities) and the
+    constraint quantity v of each element (``mech.constraints`` order; the reactions read
+    their dv/dq blocks)."""
 
     residual: np.ndarray
     jacobian: np.ndarray
     c_t: np.ndarray
     gamma: np.ndarray | None
+    parts: list
 
 
 def _target(target, t, m):
@@ -52,8 +58,10 @@ def equations(mech, st: State, jacobian: bool = True) -> Equations:
     residual, c_t = np.zeros((n, m)), np.zeros((n, m))
     jac = np.zeros((n, m, mech.nq)) if jacobian else None
     gamma = np.zeros((n, m)) if st.qd is not None else None
+    parts = []
     for el, rows in zip(mech.constraints, mech.rows):
         v, target = el.constraint(st)
+        parts.append(v)
         f, df, ddf = _target(target, st.t, el.equations)
         residual[:, rows] = v.value - f
         c_t[:, rows] = -np.broadcast_to(df, (n, el.equations))
@@ -61,16 +69,17 @@ def equations(mech, st: State, jacobian: bool = True) -> Equations:
             v.rows(jac, rows.start)
         if gamma is not None:
             gamma[:, rows] = ddf - v.conv
-    return Equations(residual, jac, c_t, gamma)
+    return Equations(residual, jac, c_t, gamma, parts)
 
 
-def chunks(mech, n: int, sparse: bool = False):
+def chunks(mech, n: int, sparse: bool = False, most: int | None = None):
     """Slices of the n steps, each small enough that its Jacobian fits in CHUNK_BYTES
-    (sparse: SPARSE_CHUNK unknowns)."""
+    (sparse: SPARSE_CHUNK unknowns), and of at most ``most`` steps."""
     if sparse:
         size = max(1, SPARSE_CHUNK // max(1, mech.nq))
     else:
         size = max(1, CHUNK_BYTES // (8 * max(1, mech.n_equations) * mech.nq))
+    size = min(size, most or size)
     return (slice(a, min(n, a + size)) for a in range(0, n, size))
 
 
@@ -108,8 +117,8 @@ def residuals(mech, t, q) -> np.ndarray:
     """Constraint residual C(q, t), (n, m)."""
     t, q = np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(q)
     out = np.empty((len(t), mech.n_equations))
-    for s in chunks(mech, len(t)):
-        out[s] = equations(mech, State(t[s], q[s]), jacobian=False).residual
+    for s in chunks(mech, len(t), most=RESIDUAL_CHUNK):
+        out[s] = equations(mech, State(t[s], q[s], jacobians=False), jacobian=False).residual
     return out
 
 
@@ -150,9 +159,13 @@ def turns_jumped(t, q, qd, solids: int) -> np.ndarray:
     fi, w = q[:, ANGLES][:, :solids], qd[:, ANGLES][:, :solids]
     valid = np.isfinite(w).all(axis=1)
     valid[0] = True
-    last = np.maximum.accumulate(np.where(valid, np.arange(len(t)), 0))
-    j, k = last[:-1], np.arange(1, len(t))
-    wk = np.where(valid[k, None], w[k], w[j])
+    if valid.all():                  # j = k − 1 at every step: slices, not gathers
+        j, k = slice(None, -1), slice(1, None)
+        wk = w[k]
+    else:
+        last = np.maximum.accumulate(np.where(valid, np.arange(len(t)), 0))
+        j, k = last[:-1], np.arange(1, len(t))
+        wk = np.where(valid[k, None], w[k], w[j])
     n = np.zeros(fi.shape)
     with np.errstate(invalid="ignore"):
         n[1:] = np.rint((fi[k] - fi[j] - (t[k] - t[j])[:, None] * (wk + w[j]) / 2)
@@ -200,9 +213,12 @@ def continuity_defect(t, qd, qdd, scale, breakpoints=()) -> np.ndarray:
     """
     dt = np.diff(t)[:, None]
     d = np.zeros(len(t))
-    jump = qd[1:] - qd[:-1] - dt * (qdd[1:] + qdd[:-1]) / 2
-    with np.errstate(invalid="ignore"):
-        d[1:] = np.max(np.abs(jump) / scale, axis=1)
+    for a in range(1, len(t), RESIDUAL_CHUNK):      # in blocks that stay in the cache
+        k = slice(a, min(len(t), a + RESIDUAL_CHUNK))
+        j = slice(a - 1, k.stop - 1)
+        jump = qd[k] - qd[j] - dt[j] * (qdd[k] + qdd[j]) / 2
+        with np.errstate(invalid="ignore"):
+            d[k] = np.max(np.abs(jump) / scale, axis=1)
     d[np.isnan(d)] = np.inf
     for b in breakpoints:
         d[1:][(t[:-1] < b) & (b <= t[1:])] = 0.0
@@ -216,7 +232,7 @@ def rates(mech, t, q, accelerations: bool, redundant: bool):
     qd = np.zeros_like(q)
     qdd = np.zeros_like(q) if accelerations else None
     residual = np.empty((n, mech.n_equations))
-    rows, cols = _moving(mech)
+    rows, cols = moving(mech)
     sparse = not redundant and mech.n_equations >= SPARSE_FROM
     parts = list(chunks(mech, n, sparse=sparse))
     # a bar on a terminal when the pass takes several chunks (one chunk: over in a blink)
@@ -242,7 +258,7 @@ def _sparse_rates(mech, t, q, qd, qdd, residual, rows, cols) -> bool:
         return False
     qd[:, cols] = lu.solve(np.ascontiguousarray(-eq.c_t[:, rows]).ravel()).reshape(n, -1)
     if qdd is not None:
-        gamma = equations(mech, State(t, q, qd), jacobian=False).gamma
+        gamma = equations(mech, State(t, q, qd, jacobians=False), jacobian=False).gamma
         qdd[:, cols] = lu.solve(np.ascontiguousarray(gamma[:, rows]).ravel()).reshape(n, -1)
     return True
 
@@ -254,11 +270,11 @@ def _dense_rates(mech, t, q, qd, qdd, residual, rows, cols, redundant) -> None:
     J = eq.jacobian[:, rows[:, None], cols]
     qd[:, cols] = _solve(J, -eq.c_t[:, rows], redundant)
     if qdd is not None:
-        gamma = equations(mech, State(t, q, qd), jacobian=False).gamma
+        gamma = equations(mech, State(t, q, qd, jacobians=False), jacobian=False).gamma
         qdd[:, cols] = _solve(J, gamma[:, rows], redundant)
 
 
-def _moving(mech):
+def moving(mech):
     """(rows, columns) of Cq left once fixed links and the solids they hold are removed:
     those solids do not move (q̇ = q̈ = 0), so the rate solves are smaller."""
     held = {el.ref1.solid for el in mech.constraints if el.grounds}
@@ -455,7 +471,8 @@ def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, 
 
     def fun(q):
         with np.errstate(all="ignore"):
-            f = weight * equations(mech, State([t], q[None]), jacobian=False).residual[0]
+            st = State([t], q[None], jacobians=False)
+            f = weight * equations(mech, st, jacobian=False).residual[0]
         size = float(np.dot(f, f))
         if size < best[0]:
             best[:] = size, q.copy(), f
