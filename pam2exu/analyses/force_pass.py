@@ -190,13 +190,35 @@ def multipliers(mech, st: State, rhs: np.ndarray, redundant: bool,
             return lam
     if eq is None or eq.jacobian is None:
         eq = native.equations(mech, st)
-    A = np.swapaxes(eq.jacobian, 1, 2)                                  # Cqᵀ, (n, nq, m)
     if not redundant:
-        return np.linalg.solve(A, rhs[..., None])[..., 0]
+        return _solve_transposed(mech, eq.jacobian, rhs)
+    A = np.swapaxes(eq.jacobian, 1, 2)                                  # Cqᵀ, (n, nq, m)
     B = _report_matrix(mech, st, eq.parts)
     AB = np.swapaxes(np.linalg.solve(np.swapaxes(B, 1, 2), np.swapaxes(A, 1, 2)), 1, 2)
     R = np.einsum("nmq,nq->nm", np.linalg.pinv(AB, rcond=rcond), rhs)
     return np.linalg.solve(B, R[..., None])[..., 0]
+
+
+def _solve_transposed(mech, J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """λ with Jᵀ λ = rhs per step, J = Cq (n, m, nq) square, the fixed links solved apart.
+
+    A fixed link's rows of Cq are the identity on its solid's columns H and zero elsewhere,
+    so Cqᵀ is block-triangular: Cq[r, M]ᵀ λ_r = rhs_M on the other rows r and the moving
+    columns M (one smaller solve), then λ_fixed = rhs_H − Cq[r, H]ᵀ λ_r.
+    """
+    rows, cols = native.moving(mech)
+    fixed = [(rr.start + k, column(el.ref1.solid, k))
+             for el, rr in zip(mech.constraints, mech.rows) if el.grounds for k in range(3)]
+    held = [h for _, h in fixed]
+    if len(rows) != len(cols) or len(set(held)) != len(held):
+        return np.linalg.solve(np.swapaxes(J, 1, 2), rhs[..., None])[..., 0]
+    lam = np.empty(rhs.shape[:1] + J.shape[1:2])
+    A = np.swapaxes(J[:, rows[:, None], cols], 1, 2)
+    lam[:, rows] = np.linalg.solve(A, rhs[:, cols, None])[..., 0] if len(rows) else 0.0
+    if fixed:
+        g, h = (np.array(x) for x in zip(*fixed))
+        lam[:, g] = rhs[:, h] - np.einsum("nrh,nr->nh", J[:, rows[:, None], h], lam[:, rows])
+    return lam
 
 
 @dataclass
