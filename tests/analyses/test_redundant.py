@@ -52,8 +52,8 @@ def test_redundant_mechanism_passes_its_change_points_on_its_branch(request, eve
     At the change point two branches cross: the equations hold to second order along both,
     so Newton's error there halves per iteration and stops at ~√ε (1e-8) once the residual
     is at round-off. Exudyn's iterates stay exact parallelograms and reach 1e-12; the
-    natural backend's (least-squares steps) do not: 4e-9 at those two steps (measured),
-    1e-8 allowed.
+    natural backend's (least-squares steps) do not: between 4e-9 and 1.5e-8 (√ε) at those
+    two steps as round-off falls (measured), 5e-8 allowed.
     """
     from pam2exu.analyses import ConditionWarning
     model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
@@ -64,7 +64,7 @@ def test_redundant_mechanism_passes_its_change_points_on_its_branch(request, eve
     th, w = np.pi / 2 + 2 * np.pi * res.t, 2 * np.pi
     at_crossing = np.full(len(th), 1e-12)
     if every_backend == "natural":
-        at_crossing[[100, 300]] = 1e-8
+        at_crossing[[100, 300]] = 5e-8
     for crank in ("crank1", "crank2", "crank3"):
         assert np.all(np.abs(res[f"{crank}.fi"] - th) <= at_crossing), crank
         np.testing.assert_allclose(res[f"{crank}.Dfi"], w, rtol=0, atol=1e-9 * w)

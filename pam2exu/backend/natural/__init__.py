@@ -12,13 +12,15 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+from scipy import sparse
 
 from ...errors import SolverError
 from ...kinematics import ANGLES, PER_SOLID, column
 from ..base import Positions
 from .formulation import Coordinate, Formulation, Frame
 from .loads import multipliers
-from .solver import MAX_SUBSTEPS, NaturalSettings, Solver, anchored
+from .anchored import anchored
+from .solver import MAX_SUBSTEPS, NaturalSettings, Solver
 
 __all__ = ["Natural", "NaturalSettings", "Formulation", "Frame", "Coordinate"]
 
@@ -121,31 +123,32 @@ class Natural:
     # ---- back to x, y, fi ---------------------------------------------------------------------
     def to_q(self, form: Formulation, mech, z: np.ndarray, start: np.ndarray) -> np.ndarray:
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
-        value in the whole turn nearest ``start`` (in chunks of steps: bounded memory)."""
-        K = form.pose_forms()
+        value in the whole turn nearest ``start`` (in chunks of steps: bounded memory; one
+        row per quantity inside, the step axis last)."""
+        K = _summing(form.pose_forms())
         kind = self._angle_kinds(form)
-        q = np.empty((len(z), mech.nq))
+        qT = np.empty((mech.nq, len(z)))             # one row per x, y, fi
         free, c = kind.free, kind.coordinate
-        raw = np.empty((len(z), free.size))
+        raw = np.empty((free.size, len(z)))
         for s in _chunks(len(z)):
-            pose = np.c_[z[s], np.ones(len(z[s]))] @ K.T      # x, y, cos, sin per solid
-            q[s, 0::PER_SOLID], q[s, 1::PER_SOLID] = pose[:, 0::4], pose[:, 1::4]
-            fi = np.empty((len(pose), len(form.frames)))
-            fi[:, kind.fixed] = kind.fixed_values
+            zT = z[s].T
+            pose = K @ _ext(zT)                             # x, y, cos, sin per solid
+            qT[0::PER_SOLID, s], qT[1::PER_SOLID, s] = pose[0::4], pose[1::4]
+            fi = qT[2::PER_SOLID, s]
+            fi[kind.fixed] = kind.fixed_values[:, None]
             # fi is the angle coordinate where the solid's vector points that way (to
             # round-off), else the vector's direction: the tie v × e(fi) = 0 also holds π
             # away, and the residual check then sees the actuator violated instead
-            theta = z[s][:, kind.columns]
-            gap = np.arctan2(pose[:, 4 * c + 3], pose[:, 4 * c + 2]) - theta
+            theta = zT[kind.columns]
+            gap = np.arctan2(pose[4 * c + 3], pose[4 * c + 2]) - theta
             gap -= 2 * np.pi * np.rint(gap / (2 * np.pi))
-            fi[:, c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
-            raw[s] = np.arctan2(pose[:, 4 * free + 3], pose[:, 4 * free + 2])
-            q[s, ANGLES] = fi
+            fi[c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
+            raw[:, s] = np.arctan2(pose[4 * free + 3], pose[4 * free + 2])
         if free.size:
-            raw = np.unwrap(raw, axis=0)
-            raw += 2 * np.pi * np.rint((start[ANGLES][free] - raw[0]) / (2 * np.pi))
-            q[:, column(free, 2)] = raw
-        return q
+            raw = np.unwrap(raw, axis=1)
+            raw += 2 * np.pi * np.rint((start[ANGLES][free] - raw[:, 0]) / (2 * np.pi))[:, None]
+            qT[column(free, 2)] = raw
+        return qT.T
 
     def _angle_kinds(self, form: Formulation):
         """Which solids' fi are constant (ground), an angle coordinate, or atan2 of the vector."""
@@ -162,31 +165,44 @@ class Natural:
 
     def to_rates(self, form: Formulation, mech, z, zd, zdd):
         """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
-        (in chunks of steps: bounded memory)."""
+        (in chunks of steps: bounded memory; one row per quantity inside)."""
         K = form.pose_forms()
+        Kz, K = _summing(K[:, :form.nz]), _summing(K)
         kind = self._angle_kinds(form)
-        qd, qdd = np.empty((len(z), mech.nq)), np.empty((len(z), mech.nq))
+        qdT, qddT = np.empty((mech.nq, len(z))), np.empty((mech.nq, len(z)))
         f, c = kind.free, kind.coordinate
         for s in _chunks(len(z)):
-            pose = np.c_[z[s], np.ones(len(z[s]))] @ K.T
-            d1, d2 = zd[s] @ K[:, :form.nz].T, zdd[s] @ K[:, :form.nz].T
-            for out, d in ((qd, d1), (qdd, d2)):
-                out[s, 0::PER_SOLID], out[s, 1::PER_SOLID] = d[:, 0::4], d[:, 1::4]
-            w, a = np.zeros((len(pose), len(form.frames))), np.zeros((len(pose), len(form.frames)))
-            w[:, c], a[:, c] = zd[s][:, kind.columns], zdd[s][:, kind.columns]
+            pose = K @ _ext(z[s].T)
+            d1, d2 = Kz @ zd[s].T, Kz @ zdd[s].T
+            for out, d in ((qdT, d1), (qddT, d2)):
+                out[0::PER_SOLID, s], out[1::PER_SOLID, s] = d[0::4], d[1::4]
+            w, a = qdT[2::PER_SOLID, s], qddT[2::PER_SOLID, s]
+            w[kind.fixed] = a[kind.fixed] = 0.0
+            w[c], a[c] = zd[s].T[kind.columns], zdd[s].T[kind.columns]
             if f.size:
-                cs, sn = pose[:, 4 * f + 2], pose[:, 4 * f + 3]
-                dc, ds = d1[:, 4 * f + 2], d1[:, 4 * f + 3]
-                ddc, dds = d2[:, 4 * f + 2], d2[:, 4 * f + 3]
+                cs, sn = pose[4 * f + 2], pose[4 * f + 3]
+                dc, ds = d1[4 * f + 2], d1[4 * f + 3]
+                ddc, dds = d2[4 * f + 2], d2[4 * f + 3]
                 r2 = cs * cs + sn * sn
-                w[:, f] = (cs * ds - sn * dc) / r2
-                a[:, f] = (cs * dds - sn * ddc) / r2 - 2 * (cs * dc + sn * ds) * w[:, f] / r2
-            qd[s, ANGLES], qdd[s, ANGLES] = w, a
-        return qd, qdd
+                w[f] = (cs * ds - sn * dc) / r2
+                a[f] = (cs * dds - sn * ddc) / r2 - 2 * (cs * dc + sn * ds) * w[f] / r2
+        return qdT.T, qddT.T
 
 
 #: steps converted to x, y, fi at a time
 CONVERT_ROWS = 1 << 16
+
+
+def _ext(zT: np.ndarray) -> np.ndarray:
+    """[z; 1] (nz + 1, n)."""
+    return np.vstack([zT, np.ones((1, zT.shape[1]))])
+
+
+def _summing(K: np.ndarray) -> sparse.csr_matrix:
+    """K as a sparse matrix: K @ z sums the same terms in the same order whatever the number
+    of columns (a dense product's order depends on it, and chunked runs would differ in the
+    last bit)."""
+    return sparse.csr_matrix(K)
 
 
 def _chunks(n: int):

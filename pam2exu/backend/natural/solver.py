@@ -1,15 +1,20 @@
 """Newton's method on the natural-coordinate equations, for all time steps at once.
 
-A run is solved in two passes (vectorised over steps, sequential only where it must be):
+A run is solved in three passes (vectorised over steps, sequential only where it must be):
 
-1. a coarse sequential pass: every ``stride``-th step from the previous one, Newton started
-   from the Taylor predictor z + h ż + h²/2 z̈ (velocities and accelerations there are two
-   linear solves); an interval whose predictor misses by more than ``COARSE_MISS`` (a fast
-   or nearly singular motion) is solved step by step instead;
-2. every step in between at once: Newton started from the cubic Hermite interpolation of
+1. a coarse sequential pass: every ``stride``-th step from the previous one (COARSE / LEVEL
+   intervals), Newton started from the Taylor predictor z + h ż + h²/2 z̈ (velocities and
+   accelerations there are two linear solves); an interval whose predictor misses by more
+   than ``COARSE_MISS`` (a fast or nearly singular motion) is cut shorter, down to step by
+   step;
+2. the steps every LEVEL times closer (COARSE intervals) inside those intervals, at once,
+   from cubic Hermite guesses (below), with their rates;
+3. every step in between at once: Newton started from the cubic Hermite interpolation of
    z and ż at the ends of its interval (error O(h⁴)), Jacobians and solves batched over the
-   steps. A step that does not converge, or converges far from its guess (another branch),
-   has its interval solved step by step.
+   steps (``batched``: blocks of BLOCK steps, the equations ordered as the pivots at the
+   start of their interval, so that rows are seldom exchanged). A step that does not
+   converge, or converges far from its guess (another branch), has its interval solved
+   one level down: by pass 1 at pass 2's stride, step by step in pass 3.
 
 A step that Newton cannot solve from the previous one is cut into 2, 4, … 64 sub-steps
 before the run stops there.
@@ -20,14 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import SolverError
 from ...batched import lu_factor, lu_solve
 
 #: from this many coordinates on, a chunk of steps is solved as one sparse block-diagonal
 #: system (cost linear in the mechanism's size) instead of dense batched solves
 SPARSE_FROM = 40
-#: intervals of the coarse pass (fewer when the run is short)
+#: intervals of the second pass (fewer when the run is short); the sequential first pass
+#: takes LEVEL times fewer, and the points in between are solved at once
 COARSE = 100
+LEVEL = 10
 #: the coarse predictor may miss by this much (relative: lengths / L, angles in rad)
 #: before its interval is solved step by step
 COARSE_MISS = 2e-2
@@ -147,19 +153,21 @@ class Solver:
         except RuntimeError:
             return None
 
-    def pivot_order(self, t0: float, z0: np.ndarray):
-        """Order the equations as partial pivoting would at (t0, z0), so that the batched
-        solves (``batched.lu_factor`` with PIVOT_THRESHOLD) rarely exchange rows; the order
-        depends on the run's start only (not on how the steps are chunked)."""
-        if self.least_squares or not self.terms.m:
-            return
-        A = self.terms.dense_cols(self.terms.jacobian_cols(z0[:, None]))
+    def pivot_orders(self, z: np.ndarray) -> np.ndarray:
+        """The equations' order (N, m) that partial pivoting gives at each configuration z
+        (N, nz), so that the batched solves near it (``batched.lu_factor`` with
+        PIVOT_THRESHOLD) rarely exchange rows (which is what costs); ``self.order`` where
+        Φ_z is singular."""
+        m, N = self.terms.m, len(z)
+        A = self.terms.dense_cols(self.terms.jacobian_cols(z.T))
         swaps, regular = lu_factor(A)
-        if regular.all():
-            order = np.arange(self.terms.m)
-            for k, p in enumerate(swaps[:, 0]):
-                order[[k, p]] = order[[p, k]]
-            self.order = order
+        order = np.tile(np.arange(m)[:, None], (1, N))
+        each = np.arange(N)
+        for k in range(m):                       # the exchanges, in turn
+            p = swaps[k]
+            order[k], order[p, each] = order[p, each], order[k].copy()
+        order[:, ~regular] = self.order[:, None]
+        return order.T
 
     def run_rates(self, t, z):
         """(ż, z̈) at the steps of the last ``run`` (z its answer, solved rows only): those
@@ -278,28 +286,46 @@ class Solver:
         n = len(t)
         z = np.full((n, self.terms.nz), np.nan)
         z[0] = z0
-        #: rates found with the positions (``_bulk``) at the steps marked in own_rates
+        #: rates found with the positions at the steps marked in own_rates
         self.zd, self.zdd = np.empty_like(z), np.empty_like(z)
         self.own_rates = np.zeros(n, dtype=bool)
-        self.pivot_order(t[0], z0)
+        #: how far each step solved in a batch landed from its guess (weighted, ``w``)
+        self.miss = np.zeros(n)
+        if self._batched() and self.terms.m:     # the order at the start: ``solve``
+            self.order = self.pivot_orders(z0[None])[0]
         stride = max(1, n // COARSE)
         if stride < 4:
             return self._sequential(t, z, 0, n)
-        base, intervals = stride, []      # (k, j, ż_k, ż_j, miss) to fill in the second pass
-        end = n                                # the steps solved (all, unless one fails)
-        k, zd, zdd = 0, *(r[0] for r in self.rates(t[:1], z[:1]))
-        while k < n - 1:
-            j = min(n - 1, k + stride)
+        self.zd[:1], self.zdd[:1] = self.rates(t[:1], z[:1])
+        self.own_rates[0] = True
+        intervals, end = self._coarse(t, z, 0, n - 1, LEVEL * stride)
+        intervals, end = self._refine(t, z, intervals, stride, end)
+        bad = self._fill(t, z, intervals)
+        for number in bad:                     # another branch, or no convergence
+            k, j = intervals[number][:2]
+            self.own_rates[k + 1:j + 1] = False
+            z, solved = self._sequential(t, z, k, j + 1)
+            if solved <= j:
+                return z, solved
+        return z, end
+
+    def _coarse(self, t, z, k: int, last: int, stride: int):
+        """(intervals, end): steps from the solved step k to ``last`` one after the other,
+        every ``stride`` steps (fewer where the motion is fast), each from the Taylor
+        predictor z + h ż + h²/2 z̈; their rates kept. intervals: (k, j, miss) to fill in;
+        end: the first step not solved (len(t) when all are)."""
+        base, intervals = stride, []
+        while k < last:
+            j = min(last, k + stride)
             if j - k < 4:                      # too fast or too near a singular position
                 z, solved = self._sequential(t, z, k, j + 1)
                 if solved <= j:
-                    end = solved
-                    break
+                    return intervals, solved
                 k, stride = j, min(base, 4 * stride)
-                zd, zdd = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
+                self._keep_rates(t, z, j)
                 continue
             h = t[j] - t[k]
-            guess = z[k] + h * zd + 0.5 * h * h * zdd
+            guess = z[k] + h * self.zd[k] + 0.5 * h * h * self.zdd[k]
             zj, ok = self.newton(t[j:j + 1], guess[None])
             miss = float(np.max(np.abs(zj[0] - guess) * self.w)) if ok[0] else np.inf
             if miss > COARSE_MISS:             # a shorter interval
@@ -308,75 +334,110 @@ class Solver:
             if miss < COARSE_MISS / 64:
                 stride = min(base, 2 * stride)
             z[j] = zj[0]
-            zdj, zddj = (r[0] for r in self.rates(t[j:j + 1], z[j:j + 1]))
-            intervals.append((k, j, zd, zdj, miss))
-            k, zd, zdd = j, zdj, zddj
-        bad = self._fill(t, z, intervals)
-        for number in bad:                     # another branch, or no convergence
-            k, j = intervals[number][:2]
-            self.own_rates[k:j + 1] = False
-            z, solved = self._sequential(t, z, k, j + 1)
-            if solved <= j:
-                return z, solved
-        return z, end
+            self._keep_rates(t, z, j)
+            intervals.append((k, j, miss))
+            k = j
+        return intervals, len(t)
 
-    def _fill(self, t, z, intervals) -> list[int]:
-        """Solve the steps inside every interval at once from cubic Hermite guesses; the
-        numbers of the intervals where some step failed or left its guess far behind."""
+    def _keep_rates(self, t, z, *steps: int):
+        """Solve and keep the rates at these steps (solved)."""
+        at = list(steps)
+        self.zd[at], self.zdd[at] = self.rates(t[at], z[at])
+        self.own_rates[at] = True
+
+    def _refine(self, t, z, intervals, stride: int, end: int):
+        """(intervals, end) of about ``stride`` steps: inside each interval of the coarse
+        pass, the steps every ``stride`` steps solved at once (``_fill``); an interval where
+        one failed or left its guess far behind goes through ``_coarse`` at ``stride``."""
+        bad = set(self._fill(t, z, intervals, every=stride))
+        out = []
+        for number, (k, j, miss) in enumerate(intervals):
+            if number in bad:
+                self.own_rates[k + 1:j] = False
+                finer, solved = self._coarse(t, z, k, j, stride)
+                out += finer
+                if solved <= j:
+                    return out, solved
+                continue
+            points = [k, *range(k + stride, j, stride), j]
+            missing = [i for i in points if not self.own_rates[i]]
+            if missing:                        # solved without their rates (``newton``)
+                self._keep_rates(t, z, *missing)
+            out += [(a, b, max(self.miss[a], self.miss[b]))
+                    for a, b in zip(points[:-1], points[1:])]
+        return out, end
+
+    def _fill(self, t, z, intervals, every: int = 1) -> list[int]:
+        """Solve the steps inside every interval (every ``every``-th from its start) at once
+        from cubic Hermite guesses; the numbers of the intervals where some step failed or
+        left its guess far behind (more than 10 times its interval's miss)."""
         if not intervals:
             return []
         k, j = (np.array([iv[i] for iv in intervals]) for i in (0, 1))
-        zdk, zdj = (np.array([iv[i] for iv in intervals]) for i in (2, 3))
-        allowed = np.maximum(10 * np.array([iv[4] for iv in intervals]), 1e-6)
-        counts = j - k - 1
-        owner = np.repeat(np.arange(len(intervals)), counts)
-        steps = np.concatenate([np.arange(a + 1, b) for a, b in zip(k, j)])
-        rows = self.rows_per_chunk()
+        allowed = np.maximum(10 * np.array([iv[2] for iv in intervals]), 1e-6)
+        ranges = [np.arange(a + every, b, every) for a, b in zip(k, j)]
+        owner = np.repeat(np.arange(len(intervals)), [len(r) for r in ranges])
+        steps = np.concatenate(ranges)
         failed = np.zeros(len(intervals), dtype=bool)
-        for a in range(0, len(steps), rows):    # chunks: memory bounded, whatever the run
-            part, at = steps[a:a + rows], owner[a:a + rows]
-            h = (t[j] - t[k])[at][:, None]
-            u = (t[part][:, None] - t[k][at][:, None]) / h
-            guess = ((2 * u**3 - 3 * u**2 + 1) * z[k][at] + (u**3 - 2 * u**2 + u) * h * zdk[at]
-                     + (-2 * u**3 + 3 * u**2) * z[j][at] + (u**3 - u**2) * h * zdj[at])
-            found = self._bulk(t[part], guess)
+        for a, b, order in self._blocks(z, k, owner):
+            part, at = steps[a:b], owner[a:b]
+            guess = self._hermite(t, z, part, k[at], j[at])
+            found = self._bulk(t[part], guess, order) if order is not None else None
             if found is None:
-                zi, ok = self.newton(t[part], guess)
+                zi, ok = self.newton(t[part], guess.T)
+                zi = zi.T
             else:
-                zi, ok, zd, zdd = found
+                zi, zd, zdd, ok = found
                 self.own_rates[part] = True
-                self.zd[part], self.zdd[part] = zd, zdd
-            far = np.max(np.abs(zi - guess) * self.w, axis=1) > allowed[at]
-            z[part] = zi
+                self.zd[part], self.zdd[part] = zd.T, zdd.T
+            self.miss[part] = np.max(np.abs(zi - guess) * self.w[:, None], axis=0)
+            far = self.miss[part] > allowed[at]
+            z[part] = zi.T
             failed[at[~ok | far]] = True
         return list(np.nonzero(failed)[0])
 
-    def _bulk(self, t, z, iterations: int = 4):
-        """(z, ok, ż, z̈) for many steps of a small square system from good guesses: each
-        Newton solve also solves Φ_z ż = g' (two right-hand sides, one factorisation), and
-        the last one's Jacobian (at z within the tolerance) gives z̈; None where that does
-        not apply (large, redundant or singular systems). In blocks of BLOCK steps, one
-        column per step (``batched``)."""
-        if self.least_squares or self.terms.nz >= SPARSE_FROM or not len(t):
-            return None
-        out = np.empty((3, self.terms.nz, len(t)))
-        ok = np.empty(len(t), dtype=bool)
-        for a in range(0, len(t), BLOCK):
-            s = slice(a, a + BLOCK)
-            found = self._bulk_block(t[s], z[s].T, iterations)
-            if found is None:
-                return None
-            out[:, :, s], ok[s] = found
-        return out[0].T, ok, out[1].T, out[2].T
+    def _blocks(self, z, k, owner):
+        """(a, b, order): the steps a:b of ``_fill`` solved together, and their equations'
+        order for ``_bulk`` (None: not batched). Batched: blocks of at most BLOCK steps,
+        which stay in the cache, of intervals whose first steps pivot alike
+        (``pivot_orders``); else chunks whose Jacobians take bounded memory."""
+        if not self._batched() or not self.terms.m:
+            rows = self.rows_per_chunk()
+            yield from ((a, a + rows, None) for a in range(0, len(owner), rows))
+            return
+        if len(owner) <= BLOCK:                  # one block (a few numpy calls less)
+            yield 0, len(owner), self.pivot_orders(z[k[:1]])[0]
+            return
+        orders = self.pivot_orders(z[k])[owner]
+        change = np.nonzero(np.any(orders[1:] != orders[:-1], axis=1))[0] + 1
+        edges = [0, *change, len(owner)]
+        for a, b in zip(edges[:-1], edges[1:]):
+            for c in range(a, b, BLOCK):
+                yield c, min(b, c + BLOCK), orders[c]
 
-    def _bulk_block(self, t, z, iterations):
-        """((z, ż, z̈) (3, nz, n), ok) of ``_bulk`` for one block, z (nz, n)."""
+    def _hermite(self, t, z, steps, k, j):
+        """z at the steps (nz, n) on the cubic through z and ż at the ends k, j of their
+        intervals (error O(h⁴))."""
+        h = t[j] - t[k]
+        u = (t[steps] - t[k]) / h
+        u2, u3 = u * u, u * u * u
+        return ((2 * u3 - 3 * u2 + 1) * z[k].T + (u3 - 2 * u2 + u) * h * self.zd[k].T
+                + (3 * u2 - 2 * u3) * z[j].T + (u3 - u2) * h * self.zd[j].T)
+
+    def _batched(self) -> bool:
+        """Whether the steps are solved by ``_bulk`` (small square systems)."""
+        return not self.least_squares and self.terms.nz < SPARSE_FROM
+
+    def _bulk(self, t, z, order, iterations: int = 4):
+        """(z, ż, z̈, ok) for a block of steps of a small square system from good guesses
+        (z (nz, n), one column per step, as the answers): each Newton solve also solves
+        Φ_z ż = g' (two right-hand sides, one factorisation), and the last one's Jacobian
+        (at z within the tolerance) gives z̈; None where a Jacobian is singular."""
         terms, tol = self.terms, self.settings.tolerance
         z = np.array(z, dtype=float)
         rhs = np.empty((terms.m, 2, len(t)))
-        rhs[:, 1] = terms.velocity_rhs_cols(t)[self.order]
+        rhs[:, 1] = terms.velocity_rhs_cols(t)[order]
         w = self.w[:, None]
-        order = self.order
         with np.errstate(all="ignore"):
             for _ in range(iterations):
                 A = terms.dense_cols(terms.jacobian_cols(z))[order]
@@ -392,7 +453,7 @@ class Solver:
                     break
             zd = x[:, 1]
             zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
-        return np.stack([z, zd, zdd]), step <= tol
+        return z, zd, zdd, step <= tol
 
     def _sequential(self, t, z, k: int, end: int):
         """(z, solved): steps k+1 … end−1 one after the other from the solved step k,
@@ -420,31 +481,3 @@ class Solver:
                               for b in range(len(known)) if b != a])
             out += weight * zs[a]
         return out
-
-
-def anchored(terms, t0: float, z: np.ndarray, K: np.ndarray, target: np.ndarray,
-             weight: np.ndarray, settings: NaturalSettings, w: np.ndarray) -> np.ndarray:
-    """z minimising ½ Σ weight (K [z; 1] − target)² subject to Φ(z, t0) = 0: Newton on the
-    optimality conditions, H Δz + Φ_zᵀ μ = −∇E, Φ_z Δz = −Φ (H: the Lagrangian's Hessian).
-
-    The free degrees of freedom settle nearest the guess (an assembly with free solids).
-    Raises SolverError when it does not converge.
-    """
-    nz, m = terms.nz, terms.m
-    A = K[:, :nz]
-    mu = np.zeros(m)
-    t = np.array([t0])
-    for _ in range(4 * settings.max_iterations):
-        phi = terms.residual(t, z[None])[0]
-        J = terms.dense(terms.jacobian(z[None]))[0]
-        gap = K @ np.r_[z, 1.0] - target
-        H = A.T @ (weight[:, None] * A) + terms.hessian(z, mu)
-        kkt = np.block([[H, J.T], [J, np.zeros((m, m))]])
-        rhs = -np.r_[A.T @ (weight * gap), phi]
-        sol = np.linalg.lstsq(kkt, rhs, rcond=1e-13)[0]
-        dz, mu = sol[:nz], sol[nz:]
-        z = z + dz
-        if np.max(np.abs(dz) * w, initial=0.0) <= settings.tolerance:
-            return z
-    raise SolverError("the natural-coordinate assembly with free degrees of freedom did not "
-                      "converge")
