@@ -1,23 +1,23 @@
 """Newton's method on the natural-coordinate equations, for all time steps at once.
 
-A run is solved in three passes (vectorised over steps, sequential only where it must be):
+A run is solved in two passes (vectorised over steps, sequential only where it must be):
 
-1. a coarse sequential pass: every ``stride``-th step from the previous one (COARSE / LEVEL
-   intervals), Newton started from the Taylor predictor z + h ż + h²/2 z̈ (velocities and
-   accelerations there are two linear solves); an interval whose predictor misses by more
-   than ``COARSE_MISS`` (a fast or nearly singular motion) is cut shorter, down to step by
-   step;
-2. the steps every LEVEL times closer (COARSE intervals) inside those intervals, at once,
-   from cubic Hermite guesses (below), with their rates;
-3. every step in between at once: Newton started from the cubic Hermite interpolation of
+1. a coarse sequential pass: every ``stride``-th step from the previous one (COARSE
+   intervals, at least 4 steps long), Newton started from the Taylor predictor
+   z + h ż + h²/2 z̈ (velocities and accelerations there are two linear solves); an interval
+   whose predictor misses by more than ``COARSE_MISS`` (a fast or nearly singular motion)
+   is cut shorter, down to step by step. Its steps stay close enough that Newton does not
+   jump to a nearby branch (a pass with intervals ten times longer, tried, did so next to
+   a change point: tests/analyses/test_hard_cases.py);
+2. every step in between at once: Newton started from the cubic Hermite interpolation of
    z and ż at the ends of its interval (error O(h⁴)), Jacobians and solves batched over the
    steps (``batched``: blocks of BLOCK steps, the equations ordered as the pivots at the
    start of their interval, so that rows are seldom exchanged). A step that does not
    converge, or converges far from its guess (another branch), has its interval solved
-   one level down: by pass 1 at pass 2's stride, step by step in pass 3.
+   step by step.
 
 A step that Newton cannot solve from the previous one is cut into 2, 4, … 64 sub-steps
-before the run stops there.
+before the run stops there. Runs shorter than SHORT steps are solved step by step.
 """
 from __future__ import annotations
 
@@ -30,10 +30,10 @@ from ...batched import lu_factor, lu_solve
 #: from this many coordinates on, a chunk of steps is solved as one sparse block-diagonal
 #: system (cost linear in the mechanism's size) instead of dense batched solves
 SPARSE_FROM = 40
-#: intervals of the second pass (fewer when the run is short); the sequential first pass
-#: takes LEVEL times fewer, and the points in between are solved at once
+#: intervals of the coarse pass (fewer when the run is short)
 COARSE = 100
-LEVEL = 10
+#: runs shorter than this are solved step by step
+SHORT = 64
 #: the coarse predictor may miss by this much (relative: lengths / L, angles in rad)
 #: before its interval is solved step by step
 COARSE_MISS = 2e-2
@@ -293,13 +293,12 @@ class Solver:
         self.miss = np.zeros(n)
         if self._batched() and self.terms.m:     # the order at the start: ``solve``
             self.order = self.pivot_orders(z0[None])[0]
-        stride = max(1, n // COARSE)
-        if stride < 4:
+        if n < SHORT:
             return self._sequential(t, z, 0, n)
+        stride = max(4, n // COARSE)
         self.zd[:1], self.zdd[:1] = self.rates(t[:1], z[:1])
         self.own_rates[0] = True
-        intervals, end = self._coarse(t, z, 0, n - 1, LEVEL * stride)
-        intervals, end = self._refine(t, z, intervals, stride, end)
+        intervals, end = self._coarse(t, z, 0, n - 1, stride)
         bad = self._fill(t, z, intervals)
         for number in bad:                     # another branch, or no convergence
             k, j = intervals[number][:2]
@@ -345,37 +344,15 @@ class Solver:
         self.zd[at], self.zdd[at] = self.rates(t[at], z[at])
         self.own_rates[at] = True
 
-    def _refine(self, t, z, intervals, stride: int, end: int):
-        """(intervals, end) of about ``stride`` steps: inside each interval of the coarse
-        pass, the steps every ``stride`` steps solved at once (``_fill``); an interval where
-        one failed or left its guess far behind goes through ``_coarse`` at ``stride``."""
-        bad = set(self._fill(t, z, intervals, every=stride))
-        out = []
-        for number, (k, j, miss) in enumerate(intervals):
-            if number in bad:
-                self.own_rates[k + 1:j] = False
-                finer, solved = self._coarse(t, z, k, j, stride)
-                out += finer
-                if solved <= j:
-                    return out, solved
-                continue
-            points = [k, *range(k + stride, j, stride), j]
-            missing = [i for i in points if not self.own_rates[i]]
-            if missing:                        # solved without their rates (``newton``)
-                self._keep_rates(t, z, *missing)
-            out += [(a, b, max(self.miss[a], self.miss[b]))
-                    for a, b in zip(points[:-1], points[1:])]
-        return out, end
-
-    def _fill(self, t, z, intervals, every: int = 1) -> list[int]:
-        """Solve the steps inside every interval (every ``every``-th from its start) at once
-        from cubic Hermite guesses; the numbers of the intervals where some step failed or
-        left its guess far behind (more than 10 times its interval's miss)."""
+    def _fill(self, t, z, intervals) -> list[int]:
+        """Solve the steps inside every interval at once from cubic Hermite guesses; the
+        numbers of the intervals where some step failed or left its guess far behind (more
+        than 10 times its interval's miss)."""
         if not intervals:
             return []
         k, j = (np.array([iv[i] for iv in intervals]) for i in (0, 1))
         allowed = np.maximum(10 * np.array([iv[2] for iv in intervals]), 1e-6)
-        ranges = [np.arange(a + every, b, every) for a, b in zip(k, j)]
+        ranges = [np.arange(a + 1, b) for a, b in zip(k, j)]
         owner = np.repeat(np.arange(len(intervals)), [len(r) for r in ranges])
         steps = np.concatenate(ranges)
         failed = np.zeros(len(intervals), dtype=bool)
