@@ -103,6 +103,11 @@ class Solver:
         n = data.shape[0]
         if terms.nz == 0:
             return np.zeros((n, 0))
+        if not self.least_squares and terms.nz < SPARSE_FROM and n < BATCHED_FROM:
+            try:                               # a diverged step gives NaN here too
+                return np.linalg.solve(terms.dense(data), b[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                pass
         finite = np.isfinite(data).all(axis=1) & np.isfinite(b).all(axis=1)
         if not finite.all():                   # a diverged step: NaN, the others solved
             x = np.full((n, terms.nz), np.nan)
@@ -121,11 +126,6 @@ class Solver:
                 if not regular.all():              # singular: NaN (``_least_squares``)
                     x[~regular] = self._least_squares(data[~regular], b[~regular])
                 return x
-            else:
-                try:
-                    return np.linalg.solve(terms.dense(data), b[..., None])[..., 0]
-                except np.linalg.LinAlgError:
-                    pass
         return self._least_squares(data, b)
 
     def _least_squares(self, data, b):
