@@ -79,9 +79,10 @@ def test_quasi_static_through_a_singular_position_is_an_error(request, every_bac
     stop there, as kinematic does, even though Exudyn's solver, told to ignore the
     singular Jacobian, passes it."""
     if every_backend == "natural":
-        pytest.xfail("open (issue 12): the natural backend solves this change point, where two "
-                     "branches cross, only to ~1e-8, and the native rank test of the "
-                     "quasi-static analysis (exact singularity) does not see it")
+        pytest.xfail("a known limit of the natural backend (issue 12's closing note): it "
+                     "solves this change point, where two branches cross, only to ~1e-8, and "
+                     "the native rank test of the quasi-static analysis (exact singularity) "
+                     "does not see it")
     model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
     model["motor"].law, model["motor"].C = "polynomial", [np.pi / 2, 2 * np.pi]
     model.gravity = 9.81
