@@ -85,7 +85,7 @@ class Solver:
         self.least_squares = least_squares or terms.m != terms.nz
         self.iterations = 0
         self.floor = MAGNITUDE_FLOOR * terms.magnitude_at(1.0 / weights)[:, None]
-        #: the equations in the order of the pivots at the run's start (``pivot_order``)
+        #: the equations in the order of the pivots at the run's start (``pivot_orders``)
         self.order = np.arange(terms.m)
 
     def rows_per_chunk(self) -> int:
