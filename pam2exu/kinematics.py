@@ -11,6 +11,8 @@ analyses need of it:
     jac     dv/dq, per solid            {solid: (n, d, 3)}
     rate    dv/dt = jac · qd            (n, d)      (only with velocities)
     conv    d²v/dt² − jac · qdd         (n, d)      (only with velocities)
+    hess    ∂²v/∂q_a∂q_b, per pair of solids (a, b), both orders
+                                        {(a, b): (n, d, 3, 3)}  (only with hessians)
 
 so that a constraint v(q) − f(t) = 0 has C_t = −f', and Cq qdd = γ with γ = f'' − conv.
 """
@@ -67,28 +69,26 @@ class Quantity:
     jac: dict[int, np.ndarray] = field(default_factory=dict)
     rate: np.ndarray | None = None
     conv: np.ndarray | None = None
+    hess: dict[tuple[int, int], np.ndarray] | None = None
 
     def __sub__(self, other: "Quantity") -> "Quantity":
         """v = a − b."""
-        jac = dict(self.jac)
-        for solid, block in other.jac.items():
-            jac[solid] = jac[solid] - block if solid in jac else -block
-        return Quantity(self.value - other.value, jac, _sub(self.rate, other.rate),
-                        _sub(self.conv, other.conv))
+        return Quantity(self.value - other.value, _combine(self.jac, other.jac, subtract=True),
+                        _sub(self.rate, other.rate), _sub(self.conv, other.conv),
+                        _combine(self.hess, other.hess, subtract=True))
 
     def __add__(self, other: "Quantity") -> "Quantity":
         """v = a + b."""
-        jac = dict(self.jac)
-        for solid, block in other.jac.items():
-            jac[solid] = jac[solid] + block if solid in jac else block
-        return Quantity(self.value + other.value, jac, _add(self.rate, other.rate),
-                        _add(self.conv, other.conv))
+        return Quantity(self.value + other.value, _combine(self.jac, other.jac, subtract=False),
+                        _add(self.rate, other.rate), _add(self.conv, other.conv),
+                        _combine(self.hess, other.hess, subtract=False))
 
     def __mul__(self, k: float) -> "Quantity":
         """v = k a for a constant k."""
         return Quantity(self.value * k, {s: b * k for s, b in self.jac.items()},
                         None if self.rate is None else self.rate * k,
-                        None if self.conv is None else self.conv * k)
+                        None if self.conv is None else self.conv * k,
+                        None if self.hess is None else {p: b * k for p, b in self.hess.items()})
 
     def dot(self, other: "Quantity") -> "Quantity":
         """v = a · b; v'' = a''·b + a·b'' + 2 a'·b'."""
@@ -102,7 +102,18 @@ class Quantity:
         if a.rate is not None:
             rate = dot(a.rate, b.value) + dot(a.value, b.rate)
             conv = dot(a.conv, b.value) + dot(a.value, b.conv) + 2.0 * dot(a.rate, b.rate)
-        return Quantity(dot(a.value, b.value), jac, rate, conv)
+        hess = None
+        if a.hess is not None and b.hess is not None:
+            # ∂²(a·b) = b·∂²a + a·∂²b + ∂aᵀ∂b + ∂bᵀ∂a
+            hess = {}
+            for x, y in ((a, b), (b, a)):
+                for pair, block in x.hess.items():
+                    _accumulate(hess, pair, np.einsum("nd,ndkl->nkl", y.value, block))
+                for s1, j1 in x.jac.items():
+                    for s2, j2 in y.jac.items():
+                        _accumulate(hess, (s1, s2), np.einsum("ndk,ndl->nkl", j1, j2))
+            hess = {p: h[:, None] for p, h in hess.items()}
+        return Quantity(dot(a.value, b.value), jac, rate, conv, hess)
 
     def norm(self) -> "Quantity":
         """v = |a|; v' = e·a', v'' = e·a'' + (|a'|² − (e·a')²)/|a| with e = a/|a|."""
@@ -113,7 +124,25 @@ class Quantity:
         if self.rate is not None:
             rate = dot(e, self.rate)
             conv = dot(e, self.conv) + (dot(self.rate, self.rate) - rate * rate) / length
-        return Quantity(length, jac, rate, conv)
+        hess = None
+        if self.hess is not None:
+            # ∂²|a| = e·∂²a + (∂aᵀ∂a − (eᵀ∂a)ᵀ(eᵀ∂a)) / |a|
+            hess = {}
+            for pair, block in self.hess.items():
+                _accumulate(hess, pair, np.einsum("nd,ndkl->nkl", e, block))
+            for s1, j1 in self.jac.items():
+                for s2, j2 in self.jac.items():
+                    g1, g2 = jac[s1][:, 0], jac[s2][:, 0]
+                    term = (np.einsum("ndk,ndl->nkl", j1, j2)
+                            - g1[:, :, None] * g2[:, None, :]) / length[:, :, None]
+                    _accumulate(hess, (s1, s2), term)
+            hess = {p: h[:, None] for p, h in hess.items()}
+        return Quantity(length, jac, rate, conv, hess)
+
+    def weighted_hessian(self, weights: np.ndarray, out: np.ndarray) -> None:
+        """out (n, nq, nq) += Σ_d w_d ∂²v_d/∂q², weights (n, d) (λ of the rows of v)."""
+        for (a, b), block in self.hess.items():
+            out[:, pose(a), pose(b)] += np.einsum("nd,ndkl->nkl", weights, block)
 
     def rows(self, jacobian: np.ndarray, row: int) -> None:
         """Write dv/dq into rows row… of a full Jacobian (n, m, 3·solids), zero there before."""
@@ -124,6 +153,24 @@ class Quantity:
 
 def _add(a, b):
     return None if a is None else a + b
+
+
+def _combine(a: dict | None, b: dict | None, subtract: bool) -> dict | None:
+    """The blocks of a + b or a − b, per key (None if either is None)."""
+    if a is None or b is None:
+        return None
+    out = dict(a)
+    for key, block in b.items():
+        if key in out:
+            out[key] = out[key] - block if subtract else out[key] + block
+        else:
+            out[key] = -block if subtract else block
+    return out
+
+
+def _accumulate(blocks: dict, key, block: np.ndarray) -> None:
+    """blocks[key] += block (a new entry if there is none)."""
+    blocks[key] = blocks[key] + block if key in blocks else block
 
 
 def _sub(a, b):
@@ -142,9 +189,20 @@ def stack(*quantities: Quantity) -> Quantity:
                 jac[solid] = np.zeros((n, sum(dims), 3))
             jac[solid][:, offset:offset + d] += block
         offset += d
+    hess = None
+    if all(q.hess is not None for q in quantities):
+        hess = {}
+        offset = 0
+        for q, d in zip(quantities, dims):
+            for pair, block in q.hess.items():
+                if pair not in hess:
+                    hess[pair] = np.zeros((n, sum(dims), 3, 3))
+                hess[pair][:, offset:offset + d] += block
+            offset += d
     cat = lambda xs: None if xs[0] is None else np.concatenate(xs, axis=1)  # noqa: E731
     return Quantity(cat([q.value for q in quantities]), jac,
-                    cat([q.rate for q in quantities]), cat([q.conv for q in quantities]))
+                    cat([q.rate for q in quantities]), cat([q.conv for q in quantities]),
+                    hess)
 
 
 class State:
@@ -152,14 +210,16 @@ class State:
 
     ``jacobians=False``: the quantities built from it carry no dv/dq (``Quantity.jac`` is
     empty), for passes that need only values, rates and conv (residuals, γ).
+    ``hessians=True``: they also carry ∂²v/∂q² (``Quantity.hess``; the clearance analysis).
     """
 
-    def __init__(self, t, q, qd=None, jacobians: bool = True):
+    def __init__(self, t, q, qd=None, jacobians: bool = True, hessians: bool = False):
         self.t = np.atleast_1d(np.asarray(t, dtype=float))
         self.q = np.atleast_2d(np.asarray(q, dtype=float))
         self.qd = None if qd is None else np.atleast_2d(np.asarray(qd, dtype=float))
         self.n = self.q.shape[0]
-        self.jacobians = jacobians
+        self.jacobians = jacobians or hessians
+        self.hessians = hessians
         # what is evaluated once per State: (cos fi, sin fi) per solid, points and directions
         self._trig: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._rotated_memo: dict[tuple, Quantity] = {}
@@ -174,7 +234,7 @@ class State:
         rate = conv = None
         if self.qd is not None:
             rate, conv = self.qd[:, col:col + 1], np.zeros((self.n, 1))
-        return Quantity(self.q[:, col:col + 1], jac, rate, conv)
+        return Quantity(self.q[:, col:col + 1], jac, rate, conv, {} if self.hessians else None)
 
     def angle(self, solid: int) -> Quantity:
         """v = fi of a solid."""
@@ -213,7 +273,11 @@ class State:
             if translate:
                 rate = rate + self.qd[:, x:y + 1]
             conv = -(w * w) * As
-        return Quantity(value, jac, rate, conv)
+        hess = None
+        if self.hessians:                      # ∂²(A s)/∂fi² = −A s, the rest 0
+            hess = {(solid, solid): np.zeros((self.n, 2, 3, 3))}
+            hess[solid, solid][:, :, 2, 2] = -As
+        return Quantity(value, jac, rate, conv, hess)
 
     def point(self, solid: int, local) -> Quantity:
         """v = R + A(fi) s: global position of the point s of a solid."""

@@ -39,6 +39,41 @@ def test_jacobian_rate_and_convective_term_match_finite_differences(every, seed)
                                    atol=1e-7, err_msg=el.name)
 
 
+@pytest.mark.parametrize("seed", [5, 6])
+def test_second_derivatives_match_finite_differences_of_the_jacobian(every, seed):
+    """Σ_d w_d ∂²v_d/∂q² (``Quantity.hess``, the clearance analysis's Σλ F_qq) of every
+    element's constraint: against central differences of its analytic Jacobian (fourth
+    order, h = 1e-4, error O(h⁴)), column by column, so that the whole matrix is checked
+    (not only its quadratic form); and its quadratic form against the convective term,
+    which for a constraint without time is vᵀ (∂²v/∂q²) v (both analytic: round-off)."""
+    rng = np.random.default_rng(seed)
+    nq = every.nq
+    q0 = every.initial_q() + 0.05 * rng.standard_normal(nq)
+    v = rng.standard_normal(nq)
+    h = 1e-4
+    for el in every.constraints:
+        w = rng.standard_normal((1, el.equations))
+
+        def weighted_jacobian(q):
+            J = np.zeros((1, el.equations, nq))
+            el.constraint(State([0.0], q[None]))[0].rows(J, 0)
+            return w[0] @ J[0]
+
+        quantity = el.constraint(State([0.0], q0[None], v[None], hessians=True))[0]
+        H = np.zeros((1, nq, nq))
+        quantity.weighted_hessian(w, H)
+        for k in range(nq):
+            e = np.zeros(nq)
+            e[k] = h
+            column = (8 * (weighted_jacobian(q0 + e) - weighted_jacobian(q0 - e))
+                      - (weighted_jacobian(q0 + 2 * e) - weighted_jacobian(q0 - 2 * e))) / (12 * h)
+            np.testing.assert_allclose(H[0, :, k], column, atol=1e-9,
+                                       err_msg=f"{el.name}, column {k}")
+        np.testing.assert_allclose(H[0], H[0].T, atol=1e-15, err_msg=el.name)
+        np.testing.assert_allclose(v @ H[0] @ v, w[0] @ quantity.conv[0],
+                                   atol=1e-12 * (1 + abs(v @ H[0] @ v)), err_msg=el.name)
+
+
 def test_gamma_of_actuators_includes_the_law():
     """Cq qdd = γ: for fi2 − fi1 = f(t) with everything else at rest, γ = f''(t)."""
     m = pam2exu.Model("motor", gravity=0.0)
