@@ -1,0 +1,193 @@
+"""The clearance of least norm: Rameau's Lagrange conditions and how to follow them.
+
+With clearance parameters j the closure equations F(u(t), j, q, r(t)) = 0 of an
+over-constrained mechanism hold again for perturbed dimensions u(t); the clearance analysis
+(shared/spec/clearance.md) follows
+
+    (j, q)(t) = argmin ½‖j‖²  subject to  F(u(t), j, q, r(t)) = 0,
+
+whose Lagrange conditions, with y = (j, q, λ), are
+
+    h(t, y) = (j + F_jᵀλ, F_qᵀλ, F) = 0.
+
+The clearance terms are linear in j (F_j constant), so
+
+    h_y = [[I, 0, F_jᵀ], [0, W, F_qᵀ], [F_j, F_q, 0]],   W = Σ_i λ_i ∂²F_i/∂q².
+
+This module is the mathematics only, on a ``Closure`` (F, F_q, F_j and W at one time, which
+the caller evaluates): the residual h, its Jacobian, Newton's iteration on h = 0, the
+slides' ODE y' = −h_y⁻¹ h_t with a Newton corrector at each output time, and the
+conditions under which the method applies. Reference: J.-F. Rameau, "Équation
+différentielle pour modéliser les mécanismes sur-contraints avec jeu" (2014), pp. 8–10.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+#: a singular value below this fraction of the largest counts as zero (the contract's 1e-9)
+RANK = 1e-9
+
+
+@dataclass
+class Closure:
+    """The closure equations F = C(q, t) + F_j j at one time: C (m,) (``F``, without the
+    clearance terms), F_q (m, nq), F_j (m, p), and W = Σ λ_i ∂²F_i/∂q² (nq, nq) for the λ
+    they were evaluated with."""
+
+    F: np.ndarray
+    Fq: np.ndarray
+    Fj: np.ndarray
+    W: np.ndarray
+
+
+#: evaluate(t, q, λ) -> Closure
+Evaluate = Callable[[float, np.ndarray, np.ndarray], Closure]
+
+
+def split(y: np.ndarray, p: int, nq: int):
+    """(j, q, λ) of y = (j, q, λ)."""
+    return y[:p], y[p:p + nq], y[p + nq:]
+
+
+def lagrange(j: np.ndarray, lam: np.ndarray, c: Closure) -> np.ndarray:
+    """h = (j + F_jᵀλ, F_qᵀλ, C + F_j j)."""
+    return np.concatenate([j + c.Fj.T @ lam, c.Fq.T @ lam, c.F + c.Fj @ j])
+
+
+def lagrange_jacobian(c: Closure) -> np.ndarray:
+    """h_y = [[I, 0, F_jᵀ], [0, W, F_qᵀ], [F_j, F_q, 0]] (F_j constant)."""
+    m, p = c.Fj.shape
+    nq = c.Fq.shape[1]
+    return np.block([[np.eye(p), np.zeros((p, nq)), c.Fj.T],
+                     [np.zeros((nq, p)), c.W, c.Fq.T],
+                     [c.Fj, c.Fq, np.zeros((m, m))]])
+
+
+def newton(evaluate: Evaluate, t: float, y: np.ndarray, p: int, nq: int,
+           tolerance: float = 1e-13, iterations: int = 30) -> tuple[np.ndarray, bool]:
+    """(y, converged): Newton's iteration on h(t, y) = 0 from y, until the step is below
+    ``tolerance`` (relative to 1 + |y|) or h is at round-off."""
+    for _ in range(iterations):
+        j, q, lam = split(y, p, nq)
+        c = evaluate(t, q, lam)
+        h = lagrange(j, lam, c)
+        try:
+            step = np.linalg.solve(lagrange_jacobian(c), -h)
+        except np.linalg.LinAlgError:
+            return y, False
+        y = y + step
+        if np.max(np.abs(step)) <= tolerance * (1.0 + np.max(np.abs(y))):
+            return y, True
+    return y, False
+
+
+@dataclass
+class Applicability:
+    """The conditions of the slides (p. 10) at a configuration: (i) [F_j F_q] has full row
+    rank, (ii) F_q has full column rank and the reduced Hessian is positive definite."""
+
+    ratio_i: float              # σ_min / σ_max of [F_j F_q]
+    ratio_ii: float             # σ_min / σ_max of F_q
+    hessian: float              # the smallest eigenvalue of Zᵀ W_full Z (``reduced_hessian``)
+    self_stress: np.ndarray     # a unit λ with [F_j F_q]ᵀ λ ≈ 0 (where (i) fails), else empty
+    free: np.ndarray            # a unit δq with F_q δq ≈ 0 (where (ii) fails), else empty
+
+    @property
+    def holds(self) -> bool:
+        return self.ratio_i > RANK and self.ratio_ii > RANK and self.hessian > RANK
+
+
+def _ratio_and_null(A: np.ndarray, side: str):
+    """(σ_min/σ_max, the singular vector of σ_min on ``side`` 'left' or 'right')."""
+    U, s, Vt = np.linalg.svd(A)
+    size = min(A.shape)
+    if side == "left":                   # rank < rows: a left null vector
+        smallest = 0.0 if A.shape[0] > size else s[-1]
+        return smallest / s[0], U[:, -1]
+    smallest = 0.0 if A.shape[1] > size else s[-1]
+    return smallest / s[0], Vt[-1]
+
+
+def reduced_hessian(c: Closure) -> float:
+    """The smallest eigenvalue of Zᵀ diag(I, W) Z, Z an orthonormal basis of ker [F_j F_q]
+    (the second-order condition of a strict minimum); +inf where the kernel is {0}."""
+    A = np.hstack([c.Fj, c.Fq])
+    _, s, Vt = np.linalg.svd(A)
+    rank = int(np.sum(s > RANK * s[0])) if s.size else 0
+    Z = Vt[rank:].T
+    if Z.shape[1] == 0:
+        return np.inf
+    p = c.Fj.shape[1]
+    full = np.zeros((A.shape[1], A.shape[1]))
+    full[:p, :p] = np.eye(p)
+    full[p:, p:] = c.W
+    return float(np.min(np.linalg.eigvalsh(Z.T @ full @ Z)))
+
+
+def applicability(c: Closure) -> Applicability:
+    """The conditions at a configuration (``Applicability``)."""
+    ratio_i, stress = _ratio_and_null(np.hstack([c.Fj, c.Fq]), "left")
+    ratio_ii, free = _ratio_and_null(c.Fq, "right")
+    return Applicability(ratio_i, ratio_ii, reduced_hessian(c),
+                         stress if ratio_i <= RANK else np.zeros(0),
+                         free if ratio_ii <= RANK else np.zeros(0))
+
+
+def kkt_residual(j: np.ndarray, c: Closure) -> float:
+    """min over λ of ‖(F_jᵀλ + j, F_qᵀλ)‖∞ (least squares for λ): 0 where j is minus the
+    clearance part of a self-stress (the first-order condition of least norm)."""
+    A = np.vstack([c.Fj.T, c.Fq.T])
+    b = -np.concatenate([j, np.zeros(c.Fq.shape[1])])
+    lam = np.linalg.lstsq(A, b, rcond=None)[0]
+    return float(np.max(np.abs(A @ lam - b), initial=0.0))
+
+
+def time_rate(evaluate: Evaluate, p: int, step: float = 1e-6) -> Callable:
+    """h_t(t, q, λ) at fixed y by central differences in t (error O(step²)): the ODE only
+    tracks the branch, the corrector of ``follow`` makes every output meet h = 0."""
+    def h_t(t, q, lam):
+        j = np.zeros(p)
+        ahead, behind = (lagrange(j, lam, evaluate(t + s, q, lam)) for s in (step, -step))
+        return (ahead - behind) / (2 * step)
+    return h_t
+
+
+def follow(evaluate: Evaluate, h_t: Callable, times: np.ndarray, y0: np.ndarray, p: int,
+           nq: int, rtol: float = 1e-10, atol: float = 1e-12):
+    """(y (len(times), p + nq + m), converged (len(times),)): from y0 at times[0], the
+    slides' ODE y' = −h_y⁻¹ h_t integrated by scipy's ``solve_ivp`` (DOP853) through every
+    output time, then Newton on h = 0 at each output time from the integrated value."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t, y):
+        j, q, lam = split(y, p, nq)
+        return -np.linalg.solve(lagrange_jacobian(evaluate(t, q, lam)), h_t(t, q, lam))
+
+    times = np.asarray(times, dtype=float)
+    out = np.empty((len(times), len(y0)))
+    ok = np.zeros(len(times), dtype=bool)
+    out[0], ok[0] = y0, True
+    if len(times) > 1:
+        path = solve_ivp(rhs, (times[0], times[-1]), y0, method="DOP853", t_eval=times[1:],
+                         rtol=rtol, atol=atol)
+        found = path.y.T if path.success else np.full((len(times) - 1, len(y0)), np.nan)
+        for k, y in enumerate(found, start=1):
+            if np.isfinite(y).all():
+                out[k], ok[k] = newton(evaluate, float(times[k]), y, p, nq)
+            else:
+                out[k] = np.nan
+    return out, ok
+
+
+def step_by_step(evaluate: Evaluate, times: np.ndarray, y0: np.ndarray, p: int, nq: int):
+    """(y, converged) as ``follow``, by Newton on h = 0 at each time from the previous
+    solution (the reference the ODE is checked against)."""
+    out = np.empty((len(times), len(y0)))
+    ok = np.zeros(len(times), dtype=bool)
+    out[0], ok[0] = y0, True
+    for k in range(1, len(times)):
+        out[k], ok[k] = newton(evaluate, float(times[k]), out[k - 1], p, nq)
+    return out, ok

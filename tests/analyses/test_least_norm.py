@@ -1,0 +1,135 @@
+"""least_norm: Rameau's Lagrange conditions, Newton on them, the slides' ODE, the conditions.
+
+References, independent of the module: the closed-form least-norm solution of a linear
+closure (from the KKT conditions by hand, below), and scipy.optimize.minimize (SLSQP) on
+½‖j‖² with the closure as equality constraints for a nonlinear one.
+"""
+import numpy as np
+import pytest
+from scipy.linalg import null_space
+from scipy.optimize import minimize
+
+from pam2exu.analyses import least_norm as ln
+
+RNG = np.random.default_rng(7)
+A = RNG.standard_normal((3, 2))                  # F_j: 3 equations, 2 clearances
+B = RNG.standard_normal((3, 2))                  # F_q: 2 positions, over-constrained
+
+
+def c_of(t):
+    return np.array([0.3 * np.sin(t), -0.2 * t, 0.1 * np.cos(2 * t) - 0.1])
+
+
+def linear(t, q, lam):
+    """F = A j + B q − c(t), W = 0."""
+    return ln.Closure(B @ q - c_of(t), B, A, np.zeros((2, 2)))
+
+
+def linear_reference(t):
+    """min ½‖j‖² s.t. A j + B q = c: λ ∈ ker Bᵀ = span N, j = −Aᵀλ, so
+    j = Aᵀ N (Nᵀ A Aᵀ N)⁻¹ Nᵀ c and B q = c − A j."""
+    N = null_space(B.T)
+    c = c_of(t)
+    j = A.T @ N @ np.linalg.solve(N.T @ A @ A.T @ N, N.T @ c)
+    q = np.linalg.lstsq(B, c - A @ j, rcond=None)[0]
+    return j, q
+
+
+def test_newton_on_a_linear_closure_gives_the_closed_form():
+    y0 = np.zeros(2 + 2 + 3)
+    y0[2:4] = linear_reference(0.0)[1]
+    for t in (0.3, 1.1, 2.0):
+        y, ok = ln.newton(linear, t, y0, 2, 2)
+        j, q = linear_reference(t)
+        assert ok
+        np.testing.assert_allclose(y[:2], j, atol=1e-14)
+        np.testing.assert_allclose(y[2:4], q, atol=1e-14)
+
+
+# ---- a nonlinear closure: a point on three circles, two of them with clearance -----------
+
+P = np.array([[0.0, 0.0], [1.0, 0.0], [0.3, 0.9]])
+X0 = np.array([0.4, 0.35])
+R0 = np.linalg.norm(X0 - P, axis=1)              # at t = 0 the three circles meet at X0
+FJ = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
+
+
+def radii(t):
+    return R0 + (1 - np.exp(-t)) * np.array([0.02, -0.015, 0.01]) / 2 * np.cos([1.3 * t, 0.7 * t, 2.1 * t])
+
+
+def circles(t, q, lam):
+    """F_i = |q − P_i|² − r_i(t)² + (F_j j)_i, F_q = 2 (q − P_i)ᵀ, W = 2 Σλ_i I."""
+    d = q - P
+    return ln.Closure(np.sum(d * d, axis=1) - radii(t) ** 2, 2 * d, FJ, 2 * np.sum(lam) * np.eye(2))
+
+
+def minimised(t, start):
+    """(j, q) by SLSQP: min ½‖j‖² over (j, q) with the three closure equations."""
+    cons = {"type": "eq", "fun": lambda x: circles(t, x[2:], np.zeros(3)).F + FJ @ x[:2],
+            "jac": lambda x: np.hstack([FJ, circles(t, x[2:], np.zeros(3)).Fq])}
+    res = minimize(lambda x: 0.5 * x[:2] @ x[:2], start, jac=lambda x: np.r_[x[:2], 0, 0],
+                   constraints=[cons], method="SLSQP", options={"ftol": 1e-14, "maxiter": 1000})
+    assert res.success
+    return res.x[:2], res.x[2:]
+
+
+@pytest.fixture(scope="module")
+def paths():
+    times = np.linspace(0.0, 6.0, 61)
+    y0 = np.r_[0.0, 0.0, X0, 0.0, 0.0, 0.0]
+    ode = ln.follow(circles, ln.time_rate(circles, 2), times, y0, 2, 2)
+    newton = ln.step_by_step(circles, times, y0, 2, 2)
+    return times, ode, newton
+
+
+def test_the_ode_and_newton_step_by_step_agree(paths):
+    times, (ode, ok_ode), (newton, ok_newton) = paths
+    assert ok_ode.all() and ok_newton.all()
+    np.testing.assert_allclose(ode, newton, atol=1e-12)
+    assert np.max(np.abs(ode[:, :2])) > 1e-3          # a clearance there is
+
+
+def test_the_clearance_followed_is_the_least_norm_one(paths):
+    times, (ode, _), _ = paths
+    for k in (10, 35, 60):
+        j, q = minimised(times[k], ode[k, :4] + 1e-3)
+        np.testing.assert_allclose(ode[k, :2], j, atol=1e-8)
+        np.testing.assert_allclose(ode[k, 2:4], q, atol=1e-8)
+
+
+def test_every_row_meets_the_closure_and_the_optimality_conditions(paths):
+    """The contract's items 1–3, from the results alone."""
+    times, (ode, _), _ = paths
+    for t, y in zip(times, ode):
+        j, q, lam = ln.split(y, 2, 2)
+        c = circles(t, q, lam)
+        assert np.max(np.abs(c.F + FJ @ j)) <= 1e-13
+        assert ln.kkt_residual(j, c) <= 1e-12
+        assert ln.applicability(c).hessian > 1e-9
+
+
+def test_with_no_variation_the_clearance_is_zero():
+    times = np.linspace(0.0, 1.0, 11)
+    y0 = np.r_[0.0, 0.0, X0, 0.0, 0.0, 0.0]
+    fixed = lambda t, q, lam: circles(0.0, q, lam)          # noqa: E731
+    y, ok = ln.follow(fixed, ln.time_rate(fixed, 2), times, y0, 2, 2)
+    assert ok.all() and np.max(np.abs(y[:, :2])) < 1e-14
+    np.testing.assert_allclose(y[:, 2:4], np.tile(X0, (len(times), 1)), atol=1e-14)
+
+
+def test_the_conditions_name_what_fails():
+    """(i): a self-stress that loads no clearance (the third circle's twin, no clearance on
+    either); (ii): a free position (one circle only, two coordinates)."""
+    c = circles(0.0, X0, np.zeros(3))
+    assert ln.applicability(c).holds
+    twin = ln.Closure(np.r_[c.F, c.F[2]], np.vstack([c.Fq, c.Fq[2]]),
+                      np.vstack([FJ, [0.0, 0.0]]), c.W)
+    found = ln.applicability(twin)
+    assert found.ratio_i <= ln.RANK and not found.holds
+    stress = found.self_stress / np.max(np.abs(found.self_stress))
+    np.testing.assert_allclose(np.abs(stress), [0, 0, 1, 1], atol=1e-12)  # rows 3 and 4
+    alone = ln.Closure(c.F[:1], c.Fq[:1], np.array([[1.0, 0.0]]), c.W)
+    found = ln.applicability(alone)
+    assert found.ratio_ii <= ln.RANK and found.free.size == 2
+    np.testing.assert_allclose(c.Fq[0] @ found.free, 0.0, atol=1e-14)
