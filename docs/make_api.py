@@ -40,7 +40,8 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
      ("A model is solids, elements and analysis settings. `load` and `loads` read the TOML "
       "format of [model-format.md](model-format.md); `Model` builds the same in Python."),
      [("pam2exu", "load"), ("pam2exu", "loads"), ("pam2exu", "Model"), ("pam2exu", "Solid"),
-      ("pam2exu.model", "Analysis"), ("pam2exu.model", "Mechanism")]),
+      ("pam2exu.model", "Analysis"), ("pam2exu.model", "Mechanism"),
+      ("pam2exu.model", "Variation"), ("pam2exu.model", "ramped_cosine")]),
     ("Element types",
      ("The ten PAM element types, one class each, made by `Model.add(\"<type>\", …)` or "
       "directly (`m.add(pam2exu.Revolute(name=\"A\", anc1=\"crank.A\", anc2=\"rod.A\"))`). "
@@ -89,7 +90,7 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
      ("Issued with `warnings.warn` at the caller's line and kept in `Results.warnings`; "
       "filter them with the `warnings` module."),
      [("pam2exu", "RedundancyWarning"), ("pam2exu", "ConsistencyWarning"),
-      ("pam2exu", "ConditionWarning")]),
+      ("pam2exu", "ConditionWarning"), ("pam2exu", "VariationWarning")]),
 ]
 
 #: descriptions of data objects (they have no docstring of their own)
@@ -123,7 +124,7 @@ _ANCHORS = {
     "line": 'a line: ``"<solid>.<line>"`` (a bare ``"<solid>"``: its local x axis)',
 }
 _KINDS = {"constants": "list of float", "number": "float", "law": "str", "solid": "str",
-          "choice": "str"}
+          "choice": "str", "boolean": "bool"}
 _LEVELS = {POSITION: "position", VELOCITY: "velocity", ACCELERATION: "acceleration",
            FORCE: "force"}
 

@@ -15,7 +15,7 @@ from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
 from .errors import (MobilityError, ModelError, Pam2ExuError, SolverError, TranslationError)
 from .export import export
-from .errors import ConditionWarning, ConsistencyWarning, RedundancyWarning
+from .errors import ConditionWarning, ConsistencyWarning, RedundancyWarning, VariationWarning
 from .model import Law, Model, Solid, load, loads
 from .pictures import animate, draw
 from .results import CompareInputError, Comparison, Results, plot, read_csv
@@ -138,4 +138,4 @@ __all__ = ["Model", "Solid", "Law", "load", "loads", "run", "Results", "read_csv
            "Spring", "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError",
            "ModelError", "MobilityError", "SolverError", "TranslationError",
            "CompareInputError", "PictureError", "RedundancyWarning", "ConsistencyWarning",
-           "ConditionWarning"]
+           "ConditionWarning", "VariationWarning"]

@@ -3,6 +3,9 @@ what it means."""
 from __future__ import annotations
 
 import difflib
+import os
+import sys
+import warnings
 from dataclasses import dataclass
 
 
@@ -271,3 +274,26 @@ class ConditionWarning(UserWarning):
     message : str
         Where [s], how ill-conditioned, and the error to expect.
     """
+
+
+class VariationWarning(UserWarning):
+    """A ``[[variation]]`` varies a point or line that no constraint uses: it has no effect.
+
+    Issued once per model when it is validated (``load``, ``loads``, ``Model.validate``,
+    ``Model.mechanism``), naming the entry and its anchor; ``Model.warnings()`` lists the
+    same texts. Variations are read by the clearance analysis only (shared/spec/clearance.md).
+
+    Parameters
+    ----------
+    message : str
+        The entry, its anchor, and that no constraint element anchors it.
+    """
+
+
+def warn_outside(text: str, category) -> None:
+    """``warnings.warn`` at the caller's first line outside the pam2exu package."""
+    package = os.path.dirname(os.path.abspath(__file__))
+    frame, level = sys._getframe(1), 2
+    while frame is not None and frame.f_code.co_filename.startswith(package):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(text, category, stacklevel=level)

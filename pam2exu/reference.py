@@ -59,6 +59,8 @@ def _default(cls: type[Element], key: str) -> str:
     value = None if field is None else field.default
     if value is None:
         return "–"
+    if isinstance(value, bool):
+        return f"`{str(value).lower()}`"          # as TOML writes it
     if isinstance(value, tuple):
         if all(v == 0 for v in value):
             return "zeros"
@@ -128,7 +130,8 @@ def elements_markdown() -> str:
         anchors = [anchor_meaning(cls, k) for k in range(2)] if len(cls.anchors) == 2 else \
             [anchor_meaning(cls, 0) if cls.anchors else "–", "–"]
         rows.append((f"[`{cls.type}`](#{cls.type}) [`{cls.alias}`]", *anchors,
-                     ", ".join(f"`{k}`" for k in cls.params) or "–", cls.summary))
+                     ", ".join(f"`{k}`" for k, p in cls.params.items() if not p.extension)
+                     or "–", cls.summary))
     lines = _table(("type [alias]", "anc1", "anc2", "other keys", "constraint or action"), rows)
     lines.append("")
     return "\n".join(lines) + "\n" + "\n".join(element_markdown(cls) for cls in ELEMENTS.values())

@@ -3,9 +3,6 @@ prepared from a model and the overrides, the mobility check, the warnings kept w
 and the Results table it ends in."""
 from __future__ import annotations
 
-import os
-import sys
-import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -13,7 +10,7 @@ import numpy as np
 from .. import registry
 from ..backend import Backend
 from ..elements import ACCELERATION, FORCE, POSITION, VELOCITY, Var
-from ..errors import ModelError, Problem, RedundancyWarning
+from ..errors import ModelError, Problem, RedundancyWarning, warn_outside
 from ..kinematics import State, column
 from ..model import Model, load
 from ..model.solid import SOLID_OUTPUTS
@@ -136,11 +133,7 @@ def warn_redundant(job: Job, q: np.ndarray) -> None:
 def warn(job: Job, text: str, category) -> None:
     """Keep a warning with the results and issue it at the caller's line outside pam2exu."""
     job.warnings.append(text)
-    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    frame, level = sys._getframe(1), 2
-    while frame is not None and frame.f_code.co_filename.startswith(package):
-        frame, level = frame.f_back, level + 1
-    warnings.warn(text, category, stacklevel=level)
+    warn_outside(text, category)
 
 
 def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Results:

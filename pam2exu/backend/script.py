@@ -192,8 +192,9 @@ class ScriptSystem(ExudynSystem):
             return ["# --- sensors: x, y, fi of every moving solid at every load step"]
         el = owner
         keys = [f"anc{k + 1} = {getattr(el, f'anc{k + 1}')!r}" for k in range(len(el.anchors))]
-        keys += [f"{key} = {getattr(el, key)!r}" for key in el.params
-                 if getattr(el, key) is not None]
+        keys += [f"{key} = {getattr(el, key)!r}" for key, param in el.params.items()
+                 if getattr(el, key) is not None
+                 and not (param.extension and not getattr(el, key))]   # clearance = False
         lines = [f"# --- {el.name}: {el.type} (PAM {el.alias}): {el.summary}",
                  f"#     {', '.join(keys)}"]
         if not self.builds(el):

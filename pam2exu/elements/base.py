@@ -22,6 +22,9 @@ from ..laws import LAW_ALIASES, LAWS, Law, law_names
 
 #: What an output needs from an analysis, in the order analyses can provide it.
 POSITION, VELOCITY, ACCELERATION, FORCE = "position", "velocity", "acceleration", "force"
+#: the level of a joint's clearance parameters (``Element.clearance_parameters``): given by
+#: the clearance analysis only (shared/spec/clearance.md)
+CLEARANCE = "clearance"
 
 
 @dataclass(frozen=True)
@@ -40,12 +43,15 @@ class Var:
 class Param:
     """A key an element takes besides name, anc1 and anc2."""
 
-    kind: str            # "constants", "number", "law", "solid", "choice"
+    kind: str            # "constants", "number", "law", "solid", "choice", "boolean"
     meaning: str
     size: int = 4        # for constants: at most this many
     choices: tuple = ()
     required: bool = False
     limit: float = VALUE     # for numbers and constants: the largest magnitude allowed
+    #: the specification that adds the key to the model format (e.g. "clearance.md"), for
+    #: keys beyond model-format.md's element table; None for the contract's own keys
+    extension: str | None = None
 
     def problem(self, key: str, value: Any) -> str | None:
         if value is None:
@@ -81,6 +87,8 @@ class Param:
                         f"got {value!r}{closest(value, self.choices)}")
         elif self.kind == "solid" and not isinstance(value, str):
             return f"'{key}' must be a solid name, got {value!r}"
+        elif self.kind == "boolean" and not isinstance(value, bool):
+            return f"'{key}' must be true or false ({self.meaning}), got {value!r}"
         return None
 
 
@@ -136,6 +144,9 @@ class Element:
     params: ClassVar[dict[str, Param]] = {}
     #: output variables, PAM names
     outputs: ClassVar[tuple[Var, ...]] = ()
+    #: the joint's clearance parameters j (name, unit, meaning) when it has
+    #: ``clearance = true`` (shared/spec/clearance.md); empty: the type takes no clearance
+    clearance_parameters: ClassVar[tuple[Var, ...]] = ()
     #: number of constraint equations it adds (0: a force element)
     equations: ClassVar[int] = 0
     #: a constraint element's reaction, as reported: the names of the (force x, force y,

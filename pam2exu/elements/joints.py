@@ -8,7 +8,12 @@ import numpy as np
 
 from ..kinematics import stack
 from ..limits import ANGLE
-from .base import FORCE, Element, Param, Var, number
+from .base import CLEARANCE, FORCE, Element, Param, Var, number
+
+#: ``clearance = true``: the joint gets clearance parameters (shared/spec/clearance.md)
+_CLEARANCE = Param("boolean", "true: the joint has clearance parameters, which the clearance "
+                   "analysis follows; the other analyses treat the joint as ideal",
+                   extension="clearance.md")
 
 
 @dataclass(eq=False)
@@ -73,6 +78,14 @@ class Revolute(Element):
     )
     equations = 2
     wrench = ("Fx", "Fy", None)
+    clearance: bool = False
+    params = {"clearance": _CLEARANCE}
+    clearance_parameters = (
+        Var("jx", "m", CLEARANCE, "x of P2 − P1, from solid 1's point (anc1) to solid 2's "
+            "point (anc2), global basis"),
+        Var("jy", "m", CLEARANCE, "y of P2 − P1, from solid 1's point (anc1) to solid 2's "
+            "point (anc2), global basis"),
+    )
 
     def report_frame(self, st):
         """At the joint, global basis."""
@@ -120,6 +133,14 @@ class Prismatic(Element):
     )
     equations = 2
     wrench = (None, "Fnormal", "Mz")
+    clearance: bool = False
+    params = {"clearance": _CLEARANCE}
+    clearance_parameters = (
+        Var("jn", "m", CLEARANCE, "n1·(p2 − p1): signed distance of line 2's defining point "
+            "from line 1 (n1: line 1's direction turned +90°)"),
+        Var("jfi", "rad", CLEARANCE, "(fi2 + α2) − (fi1 + α1) − kπ: angle of line 2 relative "
+            "to line 1 (k: the sense chosen at assembly)"),
+    )
 
     def report_frame(self, st):
         """At the defining point of solid 2's line, x along that line (its own sense)."""
@@ -170,6 +191,12 @@ class PinSlot(Element):
                    "force the guide (solid 1) exerts on the pin (solid 2), normal to the guide"),)
     equations = 1
     wrench = (None, "Fnormal", None)
+    clearance: bool = False
+    params = {"clearance": _CLEARANCE}
+    clearance_parameters = (
+        Var("jn", "m", CLEARANCE, "n1·(P2 − p1): signed distance of the pin from the guide "
+            "(n1: the guide's direction turned +90°)"),
+    )
 
     def report_frame(self, st):
         """At the pin, x along the guide (its own sense)."""

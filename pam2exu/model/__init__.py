@@ -3,5 +3,7 @@ from ..laws import LAWS, Law
 from .loader import load, loads
 from .model import Analysis, Mechanism, Model
 from .solid import Solid
+from .variation import Variation, ramped_cosine
 
-__all__ = ["Model", "Solid", "Analysis", "Mechanism", "Law", "LAWS", "load", "loads"]
+__all__ = ["Model", "Solid", "Analysis", "Mechanism", "Variation", "ramped_cosine", "Law", "LAWS",
+           "load", "loads"]

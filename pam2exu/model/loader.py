@@ -4,22 +4,25 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from ..elements import ALIASES, ELEMENTS
+from ..elements import ALIASES, ELEMENTS, misplaced_clearance
 from ..errors import ModelError, Problem, closest
 from .model import Analysis, Model
 from .solid import Solid
+from .variation import KEYS as _VARIATION_KEYS
+from .variation import Variation
 
 _MODEL_KEYS = ("name", "gravity")
 _SOLID_KEYS = ("name", "x", "y", "fi", "mass", "inertia", "cog", "points", "lines")
 _ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs", "backend")
-_TABLES = ("model", "solid", "element", "analysis")
+_TABLES = ("model", "solid", "element", "variation", "analysis")
 
 
 def load(path: str | Path) -> Model:
     """Read a model file; raises ModelError naming the file and every problem in it.
 
     The file is TOML with the tables ``[model]`` (name, gravity), ``[[solid]]``,
-    ``[[element]]`` and ``[analysis]`` (type, t_end, steps, outputs, backend); the format is
+    ``[[element]]``, ``[[variation]]`` (the clearance analysis's dimension variations) and
+    ``[analysis]`` (type, t_end, steps, outputs, backend); the format is
     docs/model-format.md. Every problem is collected before the error is raised; mobility
     is checked later, by ``run``.
 
@@ -173,13 +176,21 @@ def loads(text: str, source: str = "<string>") -> Model:
             continue
         keys = {key: v for key, v in entry.items() if key != "type" and key in cls.keys()}
         added = model.add(cls(**keys, position=k))      # names it <type><n> when unnamed
-        _unknown_keys(entry, cls.keys(), added.where, problems)
+        if "clearance" in entry and "clearance" not in cls.keys():
+            problems.append(Problem(added.where, misplaced_clearance(cls.type)))
+        _unknown_keys({key: v for key, v in entry.items() if key != "clearance"}, cls.keys(),
+                      added.where, problems)
+    for k, entry in enumerate(_array(data, "variation", problems), start=1):
+        added = model.add_variation(Variation(
+            **{key: v for key, v in entry.items() if key in _VARIATION_KEYS}, position=k))
+        _unknown_keys(entry, _VARIATION_KEYS, added.where, problems)
     table = _table(data, "analysis", problems)
     _unknown_keys(table, _ANALYSIS_KEYS, "[analysis]", problems)
     model.analysis = Analysis(**{k: v for k, v in table.items() if k in _ANALYSIS_KEYS})
     problems += model.problems()
     if problems:
         raise ModelError(problems, source)
+    model.issue_warnings()
     return model
 
 

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 from ..elements import Element
 from ..kinematics import PER_SOLID
 from .solid import Scope, Solid
+from .variation import Variation
 
 if TYPE_CHECKING:                      # the annotation only: model.py imports this module
     from .model import Model
@@ -43,6 +44,9 @@ class Mechanism:
         Number of constraint equations.
     index : dict
         Solid name → index i (its coordinates are q[3i:3i+3]).
+    variations : list of Variation
+        Copies of the model's variations, bound to their point or line (``kind``, ``ref``,
+        ``nominal``, ``offsets(t)``); read by the clearance analysis only.
     """
 
     model: Model
@@ -67,6 +71,32 @@ class Mechanism:
         self.rows = rows
         self.n_equations = start
         self.index = scope.index
+        self.variations = [copy.copy(v) for v in self.model.variations]
+        for v in self.variations:
+            v.bind(scope)
+        self._varied = {(v.kind, v.anchor): v for v in self.variations}
+
+    def variation(self, element: Element, k: int) -> Variation | None:
+        """The variation of anchor ``k`` (0: anc1, 1: anc2) of ``element``, or None.
+
+        A variation applies wherever its point or line is an anchor: where the element
+        names it as ``"solid.point"`` or ``"solid.line"`` (a bare solid name is never
+        varied).
+
+        Parameters
+        ----------
+        element : Element
+            One of ``elements``.
+        k : int
+            The anchor: 0 for anc1, 1 for anc2.
+
+        Returns
+        -------
+        Variation or None
+            The bound variation of that point or line (``offsets(t)``: u(t) − u0 and
+            u'(t)), or None when it does not vary.
+        """
+        return self._varied.get((element.anchors[k], getattr(element, f"anc{k + 1}")))
 
     @property
     def name(self) -> str:

@@ -8,11 +8,13 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 
 from .. import limits, registry
-from ..elements import ALIASES, ELEMENTS, Element
-from ..errors import ModelError, Problem, closest
+from ..elements import ALIASES, ELEMENTS, Element, misplaced_clearance
+from ..errors import ModelError, Problem, VariationWarning, closest, warn_outside
 from ..limits import is_number as _number
 from .mechanism import Mechanism
-from .solid import Scope, Solid
+from .solid import Scope, Solid, solid_problems
+from .variation import KEYS as VARIATION_KEYS
+from .variation import Variation, variation_problems
 
 
 @dataclass
@@ -108,8 +110,9 @@ class Analysis:
 class Model:
     """A PAM model: solids, elements and the analysis to run.
 
-    Build it in Python with ``add_solid`` and ``add``, or read it from a file with ``load``;
-    run it with ``pam2exu.run``. ``add_solid`` and ``add`` reject unknown keys and element
+    Build it in Python with ``add_solid``, ``add`` (and ``add_variation``, for the clearance
+    analysis), or read it from a file with ``load``; run it with ``pam2exu.run``.
+    ``add_solid`` and ``add`` reject unknown keys and element
     types at once; values, anchors and names are checked by ``problems``, ``validate``,
     ``mechanism`` and ``run``, which report every problem at once. ``model[name]`` is the
     solid or element of that name (``KeyError`` when there is none).
@@ -139,6 +142,9 @@ class Model:
     analysis : Analysis
         The default analysis settings (``[analysis]`` of a file): kinematic, t_end = 1 s,
         100 steps, every output.
+    variations : list of Variation
+        The dimension variations (``[[variation]]``), in the order they were added; read by
+        the clearance analysis only.
 
     Examples
     --------
@@ -166,7 +172,9 @@ class Model:
 
         self.solids: list[Solid] = []
         self.elements: list[Element] = []
+        self.variations: list[Variation] = []
         self.analysis = Analysis()
+        self._warned: set[str] = set()
 
     # ---- building ----------------------------------------------------------------------
     def add_solid(self, solid: Solid | str, **keys) -> Solid:
@@ -270,7 +278,8 @@ class Model:
             cls = ELEMENTS[kind]
             unknown = [k for k in keys if k not in {f.name for f in fields(cls)}]
             if unknown:
-                raise ModelError([f"a {kind} has no key '{k}'{closest(k, cls.keys())}; its keys "
+                raise ModelError([misplaced_clearance(kind) if k == "clearance" else
+                                  f"a {kind} has no key '{k}'{closest(k, cls.keys())}; its keys "
                                   f"are: {', '.join(cls.keys()[1:])}" for k in unknown],
                                  self.source)
             element = cls(**keys)
@@ -287,6 +296,50 @@ class Model:
 
     add_element = add
 
+    def add_variation(self, variation: Variation | str | None = None, **keys) -> Variation:
+        """Add a dimension variation (a ``[[variation]]``; only the clearance analysis reads it).
+
+        Parameters
+        ----------
+        variation : Variation or str, optional
+            A Variation, or the anchor of a new one (``"solid.point"`` or ``"solid.line"``;
+            or give it as ``anchor=``).
+        **keys
+            The new variation's keys, as for ``Variation``: ``anchor``, ``dx``, ``dy`` [m],
+            ``dangle`` [rad], ``w``, ``wx``, ``wy``, ``wangle`` [rad/s], ``tau`` [s].
+
+        Returns
+        -------
+        Variation
+            The variation added (its ``position`` set to its number when unset).
+
+        Raises
+        ------
+        ModelError
+            A key that a variation does not have (the message suggests the nearest). Values
+            and the anchor are checked later, by ``problems``.
+
+        Examples
+        --------
+        >>> m = Model("demo")
+        >>> m.add_variation("ground.O2", dx=3.7e-4, wx=1.91).where
+        "[[variation]] #1 (anchor 'ground.O2')"
+        """
+        if not isinstance(variation, Variation):
+            unknown = [k for k in keys if k not in VARIATION_KEYS]
+            if unknown:
+                raise ModelError([f"a variation has no key '{k}'{closest(k, VARIATION_KEYS)}; "
+                                  f"its keys are: {', '.join(VARIATION_KEYS)}" for k in unknown],
+                                 self.source)
+            variation = Variation(variation, **keys) if variation is not None \
+                else Variation(**keys)
+        elif keys:
+            raise TypeError("add_variation: keys given with a Variation object")
+        if variation.position is None:
+            variation.position = len(self.variations) + 1
+        self.variations.append(variation)
+        return variation
+
     def __getitem__(self, name: str) -> Solid | Element:
         """The solid or element named ``name``; KeyError (suggesting the nearest) if none."""
         for item in (*self.solids, *self.elements):
@@ -300,7 +353,8 @@ class Model:
         """Every problem in the model, in file order (empty when the model is sound).
 
         Checks gravity, each solid's values, each element's keys and anchors, that names are
-        unique (solids and elements share one namespace), and the ``analysis`` settings. It
+        unique (solids and elements share one namespace), each variation's values and anchor
+        (a declared point or line, varied once), and the ``analysis`` settings. It
         does not check mobility, which needs the numerics: ``run`` does, and raises
         ``MobilityError`` when a degree of freedom is not driven.
 
@@ -333,29 +387,58 @@ class Model:
                                           f"{limits.MODEL_NAME} are allowed"))
         seen: dict[str, str] = {}
         for solid in self.solids:
-            out += [Problem(solid.where, m) for m in _solid_problems(solid)]
+            out += [Problem(solid.where, m) for m in solid_problems(solid)]
             _unique(solid.name, solid.where, seen, out)
         scope = Scope(self.solids)
         scope.elements = self.elements
         for el in self.elements:
             _unique(el.name, el.where, seen, out)
             out += [Problem(el.where, m) for m in el.problems(scope)]
+        out += [Problem(*p) for p in variation_problems(self.variations, scope,
+                                                         self.elements)[0]]
         out += [Problem("[analysis]", m) for m in self.analysis.problems()]
         if not self.solids:
             out.append(Problem("model", "there are no solids: add at least one [[solid]]"))
         return out
 
     def validate(self) -> None:
-        """Raise ModelError listing every problem, if there is any.
+        """Raise ModelError listing every problem, if there is any; else issue ``warnings()``.
 
         Raises
         ------
         ModelError
             ``problems()`` is not empty; the error's ``problems`` lists them all.
+
+        Warns
+        -----
+        VariationWarning
+            A varied point or line that no constraint uses (once per model and text).
         """
         problems = self.problems()
         if problems:
             raise ModelError(problems, self.source)
+        self.issue_warnings()
+
+    def warnings(self) -> list[Problem]:
+        """What is suspect but allowed: each varied point or line that no constraint uses.
+
+        Returns
+        -------
+        list of Problem
+            Each with ``where`` (``"[[variation]] #1 (anchor 'ground.O2')"``) and
+            ``message``; ``validate`` issues them as ``VariationWarning``.
+        """
+        scope = Scope(self.solids)
+        return [Problem(*p) for p in variation_problems(self.variations, scope,
+                                                         self.elements)[1]]
+
+    def issue_warnings(self) -> None:
+        """Issue each of ``warnings()`` not issued yet for this model (VariationWarning)."""
+        for problem in self.warnings():
+            if str(problem) not in self._warned:
+                self._warned.add(str(problem))
+                warn_outside(f"{self.source}: {problem}" if self.source else str(problem),
+                             VariationWarning)
 
     def mechanism(self) -> "Mechanism":
         """The validated, resolved model (raises ModelError).
@@ -385,70 +468,3 @@ def _unique(name, where, seen, out):
                                   "solids and elements share one namespace, rename one of them"))
     else:
         seen[name] = where
-
-
-def _pair(v) -> bool:
-    return isinstance(v, (list, tuple)) and len(v) == 2 and all(_number(x) for x in v)
-
-
-#: a solid's numbers: (key, range, unit)
-_SOLID_NUMBERS = (("x", limits.LENGTH, "m"), ("y", limits.LENGTH, "m"),
-                  ("fi", limits.ANGLE, "rad"), ("mass", limits.VALUE, "kg"),
-                  ("inertia", limits.VALUE, "kg·m²"))
-
-
-def range_problems(what: str, value, limit: float, unit: str) -> list[str]:
-    """A message when a number's magnitude exceeds its range (a unit error, most likely)."""
-    if limits.out_of_range(value, limit):
-        return [f"{what} = {value:g} {unit} is out of range: its magnitude must be at most "
-                f"{limit:g} {unit} (are the units right?)"]
-    return []
-
-
-def _point_range(what: str, p) -> list[str]:
-    """Range messages of the coordinates [x, y] of a point [m]."""
-    return [m for c, v in zip("xy", p)
-            for m in range_problems(f"{what} {c}", v, limits.LENGTH, "m")]
-
-
-def _solid_problems(s: Solid) -> list[str]:
-    out = []
-    for key, limit, unit in _SOLID_NUMBERS:
-        value = getattr(s, key)
-        if not _number(value):
-            out.append(f"{key} must be a number, got {value!r}")
-        out += range_problems(key, value, limit, unit)
-    for key in ("mass", "inertia"):
-        if _number(getattr(s, key)) and getattr(s, key) < 0:
-            out.append(f"{key} is negative ({getattr(s, key)}): it must be ≥ 0")
-    if not _pair(s.cog):
-        out.append(f"cog must be [x, y] in the local frame, got {s.cog!r}")
-    else:
-        out += _point_range("cog", s.cog)
-    if not isinstance(s.points, dict):
-        out.append(f"points must be a table {{ A = [x, y] }}, got {s.points!r}")
-    else:
-        for name, p in s.points.items():
-            if not _pair(p):
-                out.append(f"point '{name}' must be [x, y], got {p!r}")
-            else:
-                out += _point_range(f"point '{name}'", p)
-    if not isinstance(s.lines, dict):
-        out.append(f"lines must be a table {{ l = {{ point = [x, y], angle = a }} }}, got {s.lines!r}")
-        return out
-    for name, line in s.lines.items():
-        if not isinstance(line, dict):
-            out.append(f"line '{name}' must be {{ point = [x, y], angle = a }}, got {line!r}")
-            continue
-        for key in line:
-            if key not in ("point", "angle"):
-                out.append(f"line '{name}' has an unknown key '{key}'{closest(key, ('point', 'angle'))}")
-        if "point" in line and not _pair(line["point"]):
-            out.append(f"line '{name}': point must be [x, y], got {line['point']!r}")
-        elif "point" in line:
-            out += _point_range(f"line '{name}' point", line["point"])
-        if "angle" in line and not _number(line["angle"]):
-            out.append(f"line '{name}': angle must be a number [rad], got {line['angle']!r}")
-        out += range_problems(f"line '{name}' angle", line.get("angle"), limits.ANGLE, "rad")
-
-    return out

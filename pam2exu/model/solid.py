@@ -6,8 +6,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..elements.base import ACCELERATION, POSITION, VELOCITY, Var
+from .. import limits
 from ..errors import closest
-from ..limits import shown
+from ..limits import is_number, shown
 
 
 @dataclass(eq=False)
@@ -191,3 +192,71 @@ class Scope:
     def resolve(self, kind: str, text: str):
         """kind is 'solid', 'point' or 'line'."""
         return getattr(self, kind)(text)
+
+
+def _pair(v) -> bool:
+    return isinstance(v, (list, tuple)) and len(v) == 2 and all(is_number(x) for x in v)
+
+
+#: a solid's numbers: (key, range, unit)
+_SOLID_NUMBERS = (("x", limits.LENGTH, "m"), ("y", limits.LENGTH, "m"),
+                  ("fi", limits.ANGLE, "rad"), ("mass", limits.VALUE, "kg"),
+                  ("inertia", limits.VALUE, "kg·m²"))
+
+
+def range_problems(what: str, value, limit: float, unit: str) -> list[str]:
+    """A message when a number's magnitude exceeds its range (a unit error, most likely)."""
+    if limits.out_of_range(value, limit):
+        return [f"{what} = {value:g} {unit} is out of range: its magnitude must be at most "
+                f"{limit:g} {unit} (are the units right?)"]
+    return []
+
+
+def _point_range(what: str, p) -> list[str]:
+    """Range messages of the coordinates [x, y] of a point [m]."""
+    return [m for c, v in zip("xy", p)
+            for m in range_problems(f"{what} {c}", v, limits.LENGTH, "m")]
+
+
+def solid_problems(s: Solid) -> list[str]:
+    """Every problem with a solid's values (``Model.problems`` puts them under its place)."""
+    out = []
+    for key, limit, unit in _SOLID_NUMBERS:
+        value = getattr(s, key)
+        if not is_number(value):
+            out.append(f"{key} must be a number, got {value!r}")
+        out += range_problems(key, value, limit, unit)
+    for key in ("mass", "inertia"):
+        if is_number(getattr(s, key)) and getattr(s, key) < 0:
+            out.append(f"{key} is negative ({getattr(s, key)}): it must be ≥ 0")
+    if not _pair(s.cog):
+        out.append(f"cog must be [x, y] in the local frame, got {s.cog!r}")
+    else:
+        out += _point_range("cog", s.cog)
+    if not isinstance(s.points, dict):
+        out.append(f"points must be a table {{ A = [x, y] }}, got {s.points!r}")
+    else:
+        for name, p in s.points.items():
+            if not _pair(p):
+                out.append(f"point '{name}' must be [x, y], got {p!r}")
+            else:
+                out += _point_range(f"point '{name}'", p)
+    if not isinstance(s.lines, dict):
+        out.append(f"lines must be a table {{ l = {{ point = [x, y], angle = a }} }}, got {s.lines!r}")
+        return out
+    for name, line in s.lines.items():
+        if not isinstance(line, dict):
+            out.append(f"line '{name}' must be {{ point = [x, y], angle = a }}, got {line!r}")
+            continue
+        for key in line:
+            if key not in ("point", "angle"):
+                out.append(f"line '{name}' has an unknown key '{key}'{closest(key, ('point', 'angle'))}")
+        if "point" in line and not _pair(line["point"]):
+            out.append(f"line '{name}': point must be [x, y], got {line['point']!r}")
+        elif "point" in line:
+            out += _point_range(f"line '{name}' point", line["point"])
+        if "angle" in line and not is_number(line["angle"]):
+            out.append(f"line '{name}': angle must be a number [rad], got {line['angle']!r}")
+        out += range_problems(f"line '{name}' angle", line.get("angle"), limits.ANGLE, "rad")
+
+    return out

@@ -127,7 +127,7 @@ def test_unknown_key_in_analysis():
 
 def test_unknown_top_level_table():
     with pytest.raises(ModelError, match=r"\[modle\]: unknown table \(did you mean 'model'\?\); "
-                                         r"a model has model, solid, element, analysis"):
+                                         r"a model has model, solid, element, variation, analysis"):
         loads('[modle]\nname = "x"\n' + SOLIDS)
 
 
