@@ -43,7 +43,7 @@ class Equations:
     parts: list
 
 
-def _target(target, t, m):
+def target_values(target, t, m):
     """(f, f', f'') of a constraint's right-hand side, each (n, m) or broadcastable."""
     if isinstance(target, Law):
         f, df, ddf = target(t)
@@ -62,7 +62,7 @@ def equations(mech, st: State, jacobian: bool = True) -> Equations:
     for el, rows in zip(mech.constraints, mech.rows):
         v, target = el.constraint(st)
         parts.append(v)
-        f, df, ddf = _target(target, st.t, el.equations)
+        f, df, ddf = target_values(target, st.t, el.equations)
         residual[:, rows] = v.value - f
         c_t[:, rows] = -np.broadcast_to(df, (n, el.equations))
         if jac is not None:

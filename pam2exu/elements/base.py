@@ -147,6 +147,9 @@ class Element:
     #: the joint's clearance parameters j (name, unit, meaning) when it has
     #: ``clearance = true`` (shared/spec/clearance.md); empty: the type takes no clearance
     clearance_parameters: ClassVar[tuple[Var, ...]] = ()
+    #: F_j of its rows: parameter k enters equation row r of ``clearance_constraint`` as
+    #: clearance_terms[r][k] · j_k (the closure F = C(q, t) + F_j j is linear in j)
+    clearance_terms: ClassVar[tuple[tuple[float, ...], ...]] = ()
     #: number of constraint equations it adds (0: a force element)
     equations: ClassVar[int] = 0
     #: a constraint element's reaction, as reported: the names of the (force x, force y,
@@ -228,6 +231,12 @@ class Element:
     def constraint(self, st: State) -> tuple[Quantity, Any]:
         """(v, target): the equations v(q) − target(t) = 0, target a constant or a Law."""
         raise NotImplementedError(f"{self.type} adds no constraint")
+
+    def clearance_constraint(self, st: State, start: State) -> tuple[Quantity, Any]:
+        """(v, target) of its rows C(q, t) when it has clearance (``clearance_terms`` adds
+        F_j j): ``constraint`` unless the type says otherwise; ``start`` is the nominal
+        assembly, for what it fixes (a prismatic's sense)."""
+        return self.constraint(st)
 
     def compute(self, st: State, names: set[str]) -> dict[str, np.ndarray]:
         """Position- and velocity-level outputs (force outputs come from the force analyses)."""

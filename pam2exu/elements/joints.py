@@ -1,12 +1,13 @@
 """Joints: fixed link, revolute, prismatic, pin-in-slot and gear transmission."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..kinematics import stack
+from ..kinematics import column, stack
 from ..limits import ANGLE
 from .base import CLEARANCE, FORCE, Element, Param, Var, number
 
@@ -86,6 +87,8 @@ class Revolute(Element):
         Var("jy", "m", CLEARANCE, "y of P2 − P1, from solid 1's point (anc1) to solid 2's "
             "point (anc2), global basis"),
     )
+    #: C = P2 − P1 (``constraint``), F = C − j: the contract's P1 − P2 + j = 0
+    clearance_terms = ((-1.0, 0.0), (0.0, -1.0))
 
     def report_frame(self, st):
         """At the joint, global basis."""
@@ -141,6 +144,9 @@ class Prismatic(Element):
         Var("jfi", "rad", CLEARANCE, "(fi2 + α2) − (fi1 + α1) − kπ: angle of line 2 relative "
             "to line 1 (k: the sense chosen at assembly)"),
     )
+    #: rows C = ((p1 − p2)·n1, fi2 − fi1 − (α1 − α2 + kπ)) (``clearance_constraint``),
+    #: F = C + (jn, −jfi): the contract's n1·(p2 − p1) − jn = 0 and its angle equation
+    clearance_terms = ((1.0, 0.0), (0.0, -1.0))
 
     def report_frame(self, st):
         """At the defining point of solid 2's line, x along that line (its own sense)."""
@@ -154,6 +160,17 @@ class Prismatic(Element):
         parallel = st.direction(line2.solid, line2.direction).dot(
             st.direction(line1.solid, line1.normal))
         return stack(_on_line(st, line1, line2.solid, line2.point), parallel), 0.0
+
+    def clearance_constraint(self, st, start):
+        """(p1 − p2)·n1 and fi2 − fi1 − (α1 − α2 + kπ), k the sense at the nominal assembly
+        ``start`` (the contract's angle equation: linear in the angles, so jfi is an angle)."""
+        line1, line2 = self.refs
+        relative = st.angle(line2.solid) - st.angle(line1.solid)
+        at_start = (start.q[0, column(line2.solid, 2)] + line2.angle
+                    - start.q[0, column(line1.solid, 2)] - line1.angle)
+        sense = round(at_start / math.pi)
+        return (stack(_on_line(st, line1, line2.solid, line2.point), relative),
+                np.array([0.0, line1.angle - line2.angle + sense * math.pi]))
 
     def build(self, ex):
         line1, line2 = self.refs
@@ -197,6 +214,8 @@ class PinSlot(Element):
         Var("jn", "m", CLEARANCE, "n1·(P2 − p1): signed distance of the pin from the guide "
             "(n1: the guide's direction turned +90°)"),
     )
+    #: C = (p1 − P2)·n1 (``constraint``), F = C + jn: the contract's n1·(P2 − p1) − jn = 0
+    clearance_terms = ((1.0,),)
 
     def report_frame(self, st):
         """At the pin, x along the guide (its own sense)."""

@@ -1,0 +1,90 @@
+"""The closure equations of a mechanism with clearance joints, at its varied dimensions.
+
+``Closures`` evaluates, for the clearance analysis (shared/spec/clearance.md), the closure
+F(u(t), j, q, r(t)) = C(q, t) + F_j j of a mechanism at one time: every constraint element's
+rows (``Element.constraint``, or ``Element.clearance_constraint`` where the element has
+``clearance = true``), with the points and lines of the ``[[variation]]`` entries at u(t),
+and F_j from the clearance elements' ``clearance_terms``. The mathematics of the least-norm
+clearance it feeds is ``least_norm``.
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import replace
+
+import numpy as np
+
+from ..kinematics import State
+from ..model.solid import LineRef
+from .least_norm import Closure
+from .native import target_values
+
+
+class Closures:
+    """The closure of ``mech`` at any time, with its clearance parameters laid out.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The validated mechanism (its ``variations`` bound).
+    start : numpy.ndarray
+        q at the nominal assembly (what a prismatic's sense is read from).
+    """
+
+    def __init__(self, mech, start: np.ndarray):
+        self.mech = mech
+        self.start = State([0.0], np.asarray(start, dtype=float)[None])
+        #: the clearance elements, in element order, and the names of their parameters
+        self.elements = [el for el in mech.constraints if getattr(el, "clearance", False)]
+        self.names = [f"{el.name}.{var.name}" for el in self.elements
+                      for var in el.clearance_parameters]
+        self.p, self.nq, self.m = len(self.names), mech.nq, mech.n_equations
+        self.Fj = np.zeros((self.m, self.p))
+        k = 0
+        for el, rows in zip(mech.constraints, mech.rows):
+            if el in self.elements:
+                width = len(el.clearance_parameters)
+                self.Fj[rows, k:k + width] = np.asarray(el.clearance_terms, dtype=float)
+                k += width
+
+    def at(self, t: float) -> list:
+        """The constraint elements with their varied points and lines at time t (copies;
+        the elements whose anchors do not vary are the mechanism's own)."""
+        out = []
+        for el in self.mech.constraints:
+            refs = list(el.refs)
+            for k, ref in enumerate(refs):
+                variation = self.mech.variation(el, k)
+                if variation is not None:
+                    refs[k] = _moved(ref, variation.offsets(np.array([t]))[0][0])
+            if refs != list(el.refs):
+                el = copy.copy(el)
+                el.refs = tuple(refs)
+                el.ref1, el.ref2 = refs[0], refs[1] if len(refs) > 1 else None
+            out.append(el)
+        return out
+
+    def evaluate(self, t: float, q: np.ndarray, lam: np.ndarray) -> Closure:
+        """C (without F_j j), F_q, F_j and W = Σ λ_i ∂²F_i/∂q² at (t, q)."""
+        st = State([t], np.asarray(q, dtype=float)[None], hessians=True)
+        C = np.zeros(self.m)
+        Fq = np.zeros((1, self.m, self.nq))
+        W = np.zeros((1, self.nq, self.nq))
+        for el, rows in zip(self.at(t), self.mech.rows):
+            if getattr(el, "clearance", False):
+                v, target = el.clearance_constraint(st, self.start)
+            else:
+                v, target = el.constraint(st)
+            f = target_values(target, st.t, el.equations)[0]
+            C[rows] = (v.value - f)[0]
+            v.rows(Fq, rows.start)
+            v.weighted_hessian(np.asarray(lam, dtype=float)[None, rows], W)
+        return Closure(C, Fq[0], self.Fj, W[0])
+
+
+def _moved(ref, offset: np.ndarray):
+    """A point or line reference moved by u − u0 = (dx, dy, dangle) in its solid's frame."""
+    if isinstance(ref, LineRef):
+        return replace(ref, point=(ref.point[0] + offset[0], ref.point[1] + offset[1]),
+                       angle=ref.angle + offset[2])
+    return replace(ref, local=(ref.local[0] + offset[0], ref.local[1] + offset[1]))

@@ -1,0 +1,164 @@
+"""The closure of a mechanism with clearance joints (analyses/clearance.py) on the
+over-constrained parallelogram of tests/data/parallelogram5.toml (three cranks, one
+coupler: one self-stress), with clearance in pins A2 and A3.
+
+References: with no variation the least-norm clearance is 0 and the positions are the
+kinematic analysis's (shared/spec/clearance.md, item 4); with variations, SLSQP's minimum of
+½‖j‖² under the closure equations (scipy.optimize.minimize), and the contract's conditions
+1–3 computed from the rows alone.
+"""
+import warnings
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+import pam2exu
+from pam2exu.analyses import least_norm as ln
+from pam2exu.analyses.clearance import Closures
+
+
+def _model(request, variations=()):
+    model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
+    model["A2"].clearance = True
+    model["A3"].clearance = True
+    for v in variations:
+        model.add_variation(**v)
+    return model
+
+
+def _start(model, times):
+    """q of the kinematic analysis at ``times`` (nominal dimensions), and the closure."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = pam2exu.run(model, analysis="kinematic", t_end=float(times[-1]),
+                          steps=len(times) - 1)
+    mech = model.mechanism()
+    q = np.column_stack([res[f"{s.name}.{k}"] for s in mech.solids for k in ("x", "y", "fi")])
+    return mech, q
+
+
+VARIED = ({"anchor": "ground.O2", "dx": 3.7e-3, "dy": -2.9e-3, "wx": 1.91, "wy": 0.57},
+          {"anchor": "crank3.A", "dx": 2e-3, "tau": 0.2})
+
+
+def test_without_variations_the_clearance_is_zero_and_the_positions_kinematic(request):
+    times = np.linspace(0.0, 1.0, 21)
+    mech, q = _start(_model(request), times)
+    closures = Closures(mech, q[0])
+    assert closures.names == ["A2.jx", "A2.jy", "A3.jx", "A3.jy"]
+    y0 = np.r_[np.zeros(closures.p), q[0], np.zeros(closures.m)]
+    y, ok = ln.step_by_step(closures.evaluate, times, y0, closures.p, closures.nq)
+    assert ok.all()
+    assert np.max(np.abs(y[:, :closures.p])) < 1e-14
+    np.testing.assert_allclose(y[:, closures.p:closures.p + closures.nq], q, atol=1e-12)
+
+
+@pytest.fixture(scope="module")
+def varied(request):
+    """The clearance over 2 s with O2 and crank3.A varied (``VARIED``): by the slides' ODE
+    and by Newton step by step, from the nominal assembly."""
+    times = np.linspace(0.0, 2.0, 41)
+    _, q = _start(_model(request), np.array([0.0, 1e-3]))
+    closures = Closures(_model(request, VARIED).mechanism(), q[0])
+    y0 = np.r_[np.zeros(closures.p), q[0], np.zeros(closures.m)]
+    ode = ln.follow(closures.evaluate, ln.time_rate(closures.evaluate, closures.p), times, y0,
+                    closures.p, closures.nq)
+    newton = ln.step_by_step(closures.evaluate, times, y0, closures.p, closures.nq)
+    return times, closures, ode, newton
+
+
+def test_ode_and_newton_step_by_step_agree(varied):
+    times, closures, (ode, ok_ode), (newton, ok_newton) = varied
+    assert ok_ode.all() and ok_newton.all()
+    np.testing.assert_allclose(ode[:, :closures.p + closures.nq],
+                               newton[:, :closures.p + closures.nq], atol=1e-9)
+    assert np.max(np.abs(ode[:, :closures.p])) > 1e-4       # the variations need clearance
+
+
+def test_every_row_meets_the_contracts_conditions(varied):
+    times, closures, (ode, _), _ = varied
+    p, nq = closures.p, closures.nq
+    largest = np.max(np.abs(ode[:, :p]))
+    for t, y in zip(times, ode):
+        j, q, lam = ln.split(y, p, nq)
+        c = closures.evaluate(t, q, lam)
+        assert np.max(np.abs(c.F + c.Fj @ j)) <= 1e-10                     # 1. closure
+        assert ln.kkt_residual(j, c) <= 1e-8 * largest                       # 2. KKT
+        assert ln.applicability(c).hessian > 1e-9                            # 3. second order
+
+
+def test_the_clearance_is_the_least_norm_one(varied):
+    times, closures, (ode, _), _ = varied
+    p, nq = closures.p, closures.nq
+    for k in (10, 40):
+        t = times[k]
+
+        def closure(x):
+            c = closures.evaluate(t, x[p:], np.zeros(closures.m))
+            return c.F + c.Fj @ x[:p]
+
+        def jacobian(x):
+            c = closures.evaluate(t, x[p:], np.zeros(closures.m))
+            return np.hstack([c.Fj, c.Fq])
+
+        start = ode[k, :p + nq] + 1e-5
+        found = minimize(lambda x: 0.5 * x[:p] @ x[:p], start,
+                         jac=lambda x: np.r_[x[:p], np.zeros(nq)],
+                         constraints=[{"type": "eq", "fun": closure, "jac": jacobian}],
+                         method="SLSQP", options={"ftol": 1e-14, "maxiter": 1000})
+        assert found.success, found.message
+        np.testing.assert_allclose(ode[k, :p], found.x[:p], atol=1e-8)
+
+
+def test_a_revolutes_clearance_is_the_vector_between_its_points(varied):
+    """The contract's jx, jy = P2 − P1: from solid 1's point (anc1, crank2.A / crank3.A,
+    the latter varied) to solid 2's point (coupler.A2 / coupler.A3), global basis."""
+    from pam2exu.kinematics import State
+    times, closures, (ode, _), _ = varied
+    mech = closures.mech
+    index = {s.name: i for i, s in enumerate(mech.solids)}
+    for k in (5, 25, 40):
+        t, y = times[k], ode[k]
+        st = State([t], y[closures.p:closures.p + closures.nq][None])
+        # u = u0 + (1 − e^(−t/τ)) (Δ/2) cos(ω t), Δ = 2e-3, τ = 0.2, ω = 1
+        crank3_a = np.array([0.3 + (1 - np.exp(-t / 0.2)) * 1e-3 * np.cos(t), 0.0])
+        for name, crank, local, joint in (("A2", "crank2", [0.3, 0.0], 0),
+                                          ("A3", "crank3", crank3_a, 2)):
+            P1 = st.point(index[crank], local).value[0]
+            P2 = st.point(index["coupler"], [1.0 if name == "A2" else 0.5, 0.0]).value[0]
+            np.testing.assert_allclose(y[joint:joint + 2], P2 - P1, atol=1e-14, err_msg=name)
+
+
+def test_pin_slot_and_prismatic_rows_vanish_at_the_contracts_clearances():
+    """shared/spec/clearance.md: pin_slot jn = n1·(P2 − p1); prismatic jn = n1·(p2 − p1) and
+    jfi = (fi2 + α2) − (fi1 + α1) − kπ (n1: line 1's direction turned +90°, all in the
+    current configuration). At an arbitrary configuration, C + F_j j = 0 with exactly
+    those j, computed here from the geometry by hand."""
+    m = pam2exu.Model("rows", gravity=0.0)
+    m.add_solid("ground", lines={"rail": {"point": [0.1, -0.2], "angle": 0.3}})
+    m.add_solid("crank", points={"A": [0.25, 0.05]})
+    m.add_solid("slider", lines={"axis": {"point": [0.02, 0.03], "angle": 0.2}})
+    m.add("fixed", anc1="ground")
+    m.add("pin_slot", name="slot", anc1="ground.rail", anc2="crank.A", clearance=True)
+    m.add("prismatic", name="guide", anc1="ground.rail", anc2="slider.axis", clearance=True)
+    mech = m.mechanism()
+    q = np.array([0.0, 0.0, 0.0, 0.3, -0.1, 0.7, 0.5, 0.2, np.pi + 0.15])
+    closures = Closures(mech, q)                       # sense k = 1 (opposite) here
+    c = closures.evaluate(0.0, q, np.zeros(closures.m))
+
+    def rot(a, v):
+        return np.array([np.cos(a) * v[0] - np.sin(a) * v[1], np.sin(a) * v[0] + np.cos(a) * v[1]])
+
+    p1 = rot(0.0, [0.1, -0.2])                          # ground at the origin, fi = 0
+    n1 = rot(0.3, [0.0, 1.0])
+    P2 = q[3:5] + rot(q[5], [0.25, 0.05])
+    p2 = q[6:8] + rot(q[8], [0.02, 0.03])
+    jn_slot = n1 @ (P2 - p1)
+    jn_guide = n1 @ (p2 - p1)
+    jfi = (q[8] + 0.2) - (0.0 + 0.3) - np.pi
+    j = np.array([jn_slot, jn_guide, jfi])
+    assert closures.names == ["slot.jn", "guide.jn", "guide.jfi"]
+    rows = np.r_[mech.rows[1], mech.rows[2]]
+    np.testing.assert_allclose((c.F + c.Fj @ j)[rows], 0.0, atol=1e-15)
+    assert abs(jfi - 0.05) < 1e-15 and abs(jn_slot) > 0.1     # a real gap, a real angle
