@@ -14,9 +14,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..kinematics import State
+from ..errors import MobilityError, ModelError, SolverError
+from ..kinematics import PER_SOLID, State
 from ..model.solid import LineRef
-from .least_norm import Closure
+from .least_norm import RANK, Closure, applicability
 from .native import target_values
 
 
@@ -88,3 +89,59 @@ def _moved(ref, offset: np.ndarray):
         return replace(ref, point=(ref.point[0] + offset[0], ref.point[1] + offset[1]),
                        angle=ref.angle + offset[2])
     return replace(ref, local=(ref.local[0] + offset[0], ref.local[1] + offset[1]))
+
+
+# ---- when the method applies (shared/spec/clearance.md, "When the method applies") -------
+
+def loaded_elements(closures: Closures, stresses: np.ndarray) -> list[str]:
+    """The constraint elements whose rows a self-stress loads (stresses: (m, k), a basis of
+    the λ with [F_j F_q]ᵀλ = 0), in element order."""
+    size = np.max(np.abs(stresses), axis=1) if stresses.size else np.zeros(closures.m)
+    largest = float(np.max(size, initial=0.0))
+    return [el.name for el, rows in zip(closures.mech.constraints, closures.mech.rows)
+            if largest > 0 and np.max(size[rows]) > RANK * largest]
+
+
+def free_solids(mech, motions: np.ndarray) -> list[str]:
+    """The solids a free motion moves (motions: (nq, k), a basis of the δq with
+    F_q δq = 0), in solid order."""
+    size = np.max(np.abs(motions), axis=1) if motions.size else np.zeros(mech.nq)
+    largest = float(np.max(size, initial=0.0))
+    return [s.name for i, s in enumerate(mech.solids)
+            if largest > 0 and np.max(size[PER_SOLID * i:PER_SOLID * (i + 1)]) > RANK * largest]
+
+
+def require_applicable(closures: Closures, c: Closure, t: float) -> None:
+    """Raise the contract's error where the method does not apply at the start (λ = 0):
+    (i) a self-stress that loads no clearance parameter: ModelError naming the elements;
+    (ii) positions the closure and the command leave free: MobilityError naming the
+    solids. Both messages begin with ``t=<time>:``."""
+    found = applicability(c)
+    if found.self_stress.shape[1]:
+        names = ", ".join(f"'{n}'" for n in loaded_elements(closures, found.self_stress))
+        raise ModelError(
+            f"t={t:g}: condition (i) fails: the closure equations have a self-stress that no "
+            f"clearance parameter takes up (σ_min/σ_max of [F_j F_q] = "
+            f"{found.ratio_i:.3g}); it loads the elements {names}: declare clearance = true "
+            "on one of them (a revolute, pin_slot or prismatic), so that its clearance can "
+            "absorb the variations")
+    if found.free.shape[1] or found.hessian <= RANK:
+        names = ", ".join(f"'{n}'" for n in free_solids(closures.mech, found.free))
+        raise MobilityError(
+            f"t={t:g}: condition (ii) fails: the closure equations and the command do not "
+            f"fix every position (σ_min/σ_max of F_q = {found.ratio_ii:.3g}); the solids "
+            f"{names} are left free: an undriven degree of freedom (drive it with an "
+            "actuator) or a singular position (start elsewhere)")
+
+
+def require_strict_minimum(c: Closure, t: float) -> None:
+    """Raise SolverError where, at a later time, (i) or the reduced Hessian's condition
+    fails: the clearance followed is no longer a strict minimum."""
+    found = applicability(c)
+    if found.ratio_i <= RANK or found.hessian <= RANK:
+        raise SolverError(
+            f"t={t:g}: the clearance followed is no longer a strict minimum (σ_min/σ_max of "
+            f"[F_j F_q] = {found.ratio_i:.3g}, smallest eigenvalue of the reduced Hessian = "
+            f"{found.hessian:.3g}): a singular position or a bifurcation; the results stop "
+            "there", time=t)
+

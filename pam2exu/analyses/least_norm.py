@@ -92,8 +92,8 @@ class Applicability:
     ratio_i: float              # σ_min / σ_max of [F_j F_q]
     ratio_ii: float             # σ_min / σ_max of F_q
     hessian: float              # the smallest eigenvalue of Zᵀ W_full Z (``reduced_hessian``)
-    self_stress: np.ndarray     # a unit λ with [F_j F_q]ᵀ λ ≈ 0 (where (i) fails), else empty
-    free: np.ndarray            # a unit δq with F_q δq ≈ 0 (where (ii) fails), else empty
+    self_stress: np.ndarray     # (m, k): a basis of the λ with [F_j F_q]ᵀ λ ≈ 0 ((i) fails if k)
+    free: np.ndarray            # (nq, k): a basis of the δq with F_q δq ≈ 0 ((ii) fails if k)
 
     @property
     def holds(self) -> bool:
@@ -101,14 +101,16 @@ class Applicability:
 
 
 def _ratio_and_null(A: np.ndarray, side: str):
-    """(σ_min/σ_max, the singular vector of σ_min on ``side`` 'left' or 'right')."""
+    """(σ_min/σ_max, a basis of the null space on ``side``: 'left' (columns λ with Aᵀλ ≈ 0)
+    or 'right' (columns δ with A δ ≈ 0)), singular values ≤ RANK σ_max counting as 0."""
     U, s, Vt = np.linalg.svd(A)
     size = min(A.shape)
-    if side == "left":                   # rank < rows: a left null vector
+    lost = np.r_[s <= RANK * s[0], np.ones(max(A.shape) - size, dtype=bool)]
+    if side == "left":
         smallest = 0.0 if A.shape[0] > size else s[-1]
-        return smallest / s[0], U[:, -1]
+        return smallest / s[0], U[:, lost[:A.shape[0]]]
     smallest = 0.0 if A.shape[1] > size else s[-1]
-    return smallest / s[0], Vt[-1]
+    return smallest / s[0], Vt[lost[:A.shape[1]]].T
 
 
 def reduced_hessian(c: Closure) -> float:
@@ -131,9 +133,7 @@ def applicability(c: Closure) -> Applicability:
     """The conditions at a configuration (``Applicability``)."""
     ratio_i, stress = _ratio_and_null(np.hstack([c.Fj, c.Fq]), "left")
     ratio_ii, free = _ratio_and_null(c.Fq, "right")
-    return Applicability(ratio_i, ratio_ii, reduced_hessian(c),
-                         stress if ratio_i <= RANK else np.zeros(0),
-                         free if ratio_ii <= RANK else np.zeros(0))
+    return Applicability(ratio_i, ratio_ii, reduced_hessian(c), stress, free)
 
 
 def kkt_residual(j: np.ndarray, c: Closure) -> float:

@@ -162,3 +162,62 @@ def test_pin_slot_and_prismatic_rows_vanish_at_the_contracts_clearances():
     rows = np.r_[mech.rows[1], mech.rows[2]]
     np.testing.assert_allclose((c.F + c.Fj @ j)[rows], 0.0, atol=1e-15)
     assert abs(jfi - 0.05) < 1e-15 and abs(jn_slot) > 0.1     # a real gap, a real angle
+
+
+def _assembled(request, model):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = pam2exu.run(model, analysis="assembly")
+    mech = model.mechanism()
+    q0 = np.array([res[f"{s.name}.{k}"][0] for s in mech.solids for k in ("x", "y", "fi")])
+    closures = Closures(mech, q0)
+    return closures, closures.evaluate(0.0, q0, np.zeros(closures.m))
+
+
+def test_a_self_stress_without_clearance_fails_condition_i_naming_its_elements(request):
+    """The parallelogram's one self-stress runs through its six pins (the fixed link and
+    the motor carry none of it): with no clearance anywhere, (i) fails and names them."""
+    from pam2exu.analyses.clearance import require_applicable
+    model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
+    closures, c = _assembled(request, model)
+    with pytest.raises(pam2exu.ModelError) as error:
+        require_applicable(closures, c, 0.0)
+    text = str(error.value)
+    assert text.startswith("t=0: condition (i) fails")
+    assert "'O1', 'O2', 'O3', 'A1', 'A2', 'A3'" in text and "motor" not in text
+    assert "declare clearance = true on one of them" in text
+    model["A2"].clearance = True                         # one pin with clearance suffices
+    closures, c = _assembled(request, model)
+    require_applicable(closures, c, 0.0)
+
+
+def test_an_undriven_mechanism_fails_condition_ii_naming_its_solids(request):
+    from pam2exu.analyses.clearance import require_applicable
+    model = _model(request)
+    closures, _ = _assembled(request, model)
+    q0 = closures.start.q[0]
+    model.elements.remove(model["motor"])
+    closures = Closures(model.mechanism(), q0)
+    with pytest.raises(pam2exu.MobilityError) as error:
+        require_applicable(closures, closures.evaluate(0.0, q0, np.zeros(closures.m)), 0.0)
+    text = str(error.value)
+    assert text.startswith("t=0: condition (ii) fails")
+    assert "'crank1', 'crank2', 'crank3', 'coupler' are left free" in text
+    assert "'ground'" not in text
+
+
+def test_a_lost_strict_minimum_stops_the_run_at_its_time():
+    """Item 3 of the contract: a reduced Hessian with a non-positive eigenvalue (here W =
+    −5 I on a closure with a one-dimensional kernel where the δq part dominates) is a
+    SolverError at that time; the same closure with W = 0 passes."""
+    from pam2exu.analyses.clearance import require_strict_minimum
+    Fj = np.array([[1.0], [0.0]])
+    Fq = np.array([[0.1, 1.0], [1.0, 0.0]])
+    good = ln.Closure(np.zeros(2), Fq, Fj, np.zeros((2, 2)))
+    require_strict_minimum(good, 0.5)
+    bad = ln.Closure(np.zeros(2), Fq, Fj, -5.0 * np.eye(2))
+    assert ln.applicability(bad).hessian < 0
+    with pytest.raises(pam2exu.SolverError, match=r"^t=0\.5: the clearance followed is no "
+                                                  r"longer a strict minimum") as error:
+        require_strict_minimum(bad, 0.5)
+    assert error.value.time == 0.5

@@ -126,10 +126,11 @@ def test_the_conditions_name_what_fails():
     twin = ln.Closure(np.r_[c.F, c.F[2]], np.vstack([c.Fq, c.Fq[2]]),
                       np.vstack([FJ, [0.0, 0.0]]), c.W)
     found = ln.applicability(twin)
-    assert found.ratio_i <= ln.RANK and not found.holds
-    stress = found.self_stress / np.max(np.abs(found.self_stress))
+    assert found.ratio_i <= ln.RANK and not found.holds and found.self_stress.shape == (4, 1)
+    stress = found.self_stress[:, 0] / np.max(np.abs(found.self_stress))
     np.testing.assert_allclose(np.abs(stress), [0, 0, 1, 1], atol=1e-12)  # rows 3 and 4
     alone = ln.Closure(c.F[:1], c.Fq[:1], np.array([[1.0, 0.0]]), c.W)
     found = ln.applicability(alone)
-    assert found.ratio_ii <= ln.RANK and found.free.size == 2
+    assert found.ratio_ii <= ln.RANK and found.free.shape == (2, 1)
     np.testing.assert_allclose(c.Fq[0] @ found.free, 0.0, atol=1e-14)
+    assert ln.applicability(c).self_stress.shape == (3, 0)   # none where (i) holds
