@@ -20,7 +20,7 @@ import importlib
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from .elements.base import ACCELERATION, FORCE, POSITION, VELOCITY
+from .elements.base import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY
 
 
 def resolve(target: str | Callable) -> Any:
@@ -97,6 +97,11 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("kinetostatic", "cinetostatica", _ALL, driven=True, at_start=False,
                  summary="the kinematic analysis, then every force (inverse dynamics)",
                  function="pam2exu.analyses.kinetostatic:kinetostatic"),
+    AnalysisType("clearance", "joc", frozenset({POSITION, CLEARANCE}), driven=False,
+                 at_start=False,
+                 summary="the clearance of least norm of an over-constrained mechanism as "
+                 "its dimensions vary (shared/spec/clearance.md)",
+                 function="pam2exu.analyses.clearance:clearance"),
 )}
 
 #: the backends; the first is the default

@@ -17,8 +17,47 @@ import numpy as np
 from ..errors import MobilityError, ModelError, SolverError
 from ..kinematics import PER_SOLID, State
 from ..model.solid import LineRef
-from .least_norm import RANK, Closure, applicability
+from .job import Job, check_mobility, collect
+from .least_norm import RANK, Closure, applicability, follow, time_rate
 from .native import target_values
+from .positions import assemble
+
+
+def clearance(job: Job):
+    """x, y, fi of every solid and the parameters of every clearance joint over the
+    interval (shared/spec/clearance.md): the clearance of least norm as the dimensions of
+    the ``[[variation]]`` entries and the command vary.
+
+    From the nominal assembly (j = 0, λ = 0, by the backend), the slides' ODE through the
+    times of the grid, each one corrected by Newton on the Lagrange conditions
+    (``least_norm.follow``). The conditions of applicability are checked at the start
+    (``require_applicable``), the strict minimum at every output row
+    (``require_strict_minimum``).
+    """
+    mech = job.mech
+    mob = check_mobility(job, mech.initial_q(), need_driven=False)
+    job.warnings.extend(str(p) for p in mech.model.warnings())
+    q0 = assemble(job, redundant=mob.redundant > 0)
+    closures = Closures(mech, q0)
+    p, nq, m = closures.p, closures.nq, closures.m
+    t0 = float(job.times[0])
+    require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m)), t0)
+    job.stage = "following the clearance of least norm (the slides' ODE)"
+    y0 = np.r_[np.zeros(p), q0, np.zeros(m)]
+    y, ok = follow(closures.evaluate, time_rate(closures.evaluate, p), job.times, y0, p, nq)
+    if not ok.all():
+        t = float(job.times[int(np.argmin(ok))])
+        raise SolverError(
+            f"t={t:g}: the clearance of least norm could not be followed to here (h_y turned "
+            "singular, or Newton on the Lagrange conditions did not converge): the clearance "
+            "followed is no longer a strict minimum (a singular position or a bifurcation)",
+            time=t)
+    job.stage = "checking the clearance is a strict minimum at every row"
+    for k in range(0, len(job.times), job.every):
+        q, lam = y[k, p:p + nq], y[k, p + nq:]
+        require_strict_minimum(closures.evaluate(float(job.times[k]), q, lam),
+                               float(job.times[k]))
+    return collect(job, y[:, p:p + nq], extra=closures.columns(y[:, :p]))
 
 
 class Closures:
@@ -47,6 +86,19 @@ class Closures:
                 width = len(el.clearance_parameters)
                 self.Fj[rows, k:k + width] = np.asarray(el.clearance_terms, dtype=float)
                 k += width
+
+    def columns(self, j: np.ndarray) -> dict[str, np.ndarray]:
+        """The result columns of the clearance parameters j (n, p), and those derived from
+        them (a revolute's jr), as ``<element>.<name>``."""
+        out, k = {}, 0
+        for el in self.elements:
+            values = {}
+            for var in el.clearance_parameters:
+                values[var.name] = j[:, k]
+                k += 1
+            values.update(el.clearance_derived_values(values))
+            out.update({f"{el.name}.{name}": v for name, v in values.items()})
+        return out
 
     def at(self, t: float) -> list:
         """The constraint elements with their varied points and lines at time t (copies;

@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import registry
 from ..backend import Backend
-from ..elements import ACCELERATION, FORCE, POSITION, VELOCITY, Var
+from ..elements import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY, Var
 from ..errors import ModelError, Problem, RedundancyWarning, warn_outside
 from ..kinematics import State, column
 from ..model import Model, load
@@ -60,6 +60,11 @@ def available_columns(mech, analysis: str) -> dict[str, Var]:
         for var in el.outputs:
             if var.level in kind.levels:
                 out[f"{el.name}.{var.name}"] = var
+    if CLEARANCE in kind.levels:                 # the joints with clearance = true
+        for el in mech.elements:
+            if getattr(el, "clearance", False):
+                for var in el.clearance_parameters + el.clearance_derived:
+                    out[f"{el.name}.{var.name}"] = var
     return out
 
 

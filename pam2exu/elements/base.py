@@ -147,6 +147,8 @@ class Element:
     #: the joint's clearance parameters j (name, unit, meaning) when it has
     #: ``clearance = true`` (shared/spec/clearance.md); empty: the type takes no clearance
     clearance_parameters: ClassVar[tuple[Var, ...]] = ()
+    #: outputs derived from the clearance parameters (``clearance_derived_values``)
+    clearance_derived: ClassVar[tuple[Var, ...]] = ()
     #: F_j of its rows: parameter k enters equation row r of ``clearance_constraint`` as
     #: clearance_terms[r][k] · j_k (the closure F = C(q, t) + F_j j is linear in j)
     clearance_terms: ClassVar[tuple[tuple[float, ...], ...]] = ()
@@ -231,6 +233,10 @@ class Element:
     def constraint(self, st: State) -> tuple[Quantity, Any]:
         """(v, target): the equations v(q) − target(t) = 0, target a constant or a Law."""
         raise NotImplementedError(f"{self.type} adds no constraint")
+
+    def clearance_derived_values(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """The ``clearance_derived`` outputs from its parameters' values (by name)."""
+        return {}
 
     def clearance_constraint(self, st: State, start: State) -> tuple[Quantity, Any]:
         """(v, target) of its rows C(q, t) when it has clearance (``clearance_terms`` adds

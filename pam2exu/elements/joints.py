@@ -89,6 +89,11 @@ class Revolute(Element):
     )
     #: C = P2 − P1 (``constraint``), F = C − j: the contract's P1 − P2 + j = 0
     clearance_terms = ((-1.0, 0.0), (0.0, -1.0))
+    clearance_derived = (Var("jr", "m", CLEARANCE, "√(jx² + jy²): the radial clearance"),)
+
+    def clearance_derived_values(self, values):
+        """jr = √(jx² + jy²)."""
+        return {"jr": np.hypot(values["jx"], values["jy"])}
 
     def report_frame(self, st):
         """At the joint, global basis."""
