@@ -190,13 +190,18 @@ def _run(args) -> int:
         res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
                   outputs=outputs, solver=solver, backend=args.backend)
     table = res.select(args.outputs) if args.outputs and args.plot else res
+    from .results.extremes import extremes_path, extremes_table, write_extremes
     if args.output:
         path = table.to_csv(args.output)
         print(f"wrote {len(table)} rows × {len(table.columns) + 1} columns to {path}")
+        if extremes_table(table):                # a clearance run: its extremes beside
+            print(f"wrote the extremes to {write_extremes(table, extremes_path(path))}")
         for w in res.warnings:
             print(f"warning: {w}", file=sys.stderr)
     else:
         print(table.summary())
+    if extremes_table(table):
+        print(extremes_table(table))
     if args.plot:
         return _run_plot(args, res)
     return 0
