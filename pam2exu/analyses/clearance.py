@@ -18,7 +18,7 @@ from ..errors import MobilityError, ModelError, SolverError
 from ..kinematics import PER_SOLID, State
 from ..model.solid import LineRef
 from .job import Job, check_mobility, collect
-from .least_norm import RANK, Closure, applicability, follow, time_rate
+from .least_norm import RANK, Closure, applicability, follow, lagrange_jacobian, time_rate
 from .native import target_values
 from .positions import assemble
 
@@ -53,11 +53,51 @@ def clearance(job: Job):
             "followed is no longer a strict minimum (a singular position or a bifurcation)",
             time=t)
     job.stage = "checking the clearance is a strict minimum at every row"
-    for k in range(0, len(job.times), job.every):
+    rows = range(0, len(job.times), job.every)
+    for k in rows:
         q, lam = y[k, p:p + nq], y[k, p + nq:]
         require_strict_minimum(closures.evaluate(float(job.times[k]), q, lam),
                                float(job.times[k]))
+    if p:
+        _warn_far_from_first_order(job, closures, y[:, :p], list(rows), mob.redundant > 0)
+        job.stage = "collecting the result columns"
     return collect(job, y[:, p:p + nq], extra=closures.columns(y[:, :p]))
+
+
+def first_order(closures: "Closures", t: float, q_nominal: np.ndarray) -> np.ndarray:
+    """δj: the least-norm solution of F_j δj + F_q δq = −F(u(t), 0, q_nom(t)) at the
+    nominal positions (the contract's first-order estimate of the clearance): h_y at λ = 0
+    applied to (0, 0, −F)."""
+    c = closures.evaluate(t, q_nominal, np.zeros(closures.m))
+    rhs = np.r_[np.zeros(closures.p + closures.nq), -c.F]
+    return np.linalg.solve(lagrange_jacobian(c), rhs)[:closures.p]
+
+
+def _warn_far_from_first_order(job, closures, j, rows, redundant):
+    """The contract's recommended warning: a clearance column that departs from its
+    first-order estimate (``first_order``, at the nominal positions by the backend) by more
+    than half its largest magnitude, named with the first time it does."""
+    job.stage = "estimating the clearance to first order, at the nominal positions"
+    found = job.backend.solve_positions(job.mech, job.times, closures.start.q[0], job.solver,
+                                        redundant=redundant)
+    if found.solved < len(job.times):
+        job.warnings.append(
+            "no first-order estimate of the clearance to compare with: the nominal mechanism "
+            f"has no position at t = {job.times[found.solved]:.6g} s ({found.error})")
+        return
+    q_nominal = found.q
+    estimate = np.array([first_order(closures, float(job.times[k]), q_nominal[k])
+                         for k in rows])
+    gap = np.abs(j[rows] - estimate)
+    far = gap > 0.5 * np.max(np.abs(j[rows]), axis=0)
+    for col in np.nonzero(far.any(axis=0))[0]:
+        k = rows[int(np.argmax(far[:, col]))]
+        job.warnings.append(
+            f"{closures.names[col]} departs from its first-order estimate by "
+            f"{gap[rows.index(k), col]:.3g} (more than half its largest magnitude) from "
+            f"t = {job.times[k]:.6g} s: the variations are too large for the linear picture, "
+            "or a singular position of the nominal mechanism is near (shared/spec/"
+            "clearance.md, 'Scope')")
 
 
 class Closures:

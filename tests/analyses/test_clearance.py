@@ -245,3 +245,44 @@ def test_the_clearance_analysis_runs_end_to_end(request, varied):
     with pytest.raises(pam2exu.ModelError, match=r"^t=0: condition \(i\) fails"):
         pam2exu.run(request.config.rootpath / "tests/data/parallelogram5.toml",
                     analysis="clearance", steps=4)
+
+
+def test_for_small_variations_the_clearance_is_its_first_order_estimate(request):
+    """Issue 13's acceptance: for Δ of 1e-7 of the dimensions the clearance equals the
+    least-norm solution of the linearised closure at the nominal positions
+    (``first_order``) to second order in Δ: the gap scales as Δ² (×4 when Δ doubles)."""
+    from pam2exu.analyses.clearance import first_order
+    times = np.linspace(0.0, 1.0, 11)
+    _, q_nominal = _start(_model(request), times)
+    gaps = []
+    for scale in (1e-7, 2e-7):
+        varied = ({"anchor": "ground.O2", "dx": scale, "dy": -0.8 * scale, "wx": 1.91},
+                  {"anchor": "crank3.A", "dx": 0.6 * scale, "tau": 0.2})
+        closures = Closures(_model(request, varied).mechanism(), q_nominal[0])
+        y0 = np.r_[np.zeros(closures.p), q_nominal[0], np.zeros(closures.m)]
+        y, ok = ln.step_by_step(closures.evaluate, times, y0, closures.p, closures.nq)
+        assert ok.all()
+        j = y[:, :closures.p]
+        estimate = np.array([first_order(closures, t, q) for t, q in zip(times, q_nominal)])
+        assert np.max(np.abs(j)) > 0.05 * scale                 # first order in Δ
+        gaps.append(np.max(np.abs(j - estimate)))
+        assert gaps[-1] <= 1e-6 * np.max(np.abs(j))
+    assert 3.0 < gaps[1] / gaps[0] < 5.0                         # second order in Δ
+
+
+def test_a_clearance_far_from_its_first_order_estimate_is_warned(request):
+    """The contract's recommended warning: O2 moved by 20 % of the cranks' spacing, the
+    clearance of A2 departs from its first-order estimate by more than half its maximum
+    (and by less with 3.7 %: no warning)."""
+    big = _model(request, ({"anchor": "ground.O2", "dx": 0.2, "dy": -0.2, "wx": 1.91,
+                            "wy": 0.57},))
+    small = _model(request, ({"anchor": "ground.O2", "dx": 0.037, "dy": -0.037,
+                              "wx": 1.91, "wy": 0.57},))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = pam2exu.run(big, analysis="clearance", t_end=2.0, steps=40)
+        quiet = pam2exu.run(small, analysis="clearance", t_end=2.0, steps=40)
+    text = [w for w in res.warnings if "first-order estimate" in w]
+    assert text and text[0].startswith("A2.jx departs from its first-order estimate")
+    assert "from t = 1.5 s" in text[0]
+    assert not [w for w in quiet.warnings if "first-order" in w]
