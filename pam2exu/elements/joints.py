@@ -113,8 +113,12 @@ class Revolute(Element):
         nc.coincide(self.ref1, self.ref2, self)
 
     def draw(self, pen, st):
-        """A pin joint at solid 2's point (on a support when it holds a solid to ground)."""
-        pen.joint(st.point(self.ref2.solid, self.ref2.local).value[0], self.solids)
+        """A pin joint at solid 2's point (on a support when it holds a solid to ground),
+        ringed when it has clearance."""
+        p = st.point(self.ref2.solid, self.ref2.local).value[0]
+        pen.joint(p, self.solids)
+        if self.clearance:
+            pen.clearance(p)
 
 
 def _on_line(st, guide, pin_solid, pin_local):
@@ -192,12 +196,15 @@ class Prismatic(Element):
         nc.equation(self, [gap.dot(n1), nc.direction(line2.solid, line2.direction).dot(n1)])
 
     def draw(self, pen, st):
-        """Line 1 as a guide, a slider block on solid 2's defining point along line 2."""
+        """Line 1 as a guide, a slider block on solid 2's defining point along line 2,
+        ringed when it has clearance."""
         line1, line2 = self.refs
         p2 = st.point(line2.solid, line2.point).value[0]
         pen.guide(st.point(line1.solid, line1.point).value[0],
                   st.direction(line1.solid, line1.direction).value[0], p2, line1.solid)
         pen.block(p2, st.direction(line2.solid, line2.direction).value[0], line2.solid)
+        if self.clearance:
+            pen.clearance(p2)
 
 
 @dataclass(eq=False)
@@ -247,12 +254,14 @@ class PinSlot(Element):
         nc.equation(self, [gap.dot(nc.direction(guide.solid, guide.normal))])
 
     def draw(self, pen, st):
-        """The guide line, the pin on it."""
+        """The guide line, the pin on it, ringed when it has clearance."""
         guide, pin = self.refs
         p = st.point(pin.solid, pin.local).value[0]
         pen.guide(st.point(guide.solid, guide.point).value[0],
                   st.direction(guide.solid, guide.direction).value[0], p, guide.solid)
         pen.pin(p)
+        if self.clearance:
+            pen.clearance(p)
 
 
 @dataclass(eq=False)

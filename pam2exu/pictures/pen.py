@@ -244,6 +244,12 @@ class Pen:
             self._hatch(p + [0.0, -2.8 * r], 5.0 * r)
         self._circle(p, r, facecolor="white", edgecolor=INK, lw=1.5, zorder=Z_JOINT)
 
+    def clearance(self, p) -> None:
+        """A joint with clearance (``clearance = true``, the clearance analysis): a dashed
+        ring around its symbol."""
+        self._circle(p, 2.2 * self.r, facecolor="none", edgecolor=INK, lw=1.1,
+                     linestyle=(0, (3, 2)), zorder=Z_JOINT)
+
     def pin(self, p) -> None:
         """A pin that slides in a slot: a small filled circle."""
         self._circle(p, 0.65 * self.r, facecolor=INK, edgecolor="white", lw=0.8,
