@@ -55,13 +55,14 @@ class Plan:
     backend_steps: int = 100000              # four-bar steps of section 6
     backend_repeats: int = 4                 # its repeats (chain: 3 up to N = 8, then 2)
     memory_steps: int = 1000000              # four-bar steps of the memory runs
+    clearance_repeats: int = 3               # section 7: repeats of each clearance way
 
 
 FULL = Plan()
 QUICK = Plan(steps=(1000,), big_steps=0, tolerances=(1e-6, 1e-13), repeats=2, big_repeats=1,
              compare_steps=(2000,), compare_repeats=5, chain_sizes=(1, 2, 4, 8),
              chain_steps=200, long_turns=10, long_steps=10000, backend_steps=5000,
-             backend_repeats=1, memory_steps=20000)
+             backend_repeats=1, memory_steps=20000, clearance_repeats=1)
 
 
 # ---- timing --------------------------------------------------------------------------------

@@ -12,6 +12,7 @@ from pam2exu.backend.system import DENSE_UP_TO
 
 from .cases import CHAIN, CHAIN_LAW, TWO_PI
 from .measure import DEFAULT_TOLERANCE, KINDS, fit_exponent, warning_summary
+from .clearance import clearance_section
 from .report_backends import backends_section
 
 
@@ -72,9 +73,9 @@ def chain_fits(chain_rows):
 
 
 def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows, newton,
-                 profiles, sections, elapsed, side=None, memory=None):
-    """Write performance.md; ``side`` and ``memory``: section 6 (backends.py), left out
-    when None."""
+                 profiles, sections, elapsed, side=None, memory=None, clearance=None):
+    """Write performance.md; ``side`` and ``memory``: section 6 (backends.py), ``clearance``:
+    section 7 (clearance.py), each left out when None."""
     lines = []
     add = lines.append
     add("# Performance: speed against error")
@@ -497,4 +498,6 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
     add("")
     if side is not None:
         lines += backends_section(plan, quick, side, memory)
+    if clearance is not None:
+        lines += clearance_section(clearance)
     (out_dir / "performance.md").write_text("\n".join(lines) + "\n", encoding="utf-8")

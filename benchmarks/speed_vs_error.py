@@ -24,6 +24,8 @@ What it measures (each section of docs/performance.md is one of these):
    issue 12's targets: the four-bar, kinematic and kinetostatic, 100,000 steps; the chain,
    N = 1 … 64, and the exponent of its cost; the peak memory of 1,000,000 steps of the
    kinematic four-bar, each backend in its own process; the largest position error.
+7. The clearance analysis (issue 13) on its two examples: the slides' ODE against Newton
+   step by step, time and agreement (clearance.py).
 
 References (the top-level ``references`` package, shared with the tests; nothing comes from
 pam2exu). Kinematics: the closed forms of references/closed_form.py (``four_bar``, chained
@@ -36,7 +38,7 @@ solved at every step), which checks itself by the power balance before it is use
 Layout: this file is the command line and the order of the run. Measuring:
 cases.py (the mechanisms and their references), plain_exudyn.py (the hand-written Exudyn
 four-bar), measure.py (grids, timing, errors of one configuration), sections.py (the
-sections 1–5 above), backends.py (section 6). Reporting: report.py (docs/performance.md),
+sections 1–5 above), backends.py (section 6), clearance.py (section 7). Reporting: report.py (docs/performance.md),
 report_backends.py (its section 6), plot.py (docs/img/work_precision.png). The file puts the repository root on ``sys.path`` so that
 ``benchmarks`` and ``references`` import from a clone (``python -m benchmarks.speed_vs_error``
 from the root does the same).
@@ -53,6 +55,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))          # this clone's benchmarks, references (and pam2exu)
 
 from benchmarks.backends import memory, run_backend, side_by_side  # noqa: E402
+from benchmarks.clearance import measure as measure_clearance  # noqa: E402
 from benchmarks.cases import chain_model, four_bar_case  # noqa: E402
 from benchmarks.measure import DEFAULT_TOLERANCE, FULL, QUICK, log, machine, run_pam  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
@@ -123,11 +126,12 @@ def main(argv=None):
             profile(chain_model(plan.chain_sizes[-1]), "kinematic", plan.chain_steps)})
     peaks = None if args.no_memory else section("6b. peak memory, one process per run",
                                                  memory, plan)
+    clearance = section("7. clearance: ODE against Newton", measure_clearance, plan)
     elapsed = time.perf_counter() - start
     out_dir.mkdir(parents=True, exist_ok=True)
     plot(out_dir / "img" / "work_precision.png", grid, chain_rows, side)
     write_report(out_dir, info, plan, args.quick, grid, hard, chain_rows, plain_rows, newton,
-                 profiles, sections, elapsed, side, peaks)
+                 profiles, sections, elapsed, side, peaks, clearance)
     log(f"wrote {out_dir / 'performance.md'} and {out_dir / 'img' / 'work_precision.png'} "
         f"({elapsed / 60:.1f} minutes)")
 
