@@ -1,6 +1,9 @@
-"""The closure equations of a mechanism with clearance joints, at its varied dimensions.
+"""The clearance analysis (shared/spec/clearance.md, docs/clearance.md): ``clearance``.
 
-``Closures`` evaluates, for the clearance analysis (shared/spec/clearance.md), the closure
+It follows the clearance of least norm of an over-constrained mechanism whose
+``[[variation]]`` dimensions and command vary, with its conditions of applicability
+(``require_applicable``, ``require_strict_minimum``) and the recommended warning against
+the first-order estimate (``first_order``). ``Closures`` evaluates the closure
 F(u(t), j, q, r(t)) = C(q, t) + F_j j of a mechanism at one time: every constraint element's
 rows (``Element.constraint``, or ``Element.clearance_constraint`` where the element has
 ``clearance = true``), with the points and lines of the ``[[variation]]`` entries at u(t),
@@ -60,7 +63,6 @@ def clearance(job: Job):
                                float(job.times[k]))
     if p:
         _warn_far_from_first_order(job, closures, y[:, :p], list(rows), mob.redundant > 0)
-        job.stage = "collecting the result columns"
     return collect(job, y[:, p:p + nq], extra=closures.columns(y[:, :p]))
 
 
