@@ -191,17 +191,18 @@ def _run(args) -> int:
                   outputs=outputs, solver=solver, backend=args.backend)
     table = res.select(args.outputs) if args.outputs and args.plot else res
     from .results.extremes import extremes_path, extremes_table, write_extremes
+    extremes = extremes_table(table)             # a clearance run's, else ""
     if args.output:
         path = table.to_csv(args.output)
         print(f"wrote {len(table)} rows × {len(table.columns) + 1} columns to {path}")
-        if extremes_table(table):                # a clearance run: its extremes beside
+        if extremes:                             # beside the result
             print(f"wrote the extremes to {write_extremes(table, extremes_path(path))}")
         for w in res.warnings:
             print(f"warning: {w}", file=sys.stderr)
     else:
         print(table.summary())
-    if extremes_table(table):
-        print(extremes_table(table))
+    if extremes:
+        print(extremes)
     if args.plot:
         return _run_plot(args, res)
     return 0

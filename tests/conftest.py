@@ -38,6 +38,28 @@ def moved():
     return moved_model
 
 
+def guides_model(slot_clearance=True, guide_clearance=True):
+    """A pin (crank.A) in a slot and a slider (slider.axis) in a prismatic guide, both on
+    the ground's rail (point (0.1, −0.2), angle 0.3): the two line-based joints that take
+    clearance (the clearance tests and drawings)."""
+    m = pam2exu.Model("guides", gravity=0.0)
+    m.add_solid("ground", lines={"rail": {"point": [0.1, -0.2], "angle": 0.3}})
+    m.add_solid("crank", points={"A": [0.25, 0.05]})
+    m.add_solid("slider", lines={"axis": {"point": [0.02, 0.03], "angle": 0.2}})
+    m.add("fixed", anc1="ground")
+    m.add("pin_slot", name="slot", anc1="ground.rail", anc2="crank.A",
+          clearance=slot_clearance)
+    m.add("prismatic", name="guide", anc1="ground.rail", anc2="slider.axis",
+          clearance=guide_clearance)
+    return m
+
+
+@pytest.fixture
+def guides():
+    """``guides_model``, for tests."""
+    return guides_model
+
+
 def pytest_addoption(parser):
     parser.addoption("--fuzz-long", action="store_true", default=False,
                      help="tests/fuzz: run the long fuzz campaign (10,000 mutants) instead of "

@@ -249,7 +249,7 @@ def test_progress_bar_reaches_the_native_pass(monkeypatch, examples):
     assert math.isclose(float(res["crank.fi"][-1]), 10.0 * res.t[-1], rel_tol=1e-12)
 
 
-def test_draw_rings_the_joints_with_clearance(request):
+def test_draw_rings_the_joints_with_clearance(request, guides):
     """pam2exu draw marks the clearance joints (issue 13): one dashed ring per joint with
     clearance = true (revolute, pin_slot, prismatic), none on the others."""
     model = pam2exu.load(request.config.rootpath / "tests/data/parallelogram5.toml")
@@ -264,13 +264,7 @@ def test_draw_rings_the_joints_with_clearance(request):
         model["A2"].clearance = True
         model["A3"].clearance = True
         assert rings(draw(model)) == ["revolute:A2", "revolute:A3"]
-    slides = pam2exu.Model("slides", gravity=0.0)
-    slides.add_solid("ground", lines={"rail": {"point": [0.1, -0.2], "angle": 0.3}})
-    slides.add_solid("crank", points={"A": [0.25, 0.05]})
-    slides.add_solid("slider", lines={"axis": {"point": [0.02, 0.03], "angle": 0.2}})
-    slides.add("fixed", anc1="ground")
-    slides.add("pin_slot", name="slot", anc1="ground.rail", anc2="crank.A", clearance=True)
-    slides.add("prismatic", name="guide", anc1="ground.rail", anc2="slider.axis")
+    slides = guides(guide_clearance=False)
     assert rings(draw(slides)) == ["pin_slot:slot"]
     slides["guide"].clearance = True
     assert rings(draw(slides)) == ["pin_slot:slot", "prismatic:guide"]

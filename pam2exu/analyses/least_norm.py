@@ -91,7 +91,7 @@ class Applicability:
 
     ratio_i: float              # σ_min / σ_max of [F_j F_q]
     ratio_ii: float             # σ_min / σ_max of F_q
-    hessian: float              # the smallest eigenvalue of Zᵀ W_full Z (``reduced_hessian``)
+    hessian: float              # the smallest eigenvalue of Zᵀ W_full Z (``_reduced_hessian``)
     self_stress: np.ndarray     # (m, k): a basis of the λ with [F_j F_q]ᵀ λ ≈ 0 ((i) fails if k)
     free: np.ndarray            # (nq, k): a basis of the δq with F_q δq ≈ 0 ((ii) fails if k)
 
@@ -100,40 +100,44 @@ class Applicability:
         return self.ratio_i > RANK and self.ratio_ii > RANK and self.hessian > RANK
 
 
-def _ratio_and_null(A: np.ndarray, side: str):
+def _ratio_and_null(shape: tuple, svd, side: str):
     """(σ_min/σ_max, a basis of the null space on ``side``: 'left' (columns λ with Aᵀλ ≈ 0)
-    or 'right' (columns δ with A δ ≈ 0)), singular values ≤ RANK σ_max counting as 0."""
-    U, s, Vt = np.linalg.svd(A)
-    size = min(A.shape)
-    lost = np.r_[s <= RANK * s[0], np.ones(max(A.shape) - size, dtype=bool)]
+    or 'right' (columns δ with A δ ≈ 0)) of a matrix A of ``shape`` from its full SVD,
+    singular values ≤ RANK σ_max counting as 0."""
+    U, s, Vt = svd
+    size = min(shape)
+    lost = np.r_[s <= RANK * s[0], np.ones(max(shape) - size, dtype=bool)]
     if side == "left":
-        smallest = 0.0 if A.shape[0] > size else s[-1]
-        return smallest / s[0], U[:, lost[:A.shape[0]]]
-    smallest = 0.0 if A.shape[1] > size else s[-1]
-    return smallest / s[0], Vt[lost[:A.shape[1]]].T
+        smallest = 0.0 if shape[0] > size else s[-1]
+        return smallest / s[0], U[:, lost[:shape[0]]]
+    smallest = 0.0 if shape[1] > size else s[-1]
+    return smallest / s[0], Vt[lost[:shape[1]]].T
 
 
-def reduced_hessian(c: Closure) -> float:
+def _reduced_hessian(c: Closure, svd) -> float:
     """The smallest eigenvalue of Zᵀ diag(I, W) Z, Z an orthonormal basis of ker [F_j F_q]
-    (the second-order condition of a strict minimum); +inf where the kernel is {0}."""
-    A = np.hstack([c.Fj, c.Fq])
-    _, s, Vt = np.linalg.svd(A)
+    (``svd``: its full SVD), the second-order condition of a strict minimum; +inf where the
+    kernel is {0}."""
+    _, s, Vt = svd
     rank = int(np.sum(s > RANK * s[0])) if s.size else 0
     Z = Vt[rank:].T
     if Z.shape[1] == 0:
         return np.inf
     p = c.Fj.shape[1]
-    full = np.zeros((A.shape[1], A.shape[1]))
+    full = np.zeros((Vt.shape[0], Vt.shape[0]))
     full[:p, :p] = np.eye(p)
     full[p:, p:] = c.W
     return float(np.min(np.linalg.eigvalsh(Z.T @ full @ Z)))
 
 
 def applicability(c: Closure) -> Applicability:
-    """The conditions at a configuration (``Applicability``)."""
-    ratio_i, stress = _ratio_and_null(np.hstack([c.Fj, c.Fq]), "left")
-    ratio_ii, free = _ratio_and_null(c.Fq, "right")
-    return Applicability(ratio_i, ratio_ii, reduced_hessian(c), stress, free)
+    """The conditions at a configuration (``Applicability``): one SVD of [F_j F_q] for (i)
+    and the reduced Hessian, one of F_q for (ii)."""
+    A = np.hstack([c.Fj, c.Fq])
+    whole = np.linalg.svd(A)
+    ratio_i, stress = _ratio_and_null(A.shape, whole, "left")
+    ratio_ii, free = _ratio_and_null(c.Fq.shape, np.linalg.svd(c.Fq), "right")
+    return Applicability(ratio_i, ratio_ii, _reduced_hessian(c, whole), stress, free)
 
 
 def kkt_residual(j: np.ndarray, c: Closure) -> float:

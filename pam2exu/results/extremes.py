@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..elements import ELEMENTS
+from .table import csv_field
 
 #: the variables of the joints' clearance parameters and of what derives from them
 CLEARANCE_VARIABLES = frozenset(v.name for cls in ELEMENTS.values()
@@ -62,10 +63,8 @@ def write_extremes(res, path: str | Path) -> Path:
     path = Path(path)
     lines = ["column,min,t_min,max,t_max"]
     for e in extremes(res):
-        name = e.column
-        if any(ch in name for ch in ',;"'):        # quoted as the result CSV quotes it
-            name = '"' + name.replace('"', '""') + '"'
-        lines.append(",".join([name, *(repr(v) for v in (e.min, e.t_min, e.max, e.t_max))]))
+        lines.append(",".join([csv_field(e.column),
+                               *(repr(v) for v in (e.min, e.t_min, e.max, e.t_max))]))
     tmp = path.with_name(path.name + ".part")
     try:
         tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -309,8 +309,13 @@ def _csv_header(names) -> str:
     >>> _csv_header(["t", "a,b.x", 'q"uo.y', "Força.Fx"])
     't,"a,b.x","q""uo.y",Força.Fx'
     """
-    return ",".join('"' + n.replace('"', '""') + '"' if any(c in n for c in ',;"\r\n') else n
-                    for n in names)
+    return ",".join(csv_field(n) for n in names)
+
+
+def csv_field(name: str) -> str:
+    """A name as a CSV field: in quotes, '"' doubled, when it holds ',', ';', '"' or a
+    line break (``_csv_header``, the extremes' file)."""
+    return '"' + name.replace('"', '""') + '"' if any(c in name for c in ',;"\r\n') else name
 
 
 def _csv_block(values: np.ndarray) -> np.ndarray:

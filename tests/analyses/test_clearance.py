@@ -130,19 +130,12 @@ def test_a_revolutes_clearance_is_the_vector_between_its_points(varied):
             np.testing.assert_allclose(y[joint:joint + 2], P2 - P1, atol=1e-14, err_msg=name)
 
 
-def test_pin_slot_and_prismatic_rows_vanish_at_the_contracts_clearances():
+def test_pin_slot_and_prismatic_rows_vanish_at_the_contracts_clearances(guides):
     """shared/spec/clearance.md: pin_slot jn = n1·(P2 − p1); prismatic jn = n1·(p2 − p1) and
     jfi = (fi2 + α2) − (fi1 + α1) − kπ (n1: line 1's direction turned +90°, all in the
     current configuration). At an arbitrary configuration, C + F_j j = 0 with exactly
     those j, computed here from the geometry by hand."""
-    m = pam2exu.Model("rows", gravity=0.0)
-    m.add_solid("ground", lines={"rail": {"point": [0.1, -0.2], "angle": 0.3}})
-    m.add_solid("crank", points={"A": [0.25, 0.05]})
-    m.add_solid("slider", lines={"axis": {"point": [0.02, 0.03], "angle": 0.2}})
-    m.add("fixed", anc1="ground")
-    m.add("pin_slot", name="slot", anc1="ground.rail", anc2="crank.A", clearance=True)
-    m.add("prismatic", name="guide", anc1="ground.rail", anc2="slider.axis", clearance=True)
-    mech = m.mechanism()
+    mech = guides().mechanism()
     q = np.array([0.0, 0.0, 0.0, 0.3, -0.1, 0.7, 0.5, 0.2, np.pi + 0.15])
     closures = Closures(mech, q)                       # sense k = 1 (opposite) here
     c = closures.evaluate(0.0, q, np.zeros(closures.m))
