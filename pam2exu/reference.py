@@ -68,9 +68,9 @@ def _default(cls: type[Element], key: str) -> str:
     return f"`{value!r}`".replace("'", '"')
 
 
-def _analyses(level: str) -> str:
+def _analyses(level: str, owner: str = "element") -> str:
     """The analyses giving a variable of ``level`` (``registry.analyses_giving``)."""
-    return ", ".join(analyses_giving(level))
+    return ", ".join(analyses_giving(level, owner))
 
 
 def _first_line(function) -> str:
@@ -150,11 +150,14 @@ def laws_markdown() -> str:
 
 def outputs_markdown() -> str:
     """Every output variable: owner, PAM name, unit, which analyses give it, meaning."""
-    rows = [("solid", f"`{v.name}`", v.unit, _analyses(v.level), v.meaning)
+    rows = [("solid", f"`{v.name}`", v.unit, _analyses(v.level, "solid"), v.meaning)
             for v in SOLID_OUTPUTS]
     for cls in ELEMENTS.values():
         rows += [(f"[`{cls.type}`](#{cls.type})", f"`{v.name}`", v.unit,
                   _analyses(v.level), v.meaning) for v in cls.outputs]
+        rows += [(f"[`{cls.type}`](#{cls.type}), `clearance = true`", f"`{v.name}`", v.unit,
+                  _analyses(v.level), v.meaning)
+                 for v in cls.clearance_parameters + cls.clearance_derived]
     return "\n".join(_table(("owner", "variable", "unit", "given by", "meaning"), rows)) + "\n"
 
 

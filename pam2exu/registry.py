@@ -48,6 +48,10 @@ class AnalysisType:
         Every degree of freedom must be driven by an actuator (else ``MobilityError``).
     at_start : bool
         It solves t = 0 only and gives the solids' x, y, fi (no element outputs).
+    element_outputs : bool
+        The elements' outputs of its levels are among its columns (default). The clearance
+        analysis gives only the solids' x, y, fi and its clearance parameters (the contract's
+        columns): an element's outputs there would be computed at the nominal dimensions.
     summary : str
         One line for help texts.
     function : str or callable
@@ -61,6 +65,7 @@ class AnalysisType:
     at_start: bool
     summary: str
     function: str | Callable
+    element_outputs: bool = True
 
     def run(self, job):
         """Run the analysis on a prepared ``Job``."""
@@ -101,7 +106,7 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
                  at_start=False,
                  summary="the clearance of least norm of an over-constrained mechanism as "
                  "its dimensions vary (shared/spec/clearance.md)",
-                 function="pam2exu.analyses.clearance:clearance"),
+                 function="pam2exu.analyses.clearance:clearance", element_outputs=False),
 )}
 
 #: the backends; the first is the default
@@ -122,7 +127,12 @@ def analysis_type(name: str) -> AnalysisType | None:
     return next((a for a in ANALYSES.values() if a.alias == name), None)
 
 
-def analyses_giving(level: str) -> list[str]:
-    """The analyses (names, in order) whose outputs include the solids' and elements'
-    variables of ``level`` (an analysis ``at_start`` gives only the solids' x, y, fi)."""
-    return [a.name for a in ANALYSES.values() if level in a.levels and not a.at_start]
+def analyses_giving(level: str, owner: str = "element") -> list[str]:
+    """The analyses (names, in order) whose outputs include the variables of ``level`` of a
+    ``'solid'`` or an ``'element'`` (an analysis ``at_start`` gives only the solids' x, y,
+    fi; one without ``element_outputs`` no element outputs but those of its own levels)."""
+    # the levels that only analyses without element outputs give (the clearance parameters)
+    own = {lv for a in ANALYSES.values() for lv in a.levels} - {
+        lv for a in ANALYSES.values() if a.element_outputs for lv in a.levels}
+    return [a.name for a in ANALYSES.values() if level in a.levels and not a.at_start
+            and (owner == "solid" or a.element_outputs or level in own)]

@@ -15,7 +15,7 @@ import pytest
 
 from pam2exu import reference
 from pam2exu.model.solid import SOLID_OUTPUTS
-from pam2exu.elements import ACCELERATION, ALIASES, ELEMENTS, FORCE, POSITION, VELOCITY
+from pam2exu.elements import ACCELERATION, ALIASES, CLEARANCE, ELEMENTS, FORCE, POSITION, VELOCITY
 from pam2exu.laws import LAW_ALIASES, LAWS
 from pam2exu.model.model import Analysis
 from pam2exu.model.solid import Solid
@@ -112,13 +112,17 @@ def test_solid_and_analysis_keys_match_the_contract():
 def test_levels_of_the_reference_are_those_the_analyses_use():
     """Which analyses give each kind of output (the contract's analysis table: assembly
     gives only the solids' x, y, fi), as the registry declares and the pages say."""
-    expected = {POSITION: "quasi_static, kinematic, kinetostatic, clearance",   # clearance.md
+    expected = {POSITION: "quasi_static, kinematic, kinetostatic",
                 VELOCITY: "kinematic, kinetostatic", ACCELERATION: "kinematic, kinetostatic",
-                FORCE: "quasi_static, kinetostatic"}
+                FORCE: "quasi_static, kinetostatic", CLEARANCE: "clearance"}
     for level, analyses in expected.items():
         assert reference._analyses(level) == analyses
-        assert set(analyses.split(", ")) == {a.name for a in ANALYSES.values()
-                                             if level in a.levels and not a.at_start}
+        assert set(analyses.split(", ")) == {
+            a.name for a in ANALYSES.values() if level in a.levels and not a.at_start
+            and (a.element_outputs or level == CLEARANCE)}
+    # clearance.md: the clearance analysis gives the solids' x, y, fi, no element outputs
+    assert reference._analyses(POSITION, "solid") == (
+        "quasi_static, kinematic, kinetostatic, clearance")
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)

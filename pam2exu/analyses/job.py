@@ -56,7 +56,7 @@ def available_columns(mech, analysis: str) -> dict[str, Var]:
                 out[f"{s.name}.{var.name}"] = var
     if kind.at_start:
         return out
-    for el in mech.elements:
+    for el in mech.elements if kind.element_outputs else ():
         for var in el.outputs:
             if var.level in kind.levels:
                 out[f"{el.name}.{var.name}"] = var

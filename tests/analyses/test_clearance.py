@@ -217,16 +217,17 @@ def test_a_lost_strict_minimum_stops_the_run_at_its_time():
 
 
 def test_the_clearance_analysis_runs_end_to_end(request, varied):
-    """pam2exu.run(..., analysis="clearance"): the solids' x, y, fi, the motor's f(t) and
-    the clearance columns (jr = √(jx² + jy²)), equal to the ``Closures`` path above."""
+    """pam2exu.run(..., analysis="clearance"): the contract's columns, the solids' x, y, fi
+    then the clearance columns (jr = √(jx² + jy²)) and nothing else, equal to the
+    ``Closures`` path above."""
     times, closures, (ode, _), _ = varied
     model = _model(request, VARIED)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = pam2exu.run(model, analysis="clearance", t_end=2.0, steps=40)
     np.testing.assert_array_equal(res.t, times)
-    assert [c for c in res.columns if c.startswith(("A2.", "A3."))] == [
-        "A2.jx", "A2.jy", "A2.jr", "A3.jx", "A3.jy", "A3.jr"]
+    solids = [f"{s.name}.{k}" for s in closures.mech.solids for k in ("x", "y", "fi")]
+    assert res.columns == solids + ["A2.jx", "A2.jy", "A2.jr", "A3.jx", "A3.jy", "A3.jr"]
     for k, name in enumerate(closures.names):
         np.testing.assert_allclose(res[name], ode[:, k], atol=1e-12, err_msg=name)
     np.testing.assert_allclose(res["A2.jr"], np.hypot(res["A2.jx"], res["A2.jy"]), rtol=1e-15)
