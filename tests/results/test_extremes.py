@@ -6,6 +6,7 @@ here; the file read back with float() (full precision: the same floats, bit for 
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from pam2exu.cli import main
 from pam2exu.results import Results
@@ -65,3 +66,49 @@ def test_the_cli_writes_the_extremes_of_a_clearance_run_only(tmp_path, request, 
     assert main(["run", str(model), "-a", "kinematic", "--steps", "10",
                  "-o", str(tmp_path / "k.csv")]) == 0
     assert not (tmp_path / "k.extremes.csv").exists()
+
+
+def _parallelogram_with(tmp_path, root, joint_extra="", variation='anchor = "ground.O2"\n'
+                        'dx = 3.7e-3'):
+    text = (root / "tests/data/parallelogram5.toml").read_text(encoding="utf-8")
+    text = text.replace('anc2 = "coupler.A2"', f'anc2 = "coupler.A2"\n{joint_extra}')
+    text = text.replace("[analysis]", f"[[variation]]\n{variation}\n\n[analysis]")
+    model = tmp_path / "bad.toml"
+    model.write_text(text, encoding="utf-8")
+    return model
+
+
+@pytest.mark.parametrize("joint, variation, words", [
+    ("clearance = true", 'anchor = "ground.O2"\ntua = 1.0', "unknown key 'tua'"),
+    ("clearance = true", 'anchor = "ground.O2"\ndx = 1e-3\n\n[[variation]]\n'
+     'anchor = "ground.O2"\ndy = 1e-3', "is already varied by [[variation]] #1"),
+    ("clearance = true", 'anchor = "ground.O2"\ntau = 0.0', "must be > 0"),
+    ("clearance = true", 'anchor = "ground"', "is a bare solid"),
+    ("clearance = 1", 'anchor = "ground.O2"', "clearance"),
+    ("", 'anchor = "ground.O2"\ndx = 3.7e-3', "condition (i) fails"),
+])
+def test_bad_clearance_input_is_an_error_naming_it_with_nothing_written(
+        tmp_path, request, capsys, joint, variation, words):
+    """Issue 13's bad input, through the CLI: exit status 2 (a model error), the message
+    names the entry (and the file, except condition (i)'s, which the contract makes begin
+    with t=0:), and neither the result nor its extremes file exists."""
+    model = _parallelogram_with(tmp_path, Path(request.config.rootpath), joint, variation)
+    out = tmp_path / "bad.csv"
+    assert main(["run", str(model), "-a", "clearance", "--steps", "10", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert words in err and ("bad.toml" in err or words == "condition (i) fails")
+    assert not out.exists() and not (tmp_path / "bad.extremes.csv").exists()
+
+
+def test_clearance_on_a_spring_is_an_error_with_nothing_written(tmp_path, request, capsys):
+    root = Path(request.config.rootpath)
+    text = (root / "examples/all_elements.toml").read_text(encoding="utf-8")
+    assert 'type = "spring"' in text
+    text = text.replace('type = "spring"', 'type = "spring"\nclearance = true', 1)
+    model = tmp_path / "spring.toml"
+    model.write_text(text, encoding="utf-8")
+    out = tmp_path / "spring.csv"
+    assert main(["run", str(model), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "spring.toml" in err and "clearance" in err and "spring" in err
+    assert not out.exists()
