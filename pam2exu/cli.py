@@ -57,6 +57,9 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("model", help="model file (TOML)")
     check.add_argument("--analysis", "-a", metavar="TYPE",
                        help="the analysis to check for (default: the model's)")
+    run.add_argument("--angles", choices=("rad", "deg"),
+                     help="unit of the angular results: rad (rad/s, rad/s²) or deg (deg/s, "
+                          "deg/s²); default: the model's [model] angles")
     check.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
     check.add_argument("--steps", type=int, metavar="N", help="number of intervals")
     check.add_argument("--backend", metavar="NAME",
@@ -188,7 +191,7 @@ def _run(args) -> int:
         if outputs and args.plot:
             outputs = [*outputs, *args.plot]      # the plotted variables are computed too
         res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
-                  outputs=outputs, solver=solver, backend=args.backend)
+                  outputs=outputs, solver=solver, backend=args.backend, angles=args.angles)
     table = res.select(args.outputs) if args.outputs and args.plot else res
     from .results.extremes import extremes_path, extremes_table, write_extremes
     extremes = extremes_table(table)             # a clearance run's, else ""
@@ -269,6 +272,9 @@ def _elements(args) -> int:
     if not args.types:
         from .elements import ELEMENTS
         width = max(len(t) + len(c.alias) for t, c in ELEMENTS.items()) + 3
+    from .model.angles import angle_warnings
+    for problem in angle_warnings(model):
+        print(f"warning: {problem}")
         for kind, cls in ELEMENTS.items():
             anchors = ", ".join(reference.anchor_meaning(cls, k) for k in range(len(cls.anchors)))
             print(f"{f'{kind} [{cls.alias}]':<{width}}  {anchors}: {cls.summary}")

@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["Law", "LAWS", "LAW_ALIASES", "law_names"]
+__all__ = ["Law", "LAWS", "LAW_ALIASES", "VALUES_OF_F", "law_names"]
 
 
 def polynomial(t, C, xp=np):
@@ -83,6 +83,18 @@ LAWS: dict[str, tuple[Callable, bool]] = {
     "ramp": (ramp, True),
     "bezier_c1": (bezier_c1, True),
     "bezier_c2": (bezier_c2, True),
+}
+
+#: law name -> which constants are in the unit of f (per s, s², s³): C1…C4 of a polynomial,
+#: C1 and C2 of a harmonic (C3 and C4 are the cosine's ω [rad/s] and phase [rad]), C3 and C4
+#: of a transition (C1 and C2 are times). In a model with angles = "deg" these constants of an
+#: angular actuator are degrees (deg/s, …); the others keep their units.
+VALUES_OF_F: dict[str, tuple[bool, bool, bool, bool]] = {
+    "polynomial": (True, True, True, True),
+    "harmonic": (True, True, False, False),
+    "ramp": (False, False, True, True),
+    "bezier_c1": (False, False, True, True),
+    "bezier_c2": (False, False, True, True),
 }
 
 #: Catalan PAM names

@@ -6,14 +6,16 @@ after an analysis issue.
 """
 from __future__ import annotations
 
-from ..errors import (ConditionWarning, ConsistencyWarning, Pam2ExuError, RedundancyWarning,
-                      SolverError)
+from ..errors import (ConditionWarning, ConsistencyWarning, ModelError, Pam2ExuError,
+                      RedundancyWarning, SolverError)
+from ..model.angles import UNITS as ANGLE_UNITS
+from ..results.units import in_angles
 from ..registry import ANALYSES
 from .job import prepare
 
 
 def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
-        backend=None):
+        backend=None, angles=None):
     """Run an analysis and return its Results.
 
     ``pam2exu.run`` is this function, with ``t_end``, ``steps``, ``outputs`` and ``solver``
@@ -38,6 +40,10 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
     backend : str, optional
         What solves the positions (``registry.BACKENDS``: 'exudyn'); default: the model's
         [analysis] backend.
+    angles : str, optional
+        The unit of the angular columns (fi, Dfi, DDfi, f(t) of an angular actuator,
+        fi_rel, …): ``'rad'`` or ``'deg'`` (deg, deg/s, deg/s²); default: the model's
+        ``[model] angles``.
 
     Returns
     -------
@@ -71,7 +77,10 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
     job = None
     try:
         job = prepare(model, analysis, t_end, steps, outputs, solver, backend)
-        return ANALYSES[job.analysis].run(job)
+        if angles not in (None, *ANGLE_UNITS):
+            raise ModelError(f"angles must be 'rad' or 'deg' (the unit of the angular "
+                             f"results), got {angles!r}", job.mech.model.source)
+        return in_angles(ANALYSES[job.analysis].run(job), angles or job.mech.model.angles)
     except Pam2ExuError:
         raise
     except Exception as exc:         # a fault of pam2exu: say what was being done

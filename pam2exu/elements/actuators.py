@@ -25,6 +25,7 @@ class AngularActuator(Actuator):
     anchors = ("solid", "solid")
     summary = "fi2 - fi1 = f(t)"
     params = {"law": _LAW, "C": _C}
+    angular = True
     outputs = (
         Var("Mz", "N·m", FORCE, "torque the actuator exerts on solid 2 (motor torque)"),
         Var("f(t)", "rad", POSITION, "the law: relative angle fi2 − fi1"),

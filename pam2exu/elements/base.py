@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import closest
 from ..limits import VALUE, is_number, shown
 from ..kinematics import Quantity, State, pose
-from ..laws import LAW_ALIASES, LAWS, Law, law_names
+from ..laws import LAW_ALIASES, LAWS, VALUES_OF_F, Law, law_names
 
 #: What an output needs from an analysis, in the order analyses can provide it.
 POSITION, VELOCITY, ACCELERATION, FORCE = "position", "velocity", "acceleration", "force"
@@ -52,6 +52,10 @@ class Param:
     #: the specification that adds the key to the model format (e.g. "clearance.md"), for
     #: keys beyond model-format.md's element table; None for the contract's own keys
     extension: str | None = None
+    #: which of its values are angles or angular rates [rad, rad/s, …] (one flag per
+    #: constant, one for a number): given in degrees in a model with ``angles = "deg"``
+    #: (pam2exu/model/angles.py converts them once, to radians)
+    angles: tuple[bool, ...] = ()
 
     def problem(self, key: str, value: Any) -> str | None:
         if value is None:
@@ -229,6 +233,11 @@ class Element:
         """Indices of the solids the element acts on."""
         return tuple(r.solid for r in self.refs)
 
+    def angle_values(self, key: str) -> tuple[bool, ...]:
+        """Which values of ``key`` are angles or angular rates (``Param.angles``; an
+        actuator's law constants depend on its law and kind)."""
+        return self.params[key].angles
+
     # ---- kinematics --------------------------------------------------------------------
     def constraint(self, st: State) -> tuple[Quantity, Any]:
         """(v, target): the equations v(q) − target(t) = 0, target a constant or a Law."""
@@ -306,7 +315,14 @@ class Actuator(Element):
     """An element whose constraint follows a time law f(t)."""
 
     drives = True
+    #: f(t) is an angle (an angular actuator), not a length
+    angular: ClassVar[bool] = False
 
+    def angle_values(self, key):
+        """An angular actuator's law constants in the unit of f (``laws.VALUES_OF_F``)."""
+        if key == "C":
+            return VALUES_OF_F[LAW_ALIASES.get(self.law, self.law)] if self.angular else ()
+        return super().angle_values(key)
 
     def more_problems(self, scope):
         law = LAW_ALIASES.get(self.law, self.law)

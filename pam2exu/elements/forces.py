@@ -205,7 +205,8 @@ class TorsionalSpring(_SpringDamper):
     anchors = ("solid", "solid")
     summary = ("Parell = C1 + C2 (fi_rel - C3) + C4 Dfi_rel, fi_rel = fi2 - fi1; positive "
                "counter-clockwise on solid 1, clockwise on solid 2")
-    params = {"C": Param("constants", "C1 [N·m], C2 [N·m/rad], C3 [rad], C4 [N·m·s/rad]")}
+    params = {"C": Param("constants", "C1 [N·m], C2 [N·m/rad], C3 [rad], C4 [N·m·s/rad]",
+                         angles=(False, False, True, False))}
     outputs = (
         Var("Parell", "N·m", FORCE, "torque, counter-clockwise on solid 1, clockwise on solid 2"),
         Var("fi_rel", "rad", POSITION, "relative angle fi2 − fi1"),

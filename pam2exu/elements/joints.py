@@ -280,7 +280,7 @@ class Transmission(Element):
                "is ambiguous")
     params = {
         "T": Param("number", "transmission ratio", required=True, limit=1e6),
-        "C": Param("number", "initial angle [rad]", limit=ANGLE),
+        "C": Param("number", "initial angle [rad]", limit=ANGLE, angles=(True,)),
         "arm": Param("solid", "the solid both gears are hinged to (found when unambiguous)"),
     }
     outputs = (Var("Parell", "N·m", FORCE, "torque solid 2 receives from the transmission "

@@ -11,7 +11,7 @@ from .solid import Solid
 from .variation import KEYS as _VARIATION_KEYS
 from .variation import Variation
 
-_MODEL_KEYS = ("name", "gravity")
+_MODEL_KEYS = ("name", "gravity", "angles")
 _SOLID_KEYS = ("name", "x", "y", "fi", "mass", "inertia", "cog", "points", "lines")
 _ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs", "backend")
 _TABLES = ("model", "solid", "element", "variation", "analysis")
@@ -153,7 +153,7 @@ def loads(text: str, source: str = "<string>") -> Model:
     head = _table(data, "model", problems)
     _unknown_keys(head, _MODEL_KEYS, "[model]", problems)
     model = Model(name=head.get("name", Path(source).stem), gravity=head.get("gravity", 9.81),
-                  source=source)
+                  source=source, angles=head.get("angles", "rad"))
     for k, entry in enumerate(_array(data, "solid", problems), start=1):
         where = f"[[solid]] #{k}" + (f" '{entry['name']}'" if "name" in entry else "")
         _unknown_keys(entry, _SOLID_KEYS, where, problems)

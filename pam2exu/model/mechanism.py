@@ -2,13 +2,13 @@
 analyses work on (``Model.mechanism()`` makes it)."""
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass, field
 
 from typing import TYPE_CHECKING
 
 from ..elements import Element
 from ..kinematics import PER_SOLID
+from .angles import si_inputs
 from .solid import Scope, Solid
 from .variation import Variation
 
@@ -33,9 +33,11 @@ class Mechanism:
     model : Model
         The model it was made from.
     solids : list of Solid
-        The model's solids, in order.
+        The model's solids, in order (copies with fi and line angles in radians when the
+        model gives degrees).
     elements : list of Element
-        Copies of the model's elements, bound to their anchors (``ref1``, ``ref2``).
+        Copies of the model's elements, bound to their anchors (``ref1``, ``ref2``), their
+        angles in radians.
     constraints : list of Element
         The elements that add constraint equations, in order.
     rows : list of slice
@@ -54,10 +56,10 @@ class Mechanism:
     elements: list[Element] = field(init=False)
 
     def __post_init__(self):
-        self.solids = list(self.model.solids)
+        # the model's angles in radians (copies where it gives degrees: model/angles.py)
+        self.solids, self.elements, self.variations = si_inputs(self.model)
         scope = Scope(self.solids)
         scope.elements = self.model.elements
-        self.elements = [copy.copy(e) for e in self.model.elements]
         for el in self.elements:
             el.bind(scope)
         self.constraints = [e for e in self.elements if e.equations]
@@ -71,7 +73,6 @@ class Mechanism:
         self.rows = rows
         self.n_equations = start
         self.index = scope.index
-        self.variations = [copy.copy(v) for v in self.model.variations]
         for v in self.variations:
             v.bind(scope)
         self._varied = {(v.kind, v.anchor): v for v in self.variations}

@@ -11,6 +11,7 @@ from .. import limits, registry
 from ..elements import ALIASES, ELEMENTS, Element, misplaced_clearance
 from ..errors import ModelError, Problem, VariationWarning, closest, warn_outside
 from ..limits import is_number as _number
+from .angles import angles_problem
 from .mechanism import Mechanism
 from .solid import Scope, Solid, solid_problems
 from .variation import KEYS as VARIATION_KEYS
@@ -126,6 +127,12 @@ class Model:
         Used by the quasi_static and kinetostatic analyses.
     source : str, optional
         The model file, named in error messages (set by ``load``).
+    angles : str
+        The unit of every angle and angular rate the model gives: ``"rad"`` (the default)
+        or ``"deg"`` (``[model] angles``, an extension of the format): the solids' ``fi``,
+        lines' ``angle``, a transmission's ``C``, a torsional spring's ``C3``, an angular
+        actuator's law constants in the unit of f, a variation's ``dangle``; the results
+        of ``run`` are then in degrees too (``model/angles.py``).
 
     Attributes
     ----------
@@ -163,10 +170,12 @@ class Model:
     []
     """
 
-    def __init__(self, name: str = "model", gravity: float = 9.81, source: str | None = None):
+    def __init__(self, name: str = "model", gravity: float = 9.81, source: str | None = None,
+                 angles: str = "rad"):
         self.name = name
         self.gravity = gravity
         self.source = source
+        self.angles = angles
         #: how the model file was read: "utf-8", or "cp1252" (Windows-1252, see ``load``)
         self.encoding = "utf-8"
 
@@ -380,6 +389,8 @@ class Model:
         elif self.gravity > limits.VALUE:
             out.append(Problem("[model]", f"gravity = {self.gravity:g} m/s² is out of range "
                                           f"(at most {limits.VALUE:g})"))
+        if angles_problem(self.angles):
+            out.append(Problem("[model]", angles_problem(self.angles)))
         if not isinstance(self.name, str):
             out.append(Problem("[model]", f"name must be a string, got {self.name!r}"))
         elif len(self.name) > limits.MODEL_NAME:

@@ -10,6 +10,7 @@ what kind of element ``motor`` is) and is '' without it.
 from __future__ import annotations
 
 import functools
+import math
 
 from ..elements import ELEMENTS
 from ..model.solid import SOLID_OUTPUTS
@@ -85,3 +86,70 @@ def _unit_in_model(model, owner: str, variable: str) -> str | None:
         if var.name == variable:
             return var.unit
     return None
+
+
+#: the angular units of results and their degree counterparts (``[model] angles = "deg"``)
+DEGREE_UNITS = {"rad": "deg", "rad/s": "deg/s", "rad/s²": "deg/s²"}
+#: and back
+RADIAN_UNITS = {deg: rad for rad, deg in DEGREE_UNITS.items()}
+
+
+def angle_factor(unit: str, angles: str) -> tuple[float, str]:
+    """(factor, new unit) that expresses a column in ``unit`` in ``angles`` ("rad" or "deg"):
+    v [deg…] = v [rad…] · 180/π and back; (1, unit) for a column that is not angular."""
+    if angles == "deg" and unit in DEGREE_UNITS:
+        return 180.0 / math.pi, DEGREE_UNITS[unit]
+    if angles == "rad" and unit in RADIAN_UNITS:
+        return math.pi / 180.0, RADIAN_UNITS[unit]
+    return 1.0, unit
+
+
+def in_angles(res, angles: str | None):
+    """The table with its angular columns in ``angles``: "deg" (deg, deg/s, deg/s²) or "rad".
+
+    The one conversion of results between radians and degrees: a column is angular by its
+    unit (``res.units``: rad, rad/s, rad/s² or deg, deg/s, deg/s²); the others are copied
+    as they are.
+
+    Parameters
+    ----------
+    res : Results
+        A table with units (a run's, or ``read_csv``'s).
+    angles : str or None
+        ``"deg"``, ``"rad"``, or None (``res`` itself, unchanged).
+
+    Returns
+    -------
+    Results
+        ``res`` when nothing changes, else a new table (same times, analysis, model,
+        warnings and info) with the angular columns × 180/π (to degrees) or × π/180 (to
+        radians) and their units renamed.
+
+    Raises
+    ------
+    ValueError
+        ``angles`` is not "rad", "deg" or None.
+
+    Examples
+    --------
+    >>> from pam2exu.results import Results
+    >>> res = Results([0.0, 1.0], {"crank.fi": [0.0, 3.141592653589793], "B.Fx": [1.0, 2.0]},
+    ...               {"crank.fi": "rad", "B.Fx": "N"})
+    >>> deg = in_angles(res, "deg")
+    >>> deg["crank.fi"].tolist(), deg.units["crank.fi"], deg["B.Fx"].tolist()
+    ([0.0, 180.0], 'deg', [1.0, 2.0])
+    >>> in_angles(deg, "rad").units["crank.fi"]
+    'rad'
+    """
+    if angles is None:
+        return res
+    if angles not in ("rad", "deg"):
+        raise ValueError(f"angles must be 'rad' or 'deg', got {angles!r}")
+    factors = {c: angle_factor(res.units.get(c, ""), angles) for c in res.columns}
+    if all(f == 1.0 for f, _ in factors.values()):
+        return res
+    from .table import Results
+    return Results(res.t, {c: res[c] * f if f != 1.0 else res[c]
+                           for c, (f, _) in factors.items()},
+                   {c: u for c, (_, u) in factors.items()}, res.analysis, res.model,
+                   res.warnings, res.info)
