@@ -315,7 +315,8 @@ def _run(model, backend: str, solver, **settings) -> Results:
     """One run; a solver failure or a failed self-check names the backend."""
     from .analyses import run
     try:
-        return run(model, backend=backend, solver=solver, **settings)
+        # in SI radians, whatever the model's angles: the tolerances are per SI unit
+        return run(model, backend=backend, solver=solver, angles="rad", **settings)
     except (SolverError, TranslationError) as exc:
         exc.args = (f"{backend} backend: {exc.args[0]}", *exc.args[1:])
         raise

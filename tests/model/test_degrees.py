@@ -197,3 +197,13 @@ def test_run_cli_angles_deg(tmp_path, capsys):
     assert rows["crank.fi"][:3] == ["deg", "0", "360"]
     assert rows["motor.Df(t)"][:3] == ["deg/s", "360", "360"]
     assert rows["rocker.x"][:3] == ["m", "0.4", "0.4"]
+
+
+def test_verify_compares_a_degrees_model_in_radians():
+    """verify's tolerances are per SI unit: both runs are made in radians."""
+    text = FOUR_BAR.read_text()
+    deg = _in_degrees(loads(text))
+    found = pam2exu.verify(deg, steps=10)
+    assert found.ok
+    assert found.comparison["crank.fi"].unit == "rad"
+    assert found.reference["motor.f(t)"][-1] == pytest.approx(2 * math.pi, rel=1e-14)
