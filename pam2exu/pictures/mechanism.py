@@ -171,7 +171,7 @@ class Scene:
         ax.grid(True, alpha=0.2)
         with self.pen.owner("frame"):
             self.pen.frame()
-        self.pen.artists = []                  # the frame stays from frame to frame
+        self.pen.freeze()                      # the frame stays from frame to frame
 
     def _box(self, q_all, extra):
         """Lower-left and upper-right corners of everything drawn, over every row of q."""
@@ -213,6 +213,9 @@ class Scene:
         for el in self.mech.elements:
             with pen.owner(f"{el.type}:{el.name}"):
                 el.draw(pen, st)
+                if el.equations:               # joints and actuators: their names
+                    pen.name(el.name)
+        pen.place_labels()
 
 
 def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI,
@@ -278,9 +281,18 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     scene.show(t, q)
     when = f"t = {t:g} s (kinematic run)" if t else "assembled at t = 0"
     ax.set_title(f"'{mech.name}' — {when}")
+    _settle(fig, scene)
     if path is not None:
         save(fig, path)
     return fig
+
+
+def _settle(fig, scene) -> None:
+    """Lay the figure out once and keep that layout, then place the names for it (their
+    places depend on the axes' size in pixels)."""
+    fig.canvas.draw()
+    fig.set_layout_engine("none")
+    scene.pen.place_labels()
 
 
 def _traces(mech, names) -> list[tuple[str, int, tuple[float, float]]]:

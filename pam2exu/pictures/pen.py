@@ -31,8 +31,10 @@ JOINT = 0.012
 GUIDE = 0.12
 #: length of a force arrow and of the global frame's axes, fraction of the size
 ARROW, FRAME = 0.10, 0.08
-#: gap between a solid's shape and its name [points]
-LABEL_OFFSET = 7.0
+#: gap between a symbol and its name [points]
+LABEL_OFFSET = 4.0
+#: font sizes of the names of solids and of joints and actuators [points]
+SOLID_FONT, ELEMENT_FONT = 9, 8
 
 # drawing order (larger on top)
 Z_GUIDE, Z_SOLID, Z_BAR, Z_SPRING, Z_BLOCK, Z_SUPPORT, Z_JOINT, Z_LOAD, Z_TEXT = range(1, 10)
@@ -91,7 +93,18 @@ class Pen:
         self.grounded = set(grounded)
         self.colors = dict(colors or {})
         self.artists: list = []
-        self.labels: list[np.ndarray] = []          # where the solids' names are
+        #: names to place (``place_labels``): dicts of artist, anchor [m], reach [m],
+        #: extra reach [points] and preferred direction
+        self.labels: list[dict] = []
+        #: what the drawing covers, in metres: polylines the names keep off
+        self.marks: list[np.ndarray] = []
+        #: where each owner's symbol is: gid → (point [m], reach [m], colour)
+        self.symbols: dict[str, tuple[np.ndarray, float, str]] = {}
+        #: the global frame's lines and texts, kept from frame to frame (``freeze``)
+        self.static_marks: list[np.ndarray] = []
+        self.static_texts: list = []
+        #: the thin lines from a symbol to its name when it is far (``place_labels``)
+        self.leaders: list = []
         self._gid: str | None = None
 
     # ---- bookkeeping -------------------------------------------------------------------
@@ -105,10 +118,27 @@ class Pen:
             self._gid = before
 
     def clear(self) -> None:
-        """Remove everything this pen drew."""
+        """Remove everything this pen drew (since ``freeze``)."""
         for a in self.artists:
             a.remove()
-        self.artists, self.labels = [], []
+        self.artists, self.labels, self.marks, self.symbols = [], [], [], {}
+        self.leaders = []
+
+    def freeze(self) -> None:
+        """Keep what is drawn so far (the global frame) through every ``clear``: its lines and
+        texts stay obstacles for the names."""
+        from matplotlib.text import Text
+        self.static_marks += self.marks
+        self.static_texts += [a for a in self.artists if isinstance(a, Text)]
+        self.artists, self.marks = [], []
+
+    def _mark(self, xy) -> None:
+        self.marks.append(np.asarray(xy, dtype=float).reshape(-1, 2))
+
+    def _symbol(self, p, reach: float, color=INK) -> None:
+        """Record the owner's symbol (its first one) for its name: at p, ``reach`` [m]."""
+        if self._gid is not None and self._gid not in self.symbols:
+            self.symbols[self._gid] = (np.asarray(p, dtype=float), float(reach), color)
 
     def color(self, solid: int) -> str:
         return GROUND if solid in self.grounded else self.colors.get(solid, INK)
@@ -126,18 +156,24 @@ class Pen:
     def _line(self, xy, **style):
         from matplotlib.lines import Line2D
         xy = np.asarray(xy, dtype=float)
+        self._mark(xy)
         return self._keep(self.ax.add_artist(Line2D(xy[:, 0], xy[:, 1], **style)))
 
     def _polygon(self, xy, **style):
         from matplotlib.patches import Polygon
-        return self._patch(Polygon(np.asarray(xy, dtype=float), closed=True, **style))
+        xy = np.asarray(xy, dtype=float)
+        self._mark(np.vstack([xy, xy[:1]]))
+        return self._patch(Polygon(xy, closed=True, **style))
 
     def _circle(self, p, radius, **style):
         from matplotlib.patches import Circle
+        a = np.linspace(0.0, 2.0 * np.pi, 17)
+        self._mark(np.asarray(p, dtype=float) + radius * np.column_stack([np.cos(a), np.sin(a)]))
         return self._patch(Circle(tuple(p), radius, **style))
 
     def _arrow(self, a, b, color, width=2.0, head=12, z=Z_LOAD):
         from matplotlib.patches import FancyArrowPatch
+        self._mark([a, b])
         return self._patch(FancyArrowPatch(tuple(a), tuple(b), arrowstyle="-|>",
                                            mutation_scale=head, color=color, lw=width,
                                            shrinkA=0, shrinkB=0, zorder=z))
@@ -171,26 +207,73 @@ class Pen:
         """Text centred ``offset`` points away from p (data coordinates), outlined in white."""
         import matplotlib.patheffects as pe
         t = self.ax.annotate(text, tuple(p), xytext=tuple(offset), textcoords="offset points",
-                             color=color, fontsize=9, ha="center", va="center",
-                             zorder=Z_TEXT, annotation_clip=True,
+                             color=color, ha="center", va="center", zorder=Z_TEXT,
+                             annotation_clip=True,
                              path_effects=[pe.withStroke(linewidth=3, foreground="white")],
-                             **style)
+                             **{"fontsize": 9, **style})
         return self._keep(t)
 
-    def label(self, p, text: str, away, color, **style):
-        """A solid's name near p, ``LABEL_OFFSET`` points along ``away``; on the other side
-        when another name is already close there."""
-        p, away = np.asarray(p, dtype=float), np.asarray(away, dtype=float)
-        near = 5.0 * self.r
-        for side in (away, -away):
-            if not any(np.hypot(*(q - (p + near * side))) < near for q in self.labels):
-                away = side
-                break
-        self.labels.append(p + near * away)
-        # clear of the shape: the text's half extent along ``away`` (9-point letters about
-        # 5.6 points wide), plus the gap
-        reach = LABEL_OFFSET + abs(away[0]) * 2.8 * len(text) + abs(away[1]) * 4.5
-        return self.text(p, text, color, offset=reach * away, **style)
+    def label(self, p, text: str, away, color, reach: float = 0.0, extra: float = 0.0,
+              **style):
+        """A name near p, placed by ``place_labels`` (after everything is drawn) where it
+        overlaps no other name: preferably along ``away`` (zero: on p; None: any side),
+        clear of ``reach`` [m] plus ``extra`` [points] around p."""
+        t = self.text(p, text, color, **style)
+        self.labels.append(dict(artist=t, anchor=np.asarray(p, dtype=float), reach=reach,
+                                extra=extra, prefer=None if away is None
+                                else np.asarray(away, dtype=float)))
+        return t
+
+    def name(self, text: str) -> None:
+        """The name of the owner (a joint, an actuator) beside its symbol, in its colour;
+        nothing when the owner drew no symbol with a place (``_symbol``)."""
+        if self._gid in self.symbols:
+            p, reach, color = self.symbols[self._gid]
+            self.label(p, text, None, color, reach=reach, extra=1.0, fontsize=ELEMENT_FONT)
+
+    def place_labels(self) -> None:
+        """Move every name to its place (``labels.place``): no two names overlap when it
+        can be helped, few lines are covered. Uses the figure's renderer: call it once the
+        axes have their final size."""
+        from .labels import place, sample
+        for line in self.leaders:              # placed before: placed again
+            line.remove()
+            self.artists.remove(line)
+        self.leaders = []
+        if not self.labels:
+            return
+        fig = self.ax.figure
+        renderer = fig.canvas.get_renderer()
+        to_px = self.ax.transData.transform
+        px_per_m = float(np.hypot(*(to_px([1.0, 0.0]) - to_px([0.0, 0.0]))))
+        px_per_pt = fig.dpi / 72.0
+        anchors, sizes = [], []
+        for lab in self.labels:
+            lab["artist"].xyann = (0.0, 0.0)
+            box = lab["artist"].get_window_extent(renderer)
+            anchors.append(to_px(lab["anchor"]))
+            sizes.append((box.width + 2.0 * px_per_pt, box.height))   # the white outline
+        reaches = [lab["reach"] * px_per_m + (lab["extra"] + LABEL_OFFSET) * px_per_pt
+                   for lab in self.labels]
+        marks = self.static_marks + self.marks
+        lines = np.vstack([sample(to_px(m)) for m in marks]) if marks else ()
+        fixed = [t.get_window_extent(renderer).extents for t in self.static_texts]
+        centres = place(np.array(anchors), reaches, sizes, [lab["prefer"] for lab in self.labels],
+                        lines, fixed, self.ax.bbox.extents, gap=LABEL_OFFSET * px_per_pt)
+        to_data = self.ax.transData.inverted().transform
+        gap = LABEL_OFFSET * px_per_pt
+        for lab, centre, anchor, size, reach in zip(self.labels, centres, anchors, sizes,
+                                                    reaches):
+            lab["artist"].xyann = tuple((centre - anchor) / px_per_pt)
+            # far from its symbol (a crowd): a thin leader from the symbol to the name
+            half = np.asarray(size) / 2
+            near = np.clip(anchor, centre - half, centre + half)
+            if np.hypot(*(near - anchor)) > reach + 2.0 * gap:
+                u = _unit(near - anchor)
+                ends = to_data(np.array([anchor + (reach - gap) * u, near - 2.0 * u]))
+                self.leaders.append(self._line(ends, color=lab["artist"].get_color(), lw=0.6,
+                                               alpha=0.7, zorder=Z_TEXT))
+                self.marks.pop()
 
     # ---- solids ------------------------------------------------------------------------
     def solid(self, solid: int, name: str, points: np.ndarray, origin: np.ndarray) -> None:
@@ -202,16 +285,18 @@ class Pen:
         if solid in self.grounded:
             self._line(everything, linestyle="none", marker="o", markersize=3.5,
                        color=GROUND, zorder=Z_SOLID)
-            self.label(origin, name, np.array([0.0, -1.9]), GROUND, fontstyle="italic")
+            self.label(origin, name, np.array([0.0, -1.0]), GROUND, reach=2.8 * self.r,
+                       fontstyle="italic", fontsize=SOLID_FONT)
             return
         shape = hull(everything, tol=1e-12 * self.size ** 2)
+        extra = 0.0
         if len(shape) == 1:
             self._circle(shape[0], 0.8 * self.r, color=color, zorder=Z_SOLID)
             where, away = shape[0], np.array([0.0, 1.0])
         elif len(shape) == 2:
             self._line(shape, color=color, lw=7, alpha=0.85, solid_capstyle="round",
                        zorder=Z_SOLID)
-            where = shape.mean(axis=0)
+            where, extra = shape.mean(axis=0), 3.5          # half the bar's width [points]
             away = _normal(_unit(shape[1] - shape[0]))
             away = away if away[1] >= 0 else -away
         else:
@@ -220,7 +305,8 @@ class Pen:
             self._polygon(shape, facecolor="none", edgecolor=color, lw=2.2,
                           joinstyle="round", zorder=Z_SOLID)
             where, away = shape.mean(axis=0), np.zeros(2)
-        self.label(where, name, away, color, fontweight="bold")
+        self.label(where, name, away, color, reach=0.8 * self.r if len(shape) == 1 else 0.0,
+                   extra=extra, fontweight="bold", fontsize=SOLID_FONT)
 
     def frame(self) -> None:
         """The global frame's x and y axes at the origin."""
@@ -237,6 +323,7 @@ class Pen:
         grounded solid to a moving one."""
         p = np.asarray(p, dtype=float)
         r = self.r
+        self._symbol(p, r)
         if any(s in self.grounded for s in solids) and not all(s in self.grounded
                                                                 for s in solids):
             self._polygon([p, p + [-1.7 * r, -2.8 * r], p + [1.7 * r, -2.8 * r]],
@@ -252,11 +339,13 @@ class Pen:
 
     def pin(self, p) -> None:
         """A pin that slides in a slot: a small filled circle."""
+        self._symbol(p, 0.65 * self.r)
         self._circle(p, 0.65 * self.r, facecolor=INK, edgecolor="white", lw=0.8,
                      zorder=Z_JOINT)
 
     def ground(self, p) -> None:
         """A fixed link: a wide ground line under the point."""
+        self._symbol(np.asarray(p, dtype=float) + [0.0, -3.2 * self.r], 0.6 * self.r)
         self._hatch(np.asarray(p, dtype=float) + [0.0, -2.8 * self.r], 8.0 * self.r)
 
     def guide(self, p, direction, follower, solid: int) -> None:
@@ -275,6 +364,7 @@ class Pen:
         """A slider block centred at p, along ``direction``."""
         p, d = np.asarray(p, dtype=float), _unit(direction)
         n, a, b = _normal(d), 2.6 * self.r, 1.6 * self.r
+        self._symbol(p, 2.0 * self.r)
         self._polygon([p - a * d - b * n, p + a * d - b * n, p + a * d + b * n,
                        p - a * d + b * n], facecolor=self.color(solid), alpha=0.9,
                       edgecolor=INK, lw=1.2, zorder=Z_BLOCK)
@@ -290,6 +380,7 @@ class Pen:
         else:
             r2 = d / (1.0 + k)
             r1 = d - r2
+        self._symbol(c1 + r1 * _unit(c2 - c1), 0.5 * self.r)
         for c, radius, s in ((c1, r1, solids[0]), (c2, r2, solids[1])):
             self._circle(c, radius, facecolor="none", edgecolor=self.color(s), lw=1.6,
                          linestyle="-.", zorder=Z_SPRING)
@@ -330,11 +421,13 @@ class Pen:
     def rotation(self, c) -> None:
         """An angular actuator about c: an arc arrow, counter-clockwise (the sense of a
         positive f(t)), open at the bottom, where a support may be."""
+        self._symbol(c, 4.2 * self.r, ACTUATOR)
         self._arc_arrow(c, 3.6 * self.r, -0.5 * np.pi + 0.75, 2.0 * np.pi - 1.9, ACTUATOR,
                         width=2.2)
 
     def cylinder(self, p, q) -> None:
         """A linear actuator: a thick bar from P to Q."""
+        self._symbol((np.asarray(p, dtype=float) + q) / 2, 0.6 * self.r, ACTUATOR)
         self._line([p, q], color=ACTUATOR, lw=9, alpha=0.45, solid_capstyle="butt",
                    zorder=Z_BAR)
         self._line([p, q], color=ACTUATOR, lw=1.5, zorder=Z_BAR)
