@@ -82,10 +82,11 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
     ("Errors",
      ("Every error pam2exu raises on purpose is a `Pam2ExuError`; its message is meant for "
       "the user as it is. Command-line exit codes: 2 for `ModelError` (and "
-      "`CompareInputError`, `PictureError`), 1 for the others."),
+      "`CompareInputError`, `PictureError`, `OutputError`), 1 for the others."),
      [("pam2exu", "Pam2ExuError"), ("pam2exu", "ModelError"), ("pam2exu", "MobilityError"),
       ("pam2exu", "SolverError"), ("pam2exu", "TranslationError"), ("pam2exu.errors", "Problem"),
-      ("pam2exu", "CompareInputError"), ("pam2exu", "PictureError")]),
+      ("pam2exu", "CompareInputError"), ("pam2exu", "PictureError"),
+      ("pam2exu", "OutputError")]),
     ("Warnings",
      ("Issued with `warnings.warn` at the caller's line and kept in `Results.warnings`; "
       "filter them with the `warnings` module."),
@@ -151,10 +152,20 @@ def is_element(obj) -> bool:
     return isinstance(obj, type) and obj in ELEMENTS.values()
 
 
+#: base classes whose methods are documented as their subclass's own (``Results``' other
+#: forms live in pam2exu/results/writers.py)
+MIXINS = ("Exports",)
+
+
 def members(cls) -> list[tuple[str, object]]:
-    """(name, attribute) of the public methods and properties a class defines, in source order."""
+    """(name, attribute) of the public methods and properties a class defines, in source order
+    (then those of its ``MIXINS`` bases)."""
     out = []
-    for name, attr in vars(cls).items():
+    own = dict(vars(cls))
+    for base in cls.__mro__[1:]:
+        if base.__name__ in MIXINS:
+            own.update({k: v for k, v in vars(base).items() if k not in own})
+    for name, attr in own.items():
         if name.startswith("_") and name not in DUNDERS:
             continue
         if isinstance(attr, (staticmethod, classmethod)):

@@ -13,7 +13,8 @@ The API reference is docs/api.md.
 """
 from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot, Prismatic,
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
-from .errors import (MobilityError, ModelError, Pam2ExuError, SolverError, TranslationError)
+from .errors import (MobilityError, ModelError, OutputError, Pam2ExuError, SolverError,
+                     TranslationError)
 from .export import export
 from .errors import ConditionWarning, ConsistencyWarning, RedundancyWarning, VariationWarning
 from .model import Law, Model, Solid, load, loads
@@ -137,5 +138,5 @@ __all__ = ["Model", "Solid", "Law", "load", "loads", "run", "Results", "read_csv
            "ELEMENTS", "Fixed", "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor",
            "Spring", "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError",
            "ModelError", "MobilityError", "SolverError", "TranslationError",
-           "CompareInputError", "PictureError", "RedundancyWarning", "ConsistencyWarning",
-           "ConditionWarning", "VariationWarning"]
+           "CompareInputError", "PictureError", "OutputError", "RedundancyWarning",
+           "ConsistencyWarning", "ConditionWarning", "VariationWarning"]

@@ -1,6 +1,7 @@
 """The ``pam2exu`` command: run and check PAM models, compare result files.
 
-Exit codes: 0 success, 1 solver failure, 2 model error (or bad command line).
+Exit codes: 0 success, 1 solver failure, 2 model error (or bad command line, or an output
+file that cannot be written as asked: an unknown suffix, a missing optional library).
 ``compare``: 0 every variable within the tolerance, 1 some outside, 2 bad input.
 ``verify``: 0 the two backends agree, 1 they differ or a run fails, 2 bad input.
 ``plot``, ``draw``, ``animate``: 2 also for a picture that cannot be made as asked (an
@@ -14,7 +15,7 @@ import sys
 import warnings
 
 from . import __version__
-from .errors import ModelError, Pam2ExuError, SolverError
+from .errors import ModelError, OutputError, Pam2ExuError, SolverError
 from .registry import ANALYSES, BACKENDS, DEFAULT_BACKEND
 from .verify import BACKENDS_COMPARED, verify
 
@@ -41,7 +42,16 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
     run.add_argument("--outputs", nargs="+", metavar="PAT",
                      help="columns to keep: names, 'solid.*', '*.Fx' or bare 'Fx'")
-    run.add_argument("-o", "--output", metavar="OUT.csv", help="write all rows as CSV")
+    run.add_argument("-o", "--output", metavar="OUT.csv",
+                     help="write all rows: .csv, .xlsx (pam2exu[excel]) or .parquet "
+                          "(pam2exu[parquet]), the format from the suffix")
+    run.add_argument("--sep", default=",", metavar="SEP",
+                     help="CSV separator: ',' (default), ';' or tab")
+    run.add_argument("--decimal", default=".", metavar="MARK",
+                     help="CSV decimal mark: '.' (default) or ',' (with --sep ';': the "
+                          "CSV Excel opens in Catalan or Spanish)")
+    run.add_argument("--bom", action="store_true",
+                     help="start the CSV with a UTF-8 byte-order mark (for Excel)")
     run.add_argument("--verbose", action="store_true", help="show Exudyn's solver output")
     run.add_argument("--plot", nargs="+", metavar="VAR",
                      help="plot these variables against t (names or patterns, as --outputs)")
@@ -181,6 +191,10 @@ def _picture_parsers(sub) -> None:
 def _run(args) -> int:
     from .analyses import run
     from .model import load
+    from .results.writers import check, write
+    sep = "\t" if args.sep in ("tab", "\\t") else args.sep
+    if args.output:                              # a bad file name fails before the run
+        check(args.output, sep, args.decimal, args.bom)
     model = load(args.model)
     backend = BACKENDS.get(args.backend or model.analysis.backend)
     # the backend's settings (an unknown name: run's model error names the known ones)
@@ -196,8 +210,10 @@ def _run(args) -> int:
     from .results.extremes import extremes_path, extremes_table, write_extremes
     extremes = extremes_table(table)             # a clearance run's, else ""
     if args.output:
-        path = table.to_csv(args.output)
+        path = write(table, args.output, sep, args.decimal, args.bom)
         print(f"wrote {len(table)} rows × {len(table.columns) + 1} columns to {path}")
+        if table.checks():
+            print("checks: " + "; ".join(table.checks()))
         if extremes:                             # beside the result
             print(f"wrote the extremes to {write_extremes(table, extremes_path(path))}")
         for w in res.warnings:
@@ -394,6 +410,8 @@ def main(argv=None) -> int:
             raise
         if isinstance(exc, ModelError):
             code, kind = 2, "model error"
+        elif isinstance(exc, OutputError):
+            code, kind = 2, "output error"
         elif isinstance(exc, SolverError):
             code, kind = 1, "solver failure"
         elif isinstance(exc, Pam2ExuError):

@@ -14,7 +14,7 @@ class Pam2ExuError(Exception):
 
     Catch this class to handle every error pam2exu raises on purpose (``ModelError``,
     ``MobilityError``, ``SolverError``, ``TranslationError``, ``CompareInputError``,
-    ``PictureError``).
+    ``PictureError``, ``OutputError``).
 
     Parameters
     ----------
@@ -206,6 +206,22 @@ class PictureError(Pam2ExuError):
     ----------
     message : str
         What cannot be done, and what to do instead.
+    """
+
+
+class OutputError(Pam2ExuError):
+    """A result cannot be written as asked: a file suffix that names no format pam2exu
+    writes, a separator and decimal mark that clash, or a format whose optional library is
+    not installed (the message names the extra to install, e.g. ``pip install
+    "pam2exu[excel]"``). CLI exit code 2.
+
+    Raised by ``Results.to_csv``, ``to_excel``, ``to_parquet``, ``to_pandas`` and
+    ``results.writers.write``; the message says what to change.
+
+    Parameters
+    ----------
+    message : str
+        What cannot be written, and what to do instead.
     """
 
 

@@ -27,6 +27,18 @@ def canonical_name(column: str, names: dict[str, str] | None = None) -> str:
     return canonical(column, names or {})[0]
 
 
+def spelled(pattern: str) -> str:
+    """A name or pattern in pam2exu's spelling: ``canonical_name`` with a dot, else the bare
+    variable through ``SPELLINGS`` (what ``--outputs``, ``plot`` and ``compare`` accept).
+
+    Examples
+    --------
+    >>> spelled("Forca"), spelled("*.Forca"), spelled("motor.f"), spelled("crank.*")
+    ('Força', '*.Força', 'motor.f(t)', 'crank.*')
+    """
+    return canonical_name(pattern) if "." in pattern else SPELLINGS.get(clean(pattern), pattern)
+
+
 def canonical(column: str, names: dict[str, str]) -> tuple[str, tuple[str, ...]]:
     """``canonical_name`` and the map keys it used."""
     col = clean(column)

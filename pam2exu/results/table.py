@@ -14,9 +14,11 @@ import numpy as np
 
 from ..errors import ModelError, Problem, closest
 from .info import RunInfo
+from .names import spelled
+from .writers import BOM, Exports, csv_translation
 
 
-class Results:
+class Results(Exports):
     """Columns ``<name>.<variable>`` over time, stored as one array.
 
     What ``pam2exu.run`` returns (and ``read_csv`` reads). ``res["crank.fi"]`` is a NumPy
@@ -24,7 +26,8 @@ class Results:
     name, for a column that does not exist), ``res.t`` the times [s], ``res.columns`` the
     column names (without ``t``), ``res.units`` their SI units, ``res.to_numpy()`` the
     (steps + 1, 1 + columns) array with ``t`` first (a view, no copy) and
-    ``res.to_csv(path)`` the CSV file of the contract. ``"crank.fi" in res`` tests for a
+    ``res.to_csv(path)`` the CSV file of the contract (``to_excel``, ``to_parquet`` and
+    ``to_pandas``: the other forms, ``results.writers``). ``"crank.fi" in res`` tests for a
     column, ``len(res)`` is the number of rows (times).
 
     Column names are ``<solid>.<variable>`` (``x``, ``y`` [m], ``fi`` [rad], ``Dx``, ``Dy``
@@ -138,7 +141,8 @@ class Results:
         """
         return self._data.T
 
-    def to_csv(self, path: str | Path) -> Path:
+    def to_csv(self, path: str | Path, sep: str = ",", decimal: str = ".",
+               bom: bool = False) -> Path:
         """Write UTF-8 CSV: header ``t,<name>.<variable>,…``, every value read back exactly.
 
         One line per time, ',' separated, each value in the fewest digits that read back as
@@ -148,12 +152,19 @@ class Results:
         name holding ',', ';' or '"' is quoted (``"a,b.x"``, a '"' doubled). The file is
         written under a temporary name and then renamed, so a failure never leaves half a
         file (nor the temporary one). ``read_csv`` and ``pam2exu compare`` read it; units
-        are not written.
+        are not written. ``sep=';', decimal=','`` writes the same digits with a decimal comma
+        (the CSV Excel opens in Catalan or Spanish), ``bom=True`` a UTF-8 byte-order mark first.
 
         Parameters
         ----------
         path : str or Path
             The CSV file to write (replaced if it exists).
+        sep : str
+            Separator: ',' (default), ';' or a tab.
+        decimal : str
+            Decimal mark: '.' (default) or ',' (with ``sep`` ';' or a tab).
+        bom : bool
+            Start the file with a UTF-8 byte-order mark (Excel then reads it as UTF-8).
 
         Returns
         -------
@@ -164,6 +175,8 @@ class Results:
         ------
         OSError
             The file cannot be written.
+        OutputError
+            An unknown separator or decimal mark, or both ','.
 
         Examples
         --------
@@ -171,13 +184,13 @@ class Results:
         >>> res.to_csv("crank.csv")                     # doctest: +SKIP
         PosixPath('crank.csv')
         """
-        path = Path(path)
+        path, translate = Path(path), csv_translation(sep, decimal)
         tmp = path.with_name(path.name + ".part")
         try:
             with open(tmp, "wb") as fh:
-                fh.write((_csv_header(self._names) + "\n").encode("utf-8"))
+                fh.write((BOM if bom else b"") + (_csv_header(self._names, sep) + "\n").encode())
                 for lines in _csv_lines(self._data.T):
-                    fh.write(lines)
+                    fh.write(lines if translate is None else translate[lines])
             tmp.replace(path)
         except BaseException:
             tmp.unlink(missing_ok=True)
@@ -299,8 +312,8 @@ _COMMA, _NEWLINE, _MINUS, _ZERO = b",\n-0"
 _WRITTEN = b"0123456789.-e,\nnaifty"
 
 
-def _csv_header(names) -> str:
-    """The header line (no line end): names ',' separated, quoted when CSV needs it.
+def _csv_header(names, sep: str = ",") -> str:
+    """The header line (no line end): names ``sep`` separated, quoted when CSV needs it.
 
     A name holding ',', ';', '"' or a line break is written in quotes, '"' doubled.
 
@@ -309,7 +322,7 @@ def _csv_header(names) -> str:
     >>> _csv_header(["t", "a,b.x", 'q"uo.y', "Força.Fx"])
     't,"a,b.x","q""uo.y",Força.Fx'
     """
-    return ",".join(csv_field(n) for n in names)
+    return sep.join(csv_field(n) for n in names)
 
 
 def csv_field(name: str) -> str:
@@ -375,7 +388,8 @@ def select_columns(columns: list[str], patterns) -> list[str]:
 
     Patterns are shell-style (``fnmatch``, case-sensitive); one without a dot means that
     variable of every solid and element (``Fx`` is ``*.Fx``). ``t`` matches nothing and is
-    no error (it is always in a table).
+    no error (it is always in a table). PAM's spellings are read as pam2exu's
+    (``names.spelled``: ``Forca`` is ``Força``, ``motor.f`` is ``motor.f(t)``).
 
     Parameters
     ----------
@@ -408,7 +422,7 @@ def select_columns(columns: list[str], patterns) -> list[str]:
     if isinstance(patterns, str):
         patterns = [patterns]
     chosen, problems = set(), []
-    for p in patterns:
+    for p in map(spelled, patterns):
         hits = [c for c in columns if fnmatch.fnmatchcase(c, _pattern(p))]
         if not hits and p != "t":
             problems.append(Problem("outputs", f"'{p}' matches no variable of this analysis"
