@@ -105,3 +105,13 @@ def four_bar(a, b, c, d, th, dth, ddth):
     ddpsi = (a * ddth * np.sin(phi - th) - a * dth**2 * np.cos(th - phi) - b * dphi**2
              + c * dpsi**2 * np.cos(psi - phi)) / (c * np.sin(phi - psi))
     return (phi, dphi, ddphi), (psi, dpsi, ddpsi)
+
+
+def rigid_point(r, dr, ddr, fi, dfi, ddfi, s):
+    """Point s (local) of a solid with origin r and angle fi: p = r + R(fi) s.
+
+    p' = r' + fi' Ω R s, p'' = r'' + fi'' Ω R s − fi'² R s (Ω: turn by +90°).
+    """
+    Rs = np.stack([np.cos(fi) * s[0] - np.sin(fi) * s[1], np.sin(fi) * s[0] + np.cos(fi) * s[1]])
+    ORs = np.stack([-Rs[1], Rs[0]])
+    return r + Rs, dr + dfi * ORs, ddr + ddfi * ORs - dfi**2 * Rs

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .. import registry
+from .. import points, registry
 from ..backend import Backend
 from ..elements import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY, Var
 from ..errors import ModelError, Problem, RedundancyWarning, warn_outside
@@ -56,6 +56,8 @@ def available_columns(mech, analysis: str) -> dict[str, Var]:
                 out[f"{s.name}.{var.name}"] = var
     if kind.at_start:
         return out
+    if kind.element_outputs:                     # opt-in: points, centres, couplers
+        out.update((c, var) for c, var in derived_columns(mech) if var.level in kind.levels)
     for el in mech.elements if kind.element_outputs else ():
         for var in el.outputs:
             if var.level in kind.levels:
@@ -65,6 +67,21 @@ def available_columns(mech, analysis: str) -> dict[str, Var]:
             if getattr(el, "clearance", False):
                 for var in el.clearance_parameters + el.clearance_derived:
                     out[f"{el.name}.{var.name}"] = var
+    return out
+
+
+def derived_columns(mech) -> list[tuple[str, Var]]:
+    """The opt-in columns (``points``), in order: per solid its instantaneous centre (if it
+    is not fixed), its transmission angle (if it is a coupler), then its points' motion."""
+    ground, coupled = points.fixed_solids(mech), {c.solid for c in points.couplers(mech)}
+    out = []
+    for i, s in enumerate(mech.solids):
+        if i not in ground:
+            out += [(f"{s.name}.{var.name}", var) for var in points.CENTRE_OUTPUTS]
+        if i in coupled:
+            out += [(f"{s.name}.{var.name}", var) for var in points.COUPLER_OUTPUTS]
+        out += [(f"{s.name}.{p}.{var.name}", var) for p in s.points
+                for var in points.POINT_OUTPUTS]
     return out
 
 
@@ -85,7 +102,10 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
     kind = registry.ANALYSES[settings.type]
     available = available_columns(mech, kind.name)
     try:
-        columns = select_columns(list(available), settings.outputs)
+        if settings.outputs is None:             # the default: every column not opt-in
+            columns = [c for c in available if not points.is_opt_in(c)]
+        else:
+            columns = select_columns(list(available), settings.outputs)
     except ModelError as exc:
         raise ModelError(exc.problems, model.source) from None
     if kind.at_start:
@@ -167,6 +187,10 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
             for var, v in el.compute(st, names).items():
                 if var in names:
                     values[f"{el.name}.{var}"] = v
+    derived, notes = points.columns(mech, t, q, qd, qdd, wanted)
+    values.update(derived)
+    if notes:
+        job.info["undefined"] = "; ".join(notes)
     values.update(extra)
     res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
                   mech.name, job.warnings, job.info)
@@ -174,5 +198,7 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
     np.add(table, 0.0, out=table)        # no negative zeros in tables
     if not (np.isfinite(table).all()
             and all(np.isfinite(v).all() for k, v in values.items() if k not in wanted)):
-        check_finite(job, t, values)
+        # an instantaneous centre is NaN by definition where the solid translates
+        check_finite(job, t, {k: v for k, v in values.items()
+                              if k.rpartition(".")[2] not in ("ICx", "ICy")})
     return res

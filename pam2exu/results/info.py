@@ -47,6 +47,9 @@ class RunInfo(MutableMapping):
         kinetostatic: steps at which the power balance was checked.
     power_balance : str
         kinetostatic: why the power balance was not checked (too few rows).
+    undefined : str
+        Columns asked for that are NaN by definition at some rows, and why (an
+        instantaneous centre where its solid translates: ``points.columns``).
 
     Examples
     --------
@@ -73,6 +76,7 @@ class RunInfo(MutableMapping):
     power_balance_tolerance: float | None = None
     power_balance_steps: int | None = None
     power_balance: str | None = None
+    undefined: str | None = None
 
     def _field(self, key: str) -> str:
         if key not in _NAMES:

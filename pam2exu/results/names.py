@@ -8,7 +8,10 @@ columns or the solid or element before the dot. ``compare``, ``read_csv``, ``plo
 """
 from __future__ import annotations
 
+import fnmatch
 import unicodedata
+
+from ..points import OPT_IN
 
 # PAM spellings of variable names -> pam2exu's (applied to the part after the last dot)
 SPELLINGS = {"Forca": "Força", "f": "f(t)", "Df": "Df(t)"}
@@ -69,3 +72,26 @@ def listing(names, n: int = _SHOWN) -> str:
     names = list(names)
     more = f", … and {len(names) - n} more" if len(names) > n else ""
     return ", ".join(names[:n]) + more
+
+
+def selects(pattern: str, column: str) -> bool:
+    """Whether an ``outputs`` pattern (a dot already added to a bare name) chooses a column.
+
+    Shell-style (``fnmatch``, case-sensitive), with two rules for the opt-in columns
+    (``points.is_opt_in``): a pattern matches only columns of as many parts (a point's
+    ``solid.point.variable`` only a pattern of three: ``coupler.P.*``, ``*.P.x``, ``*.*.v``),
+    and chooses an instantaneous centre or a transmission angle (``points.OPT_IN``) only
+    when its variable part starts with a letter, not a wildcard (``*.IC*``, ``crank.ICx``,
+    ``transmission_angle``; not ``crank.*`` nor ``*x``).
+
+    Examples
+    --------
+    >>> [selects(p, "crank.A.x") for p in ("crank.*", "crank.A.*", "*.*.x")]
+    [False, True, True]
+    >>> [selects(p, "crank.ICx") for p in ("crank.*", "*.*x", "*.IC*", "*.ICx")]
+    [False, False, True, True]
+    """
+    if pattern.count(".") != column.count(".") or not fnmatch.fnmatchcase(column, pattern):
+        return False
+    variable = column.rpartition(".")[2]
+    return variable not in OPT_IN or pattern.rpartition(".")[2][:1] not in ("*", "?", "[", "")

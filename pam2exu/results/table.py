@@ -6,7 +6,6 @@ writer writes (``_read_own``); any result CSV file is read by ``reading.read_csv
 from __future__ import annotations
 
 import csv
-import fnmatch
 import io
 from pathlib import Path
 
@@ -14,7 +13,7 @@ import numpy as np
 
 from ..errors import ModelError, Problem, closest
 from .info import RunInfo
-from .names import spelled
+from .names import selects, spelled
 from .writers import BOM, Exports, csv_translation
 
 
@@ -423,7 +422,7 @@ def select_columns(columns: list[str], patterns) -> list[str]:
         patterns = [patterns]
     chosen, problems = set(), []
     for p in map(spelled, patterns):
-        hits = [c for c in columns if fnmatch.fnmatchcase(c, _pattern(p))]
+        hits = [c for c in columns if selects(_pattern(p), c)]
         if not hits and p != "t":
             problems.append(Problem("outputs", f"'{p}' matches no variable of this analysis"
                                                f"{closest(p, columns)}"))

@@ -14,6 +14,7 @@ import math
 
 from ..elements import ELEMENTS
 from ..model.solid import SOLID_OUTPUTS
+from ..points import CENTRE_OUTPUTS, COUPLER_OUTPUTS, POINT_OUTPUTS
 from .names import canonical_name
 
 
@@ -33,7 +34,8 @@ def declared_units() -> dict[str, tuple[str, ...]]:
     (('N·m',), ('rad', 'm'))
     """
     out: dict[str, list[str]] = {}
-    for var in (*SOLID_OUTPUTS, *(v for cls in ELEMENTS.values() for v in cls.outputs)):
+    for var in (*SOLID_OUTPUTS, *POINT_OUTPUTS, *CENTRE_OUTPUTS, *COUPLER_OUTPUTS,
+                *(v for cls in ELEMENTS.values() for v in cls.outputs)):
         units = out.setdefault(var.name, [])
         if var.unit not in units:
             units.append(var.unit)

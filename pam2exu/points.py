@@ -1,0 +1,292 @@
+"""What a teacher reads off a moving mechanism besides the solids' x, y, fi: the motion of
+any declared point, each solid's instantaneous centre of rotation, and the transmission
+angle of a coupler (issue 14).
+
+These columns are *opt-in* (``OPT_IN``): ``--outputs`` / ``outputs`` patterns must ask for
+them (docs/model-format.md, "Output variables"), so default tables do not change.
+
+- ``<solid>.<point>.<variable>``: x, y [m], Dx, Dy [m/s], v = |(Dx, Dy)|, DDx, DDy [m/s²],
+  a = |(DDx, DDy)| of the point declared in the solid's ``points`` (``point_motion``:
+  exact, from the solid's own x … DDfi of the same pass, no differencing).
+- ``<solid>.ICx``, ``<solid>.ICy`` [m]: the instantaneous centre of every solid not held
+  by a ``fixed`` link (``instantaneous_centre``); NaN where it translates (Dfi = 0).
+- ``<coupler>.transmission_angle`` [rad]: of a solid joined by two revolutes to a driven
+  input and to a rocker or a slider (``couplers``, ``transmission_angle``).
+
+The functions are pure and vectorised over time steps (arrays of shape (n,) or (n, 2)),
+so a drawing can call them on one configuration as well.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .elements.base import ACCELERATION, POSITION, VELOCITY, Var
+from .kinematics import State, perp, pose, rotate
+
+#: the outputs of every declared point: columns ``<solid>.<point>.<variable>``
+POINT_OUTPUTS = (
+    Var("x", "m", POSITION, "x of the point, global frame: x_P = x + R(fi) p"),
+    Var("y", "m", POSITION, "y of the point, global frame"),
+    Var("Dx", "m/s", VELOCITY, "dx_P/dt: v_P = v + Dfi Ω R(fi) p"),
+    Var("Dy", "m/s", VELOCITY, "dy_P/dt"),
+    Var("v", "m/s", VELOCITY, "speed of the point, |v_P| = √(Dx² + Dy²)"),
+    Var("DDx", "m/s²", ACCELERATION, "d²x_P/dt²: a_P = a + DDfi Ω R(fi) p − Dfi² R(fi) p"),
+    Var("DDy", "m/s²", ACCELERATION, "d²y_P/dt²"),
+    Var("a", "m/s²", ACCELERATION, "magnitude of the point's acceleration, |a_P|"),
+)
+#: the instantaneous centre of a moving solid: columns ``<solid>.ICx``, ``<solid>.ICy``
+CENTRE_OUTPUTS = (
+    Var("ICx", "m", VELOCITY, "x of the instantaneous centre of rotation, x − Dy/Dfi "
+                              "(NaN where the solid translates, Dfi = 0)"),
+    Var("ICy", "m", VELOCITY, "y of the instantaneous centre of rotation, y + Dx/Dfi"),
+)
+#: the transmission angle of a coupler: column ``<coupler>.transmission_angle``
+COUPLER_OUTPUTS = (
+    Var("transmission_angle", "rad", POSITION,
+        "acute angle between the coupler line (input pin → output pin) and the normal to "
+        "the output pin's path: the rocker line for a rocker, the guide's normal for a "
+        "slider; π/2 is ideal (the coupler pushes along the pin's path), 0 a toggle "
+        "position"),
+)
+#: the point columns of its position, velocity and acceleration: (x, y, magnitude)
+_POINT_PARTS = (("x", "y", "distance"), ("Dx", "Dy", "v"), ("DDx", "DDy", "a"))
+#: the variables a pattern must name to select them (besides every point column)
+OPT_IN = frozenset(v.name for v in CENTRE_OUTPUTS + COUPLER_OUTPUTS)
+#: an instantaneous centre farther than this many mechanism lengths is at infinity
+#: (the solid translates): |v| / |Dfi| > FAR · L gives NaN
+FAR = 1e9
+
+
+def is_opt_in(column: str) -> bool:
+    """A column the default outputs leave out: a point's (two dots) or an ``OPT_IN`` variable.
+
+    Examples
+    --------
+    >>> is_opt_in("coupler.P.x"), is_opt_in("crank.ICx"), is_opt_in("crank.x")
+    (True, True, False)
+    """
+    owner, _, variable = column.rpartition(".")
+    return "." in owner or variable in OPT_IN
+
+
+def point_motion(r, v, a, fi, dfi, ddfi, p):
+    """(x_P, v_P, a_P) of the local point p: x + R p, v + Dfi Ω R p, a + DDfi Ω R p − Dfi² R p.
+
+    Parameters
+    ----------
+    r, v, a : array_like (n, 2)
+        The solid's origin, its velocity and acceleration (None for v, a: not computed).
+    fi, dfi, ddfi : array_like (n,)
+        Its angle and angular rates (None when not computed).
+    p : (float, float)
+        The point in the solid's local frame [m].
+
+    Returns
+    -------
+    tuple of numpy.ndarray (n, 2) or None
+        Position, velocity and acceleration of the point (None where the input was None).
+
+    Examples
+    --------
+    >>> x, v, a = point_motion([[1.0, 0.0]], [[0.0, 0.0]], [[0.0, 0.0]], [np.pi / 2],
+    ...                        [2.0], [0.0], (0.5, 0.0))
+    >>> [(np.round(u, 12) + 0.0).tolist() for u in (x, v, a)]
+    [[[1.0, 0.5]], [[-1.0, 0.0]], [[0.0, -2.0]]]
+    """
+    Rp = rotate(np.asarray(fi, dtype=float), np.asarray(p, dtype=float))
+    x = np.asarray(r, dtype=float) + Rp
+    vel = acc = None
+    if v is not None:
+        dfi = np.asarray(dfi, dtype=float)[:, None]
+        vel = np.asarray(v, dtype=float) + dfi * perp(Rp)
+        if a is not None:
+            ddfi = np.asarray(ddfi, dtype=float)[:, None]
+            acc = np.asarray(a, dtype=float) + ddfi * perp(Rp) - dfi * dfi * Rp
+    return x, vel, acc
+
+
+def instantaneous_centre(r, v, dfi, length: float = 1.0) -> np.ndarray:
+    """I = r + Ω v / Dfi: the point of the solid's plane at rest, v_I = v + Dfi Ω (I − r) = 0.
+
+    Ω v = (−vy, vx), so I = (x − Dy/Dfi, y + Dx/Dfi). Where the solid translates (Dfi = 0,
+    or I farther than ``FAR`` · ``length`` from r: |v| > FAR · length · |Dfi|) there is no
+    centre: NaN.
+
+    Parameters
+    ----------
+    r, v : array_like (n, 2)
+        Any point of the solid (its frame's origin) and that point's velocity.
+    dfi : array_like (n,)
+        The solid's angular velocity [rad/s].
+    length : float
+        The mechanism's length scale [m] (``Mechanism.scale()``), for "at infinity".
+
+    Returns
+    -------
+    numpy.ndarray (n, 2)
+        The instantaneous centre [m], NaN rows where it is undefined.
+
+    Examples
+    --------
+    >>> instantaneous_centre([[1.0, 0.0], [0.0, 0.0]], [[0.0, 2.0], [1.0, 0.0]], [2.0, 0.0])
+    array([[ 0.,  0.],
+           [nan, nan]])
+    """
+    r, v = np.asarray(r, dtype=float), np.asarray(v, dtype=float)
+    dfi = np.asarray(dfi, dtype=float)
+    speed = np.hypot(v[:, 0], v[:, 1])
+    defined = (dfi != 0.0) & (speed <= FAR * length * np.abs(dfi))
+    out = np.full(r.shape, np.nan)
+    out[defined] = r[defined] + perp(v[defined]) / dfi[defined, None]
+    return out
+
+
+def transmission_angle(a, b, normal) -> np.ndarray:
+    """μ = atan2(|c × n|, |c · n|), c = b − a: the acute angle between the coupler line (pin a
+    to pin b) and the normal n to the output pin's path at b, in [0, π/2].
+
+    For a rocker pinned at O, n = b − O (μ: the acute angle between coupler and rocker); for
+    a slider on a guide of direction d, n = Ω d. Equivalently μ = π/2 − α, α the pressure
+    angle between the coupler (the force of a two-force member) and b's velocity.
+
+    Examples
+    --------
+    >>> transmission_angle([[0.0, 0.0]], [[1.0, 1.0]], [[0.0, 1.0]]) * 4 / np.pi
+    array([1.])
+    """
+    c = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
+    n = np.asarray(normal, dtype=float)
+    return np.arctan2(np.abs(c[:, 0] * n[:, 1] - c[:, 1] * n[:, 0]),
+                      np.abs(c[:, 0] * n[:, 0] + c[:, 1] * n[:, 1]))
+
+
+@dataclass(frozen=True)
+class Coupler:
+    """A coupler of a four-bar or slider-crank: solid ``solid`` joined by revolutes to an
+    input driven from a fixed solid (at its point ``input_pin``) and to an output (at
+    ``output_pin``) that is a rocker pinned to a fixed solid at ``pivot`` or a slider on a
+    fixed solid's line ``guide`` (PointRef / LineRef; the other one None)."""
+
+    solid: int
+    input_pin: object
+    output_pin: object
+    pivot: object = None
+    guide: object = None
+
+    def angle(self, st) -> np.ndarray:
+        """Its transmission angle [rad] at the configurations of a ``kinematics.State``."""
+        a, b = (st.point(p.solid, p.local).value for p in (self.input_pin, self.output_pin))
+        if self.pivot is not None:
+            normal = b - st.point(self.pivot.solid, self.pivot.local).value
+        else:
+            normal = perp(st.direction(self.guide.solid, self.guide.direction).value)
+        return transmission_angle(a, b, normal)
+
+
+def fixed_solids(mech) -> set[int]:
+    """The solids held by a ``fixed`` link (the ground)."""
+    return {el.ref1.solid for el in mech.elements if el.type == "fixed"}
+
+
+def couplers(mech) -> list[Coupler]:
+    """The couplers whose transmission angle is defined, in the order of the solids.
+
+    A coupler is a solid not fixed whose only constraint elements are two revolutes, to two
+    other solids that are not fixed. One of those, the input, is driven by an actuator
+    from a fixed solid; the other, the output, is a rocker (a revolute to a fixed solid) or
+    a slider (a prismatic on a fixed solid). Any other arrangement has no column.
+    """
+    ground = fixed_solids(mech)
+    around: dict[int, list] = {}
+    for el in mech.constraints:
+        for s in set(el.solids):
+            around.setdefault(s, []).append(el)
+
+    def driven(x: int) -> bool:
+        return any(el.drives and set(el.solids) - {x} <= ground and x in el.solids
+                   and len(set(el.solids)) == 2 for el in around.get(x, ()))
+
+    def held(x: int, kind: str):
+        """The fixed solid's reference of a ``kind`` element between x and a fixed solid."""
+        for el in around.get(x, ()):
+            others = [r for r in el.refs if r.solid != x]
+            if el.type == kind and len(others) == 1 and others[0].solid in ground:
+                return others[0]
+        return None
+
+    out = []
+    for s in range(len(mech.solids)):
+        joints = around.get(s, [])
+        if s in ground or len(joints) != 2 or any(el.type != "revolute" for el in joints):
+            continue
+        ends = []
+        for el in joints:
+            own, other = (el.ref1, el.ref2) if el.ref1.solid == s else (el.ref2, el.ref1)
+            ends.append((own, other.solid))
+        if len({x for _, x in ends}) != 2 or any(x in ground or x == s for _, x in ends):
+            continue
+        inputs = [k for k, (_, x) in enumerate(ends) if driven(x)]
+        if len(inputs) != 1:
+            continue
+        (pin_in, _), (pin_out, x_out) = ends[inputs[0]], ends[1 - inputs[0]]
+        pivot, guide = held(x_out, "revolute"), held(x_out, "prismatic")
+        if pivot is not None or guide is not None:
+            out.append(Coupler(s, pin_in, pin_out, pivot, None if pivot is not None else guide))
+    return out
+
+
+def columns(mech, t, q, qd, qdd, wanted) -> tuple[dict[str, np.ndarray], list[str]]:
+    """The opt-in columns among ``wanted``, from x … DDfi of every solid at the times t.
+
+    Parameters
+    ----------
+    mech : Mechanism
+    t : numpy.ndarray (n,)
+    q, qd, qdd : numpy.ndarray (n, nq) or None
+        The solids' coordinates and rates (``kinematics.pose``), None where not computed.
+    wanted : set of str
+        The column names asked for.
+
+    Returns
+    -------
+    (dict, list of str)
+        Column → values (n,), and one note per solid whose centre is NaN somewhere (why,
+        where first), for the results' info.
+    """
+    out, notes = {}, []
+    length = mech.scale()
+    st = None
+    for c in couplers(mech):
+        name = f"{mech.solids[c.solid].name}.transmission_angle"
+        if name in wanted:
+            if st is None:
+                st = State(t, q, jacobians=False)
+            out[name] = c.angle(st)
+    for i, s in enumerate(mech.solids):
+        x, dx, ddx = (None if a is None else a[:, pose(i)] for a in (q, qd, qdd))
+        if f"{s.name}.ICx" in wanted or f"{s.name}.ICy" in wanted:
+            centre = instantaneous_centre(x[:, :2], dx[:, :2], dx[:, 2], length)
+            out[f"{s.name}.ICx"], out[f"{s.name}.ICy"] = centre[:, 0], centre[:, 1]
+            nan = np.flatnonzero(np.isnan(centre[:, 0]))
+            if nan.size:
+                notes.append(f"{s.name}.ICx, {s.name}.ICy are NaN at {nan.size} of {len(t)} "
+                             f"rows, first t = {t[nan[0]]:.6g} s: there the solid translates or "
+                             f"is at rest (Dfi = 0) and has no instantaneous centre")
+        for p, local in s.points.items():
+            prefix = f"{s.name}.{p}."
+            names = {v.name for v in POINT_OUTPUTS if prefix + v.name in wanted}
+            if not names:
+                continue
+            motion = point_motion(x[:, :2], None if dx is None else dx[:, :2],
+                                  None if ddx is None else ddx[:, :2], x[:, 2],
+                                  None if dx is None else dx[:, 2],
+                                  None if ddx is None else ddx[:, 2], local)
+            found = {}
+            for (along_x, along_y, size), vector in zip(_POINT_PARTS, motion):
+                if vector is not None:
+                    found[along_x], found[along_y] = vector[:, 0], vector[:, 1]
+                    found[size] = np.hypot(vector[:, 0], vector[:, 1])
+            out.update({prefix + name: found[name] for name in names})
+    return out, notes
