@@ -47,11 +47,12 @@ class AnalysisType:
     driven : bool
         Every degree of freedom must be driven by an actuator (else ``MobilityError``).
     at_start : bool
-        It solves t = 0 only and gives the solids' x, y, fi (no element outputs).
+        It solves t = 0 only (one row).
     element_outputs : bool
-        The elements' outputs of its levels are among its columns (default). The clearance
-        analysis gives only the solids' x, y, fi and its clearance parameters (the contract's
-        columns): an element's outputs there would be computed at the nominal dimensions.
+        The elements' outputs of its levels are among its columns (default). The assembly
+        gives only the solids' x, y, fi; the clearance analysis the solids' x, y, fi and its
+        clearance parameters (the contract's columns: an element's outputs there would be
+        computed at the nominal dimensions).
     summary : str
         One line for help texts.
     function : str or callable
@@ -91,7 +92,7 @@ _ALL = frozenset({POSITION, VELOCITY, ACCELERATION, FORCE})
 ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("assembly", "ensamblatge", frozenset({POSITION}), driven=False,
                  at_start=True, summary="the constraints solved at t = 0 from the guess",
-                 function="pam2exu.analyses.assembly:assembly"),
+                 function="pam2exu.analyses.assembly:assembly", element_outputs=False),
     AnalysisType("quasi_static", "quasi_estatica", frozenset({POSITION, FORCE}), driven=True,
                  at_start=False, summary="positions and static equilibrium, no rates",
                  function="pam2exu.analyses.quasi_static:quasi_static"),
@@ -107,6 +108,11 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
                  summary="the clearance of least norm of an over-constrained mechanism as "
                  "its dimensions vary (shared/spec/clearance.md)",
                  function="pam2exu.analyses.clearance:clearance", element_outputs=False),
+    AnalysisType("equilibrium", "equilibri", frozenset({POSITION, FORCE}), driven=False,
+                 at_start=True,
+                 summary="the free degrees of freedom in stable static equilibrium at t = 0 "
+                 "(shared/spec/dynamics.md)",
+                 function="pam2exu.analyses.equilibrium:equilibrium"),
 )}
 
 #: the backends; the first is the default
@@ -129,10 +135,10 @@ def analysis_type(name: str) -> AnalysisType | None:
 
 def analyses_giving(level: str, owner: str = "element") -> list[str]:
     """The analyses (names, in order) whose outputs include the variables of ``level`` of a
-    ``'solid'`` or an ``'element'`` (an analysis ``at_start`` gives only the solids' x, y,
-    fi; one without ``element_outputs`` no element outputs but those of its own levels)."""
+    ``'solid'`` or an ``'element'`` (one without ``element_outputs`` gives no element
+    outputs but those of its own levels)."""
     # the levels that only analyses without element outputs give (the clearance parameters)
     own = {lv for a in ANALYSES.values() for lv in a.levels} - {
         lv for a in ANALYSES.values() if a.element_outputs for lv in a.levels}
-    return [a.name for a in ANALYSES.values() if level in a.levels and not a.at_start
+    return [a.name for a in ANALYSES.values() if level in a.levels
             and (owner == "solid" or a.element_outputs or level in own)]

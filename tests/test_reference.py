@@ -111,18 +111,19 @@ def test_solid_and_analysis_keys_match_the_contract():
 
 def test_levels_of_the_reference_are_those_the_analyses_use():
     """Which analyses give each kind of output (the contract's analysis table: assembly
-    gives only the solids' x, y, fi), as the registry declares and the pages say."""
-    expected = {POSITION: "quasi_static, kinematic, kinetostatic",
+    gives only the solids' x, y, fi; clearance.md: clearance gives the solids' x, y, fi and
+    its clearance parameters; dynamics.md: equilibrium gives quasi_static's outputs), as
+    the registry declares and the pages say."""
+    expected = {POSITION: "quasi_static, kinematic, kinetostatic, equilibrium",
                 VELOCITY: "kinematic, kinetostatic", ACCELERATION: "kinematic, kinetostatic",
-                FORCE: "quasi_static, kinetostatic", CLEARANCE: "clearance"}
+                FORCE: "quasi_static, kinetostatic, equilibrium", CLEARANCE: "clearance"}
     for level, analyses in expected.items():
         assert reference._analyses(level) == analyses
         assert set(analyses.split(", ")) == {
-            a.name for a in ANALYSES.values() if level in a.levels and not a.at_start
+            a.name for a in ANALYSES.values() if level in a.levels
             and (a.element_outputs or level == CLEARANCE)}
-    # clearance.md: the clearance analysis gives the solids' x, y, fi, no element outputs
     assert reference._analyses(POSITION, "solid") == (
-        "quasi_static, kinematic, kinetostatic, clearance")
+        "assembly, quasi_static, kinematic, kinetostatic, clearance, equilibrium")
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)

@@ -49,15 +49,15 @@ class Job:
 def available_columns(mech, analysis: str) -> dict[str, Var]:
     """Every column the analysis can produce, in order: solids, then elements."""
     kind = registry.ANALYSES[analysis]
-    out = {}
+    out, derived = {}, {}
+    for c, var in derived_columns(mech) if kind.element_outputs else ():
+        if var.level in kind.levels:             # opt-in: points, centres, couplers
+            derived.setdefault(c.partition(".")[0], []).append((c, var))
     for s in mech.solids:
         for var in SOLID_OUTPUTS:
             if var.level in kind.levels:
                 out[f"{s.name}.{var.name}"] = var
-    if kind.at_start:
-        return out
-    if kind.element_outputs:                     # opt-in: points, centres, couplers
-        out.update((c, var) for c, var in derived_columns(mech) if var.level in kind.levels)
+        out.update(derived.get(s.name, ()))
     for el in mech.elements if kind.element_outputs else ():
         for var in el.outputs:
             if var.level in kind.levels:

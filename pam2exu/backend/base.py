@@ -67,6 +67,10 @@ class Backend(Protocol):
         the mechanism's length) and ``verbose`` (0: quiet).
     gives_rates : bool
         ``solve_positions(..., rates=True)`` returns velocities and accelerations too.
+    moves_free_solids : bool
+        ``solve_positions(..., forces=True)`` moves the free degrees of freedom to a static
+        equilibrium (the ``equilibrium`` analysis needs it); otherwise it only gives the
+        multipliers at positions the constraints fix.
     """
 
     name: ClassVar[str]
@@ -74,6 +78,7 @@ class Backend(Protocol):
     solver_name: ClassVar[str]
     Settings: ClassVar[type]
     gives_rates: ClassVar[bool]
+    moves_free_solids: ClassVar[bool]
 
     def solve_positions(self, mech, times: np.ndarray, start: np.ndarray, settings, *,
                         redundant: bool = False, forces: bool = False,
@@ -95,8 +100,9 @@ class Backend(Protocol):
             Solve the static equilibrium with the masses, gravity and force elements (no
             dampers) and return its multipliers.
         anchor_stiffness : float
-            If > 0, tie every coordinate to its initial guess by a spring of this
-            stiffness, so that free degrees of freedom stay nearest the guess (assembly).
+            If > 0, tie every coordinate to its value in ``start`` by a spring of this
+            stiffness, so that free degrees of freedom stay nearest it (the assembly from
+            the guess; the equilibrium's descent steps).
         rates : bool
             Also return ``Positions.qd`` and ``qdd`` (ignored unless ``gives_rates``).
         """

@@ -14,6 +14,7 @@ class Exudyn:
     solver_name = "Exudyn's static solver"
     Settings = SolveSettings
     gives_rates = False
+    moves_free_solids = True
 
     def solve_positions(self, mech, times, start, settings, *, redundant=False, forces=False,
                         anchor_stiffness=0.0, rates=False) -> Positions:

@@ -131,9 +131,10 @@ class ExudynSystem:
     velocity_forces : bool
         Include dampers' velocity terms (False for quasi-static analysis).
     anchor_stiffness : float
-        If > 0, tie every coordinate to its initial guess by a spring of this stiffness
-        (per m², and per rad² times the length scale²): the assembled configuration is then
-        the one nearest to the guess when degrees of freedom are left free.
+        If > 0, tie every coordinate to its start value (``start``) by a spring of this
+        stiffness (per m², and per rad² times the length scale²): the assembled
+        configuration is then the one nearest to the start when degrees of freedom are
+        left free.
     start : array, optional
         x, y, fi of every solid to start Newton's iteration from (default: the solids'
         x, y, fi in the model); used to restart a run part-way.
@@ -192,7 +193,7 @@ class ExudynSystem:
                         markerNumber=marker, loadVector=[0.0, -mech.gravity, 0.0]))
         if anchor_stiffness > 0:
             L2 = mech.scale() ** 2
-            q0 = mech.initial_q()
+            q0 = self.start
             for i in range(len(mech.solids)):
                 for k in range(3 if i not in self.grounded else 0):
                     mbs.AddObject(items.ObjectConnectorCoordinateSpringDamper(

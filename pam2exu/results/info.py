@@ -47,6 +47,9 @@ class RunInfo(MutableMapping):
         kinetostatic: steps at which the power balance was checked.
     power_balance : str
         kinetostatic: why the power balance was not checked (too few rows).
+    stiffness_eigenvalue : float
+        equilibrium: the smallest eigenvalue of the reduced tangent stiffness, angles scaled
+        by the length scale (> 0: stable) [N/m].
     undefined : str
         Columns asked for that are NaN by definition at some rows, and why (an
         instantaneous centre where its solid translates: ``points.columns``).
@@ -77,6 +80,7 @@ class RunInfo(MutableMapping):
     power_balance_steps: int | None = None
     power_balance: str | None = None
     undefined: str | None = None
+    stiffness_eigenvalue: float | None = None
 
     def _field(self, key: str) -> str:
         if key not in _NAMES:

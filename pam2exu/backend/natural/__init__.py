@@ -34,6 +34,7 @@ class Natural:
     Settings = NaturalSettings
     #: it can return velocities and accelerations with the positions
     gives_rates = True
+    moves_free_solids = False
 
     def __init__(self):
         self._forms: dict = {}
