@@ -349,6 +349,11 @@ class Model:
         self.variations.append(variation)
         return variation
 
+    def _repr_html_(self) -> str:
+        """The model in a notebook: solids, elements and a drawing (``pam2exu.notebook``,
+        resolved lazily: the drawing needs the analyses)."""
+        return registry.resolve("pam2exu.notebook:model_html")(self)
+
     def __getitem__(self, name: str) -> Solid | Element:
         """The solid or element named ``name``; KeyError (suggesting the nearest) if none."""
         for item in (*self.solids, *self.elements):

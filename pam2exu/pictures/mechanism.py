@@ -329,10 +329,11 @@ def _writer(path: Path, fps: float):
                        "when ffmpeg is installed)")
 
 
-def animate(model, path: str | Path, steps: int | None = None, t_end: float | None = None,
-            trace=(), fps: float | None = None, dpi: float = DPI,
-            size: tuple[float, float] = ANIMATION_SIZE) -> Path:
-    """Write an animation of the model's kinematic run; returns the path.
+def animate(model, path: str | Path | None = None, steps: int | None = None,
+            t_end: float | None = None, trace=(), fps: float | None = None, dpi: float = DPI,
+            size: tuple[float, float] = ANIMATION_SIZE, html: bool = False) -> Path | str:
+    """Write an animation of the model's kinematic run; returns the path (or, with
+    ``html=True``, the animation as HTML for a notebook).
 
     The frames are the positions of a kinematic run over [0, t_end] (the branch ``run``
     follows), with a clock and the paths of the traced points. A progress bar shows on
@@ -343,8 +344,8 @@ def animate(model, path: str | Path, steps: int | None = None, t_end: float | No
     ----------
     model : Model, str or Path
         A model, or the path of a model file; every degree of freedom must be driven.
-    path : str or Path
-        ``.gif`` (Pillow), or ``.mp4`` when ffmpeg is installed.
+    path : str or Path, optional
+        ``.gif`` (Pillow), or ``.mp4`` when ffmpeg is installed; None with ``html=True``.
     steps : int, optional
         Number of intervals: steps + 1 frames (default: the model's steps, at most
         ``FRAMES`` = 100).
@@ -360,17 +361,21 @@ def animate(model, path: str | Path, steps: int | None = None, t_end: float | No
         Resolution of each frame [dots per inch].
     size : (float, float)
         Width and height of each frame [in].
+    html : bool
+        Return the animation as HTML with play controls (matplotlib's ``to_jshtml``: the
+        frames as inline PNG and JavaScript) instead of writing a file; in a notebook,
+        ``IPython.display.HTML(animate(model, html=True))`` shows it.
 
     Returns
     -------
-    Path
-        ``path``.
+    Path or str
+        ``path``; with ``html=True``, the HTML text.
 
     Raises
     ------
     PictureError
         ``path`` is not .gif or .mp4, or it is .mp4 and ffmpeg is not installed (checked
-        before the run).
+        before the run); neither ``path`` nor ``html`` is given.
     ModelError
         The model has problems, or a traced point does not exist (``MobilityError``: a
         degree of freedom is not driven).
@@ -383,13 +388,16 @@ def animate(model, path: str | Path, steps: int | None = None, t_end: float | No
     >>> animate("examples/four_bar.toml", "four_bar.gif", trace=["coupler.P"])  # doctest: +SKIP
     PosixPath('four_bar.gif')
     """
-    path = Path(path)
+    if path is None and not html:
+        raise PictureError("animate needs the file to write (.gif, or .mp4 with ffmpeg), or "
+                           "html=True for a notebook")
+    path = None if html else Path(path)
     model = _model(model)
     a = model.analysis
     steps = int(steps or min(a.steps, FRAMES))
     t_end = float(t_end or a.t_end)
     fps = float(fps or min(max(steps / t_end, FPS[0]), FPS[1]))
-    writer = _writer(path, fps)                 # fail before the run, not after it
+    writer = None if html else _writer(path, fps)   # fail before the run, not after it
     mech = model.mechanism()
     traced = _traces(mech, trace)
     mech, t, q = configurations(model, t_end=t_end, steps=steps)
@@ -426,6 +434,10 @@ def animate(model, path: str | Path, steps: int | None = None, t_end: float | No
     frame(0)
     fig.canvas.draw()
     fig.set_layout_engine("none")
+    if html:                                    # matplotlib's to_jshtml: PNG frames and JS
+        from matplotlib.animation import FuncAnimation
+        return FuncAnimation(fig, frame, frames=len(t), interval=1000.0 / fps).to_jshtml(
+            fps=fps, default_mode="loop")
     with Progress(len(t), f"writing {path.name}") as bar:
         if writer is None:
             _write_gif(fig, path, fps, len(t), frame,
