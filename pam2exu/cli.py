@@ -166,6 +166,13 @@ def _picture_parsers(sub) -> None:
                       help="time [s] (default 0: the assembly)")
     draw.add_argument("-o", "--output", metavar="FIG.png",
                       help="image file, format from the suffix (default: <model>.png)")
+    draw.add_argument("--vectors", choices=("v", "a", "F"),
+                      help="arrows to scale at T: v velocities or a accelerations of the "
+                           "solids' points (kinematic run), F the joints' reaction forces "
+                           "(kinetostatic run)")
+    draw.add_argument("--guess", action="store_true",
+                      help="draw the initial guess (x, y, fi as given, not assembled), the "
+                           "constraints it does not meet in red")
     anim = sub.add_parser(
         "animate", help="animate the model's kinematic run (GIF; MP4 with ffmpeg)",
         description="An animation of the kinematic run over the model's interval, with the "
@@ -373,7 +380,7 @@ def _draw(args) -> int:
     out = args.output or Path(args.model).with_suffix(".png").name
 
     def make():
-        draw(args.model, t=args.t, path=out)
+        draw(args.model, t=args.t, path=out, vectors=args.vectors, guess=args.guess)
         return out
     return _picture("draw", make, args.debug)
 

@@ -126,6 +126,28 @@ def pose(model, t: float = 0.0):
     return mech, q[-1]
 
 
+def extent(mech, q_all, extra=()) -> tuple[np.ndarray, np.ndarray]:
+    """Lower-left and upper-right corners [m] of the origin, every solid's origin and
+    points, and every element's anchor points, over every row of q_all (n, 3·solids), and
+    the ``extra`` points (k, 2)."""
+    q_all = np.atleast_2d(q_all)
+    st = State(np.zeros(len(q_all)), q_all)
+    pts = [np.zeros((1, 2))]
+    for i, s in enumerate(mech.solids):
+        pts.append(st.point(i, (0.0, 0.0)).value)
+        for p in s.points.values():
+            pts.append(st.point(i, [float(v) for v in p]).value)
+    for el in mech.elements:                   # line points, anchors given as bare solids
+        for ref in getattr(el, "refs", ()):
+            local = getattr(ref, "local", getattr(ref, "point", (0.0, 0.0)))
+            pts.append(st.point(ref.solid, local).value)
+    if len(extra):
+        pts.append(np.asarray(extra, dtype=float).reshape(-1, 2))
+    pts = np.vstack(pts)
+    pts = pts[np.isfinite(pts).all(axis=1)]
+    return pts.min(axis=0), pts.max(axis=0)
+
+
 class Scene:
     """A mechanism on an Axes: fixed limits (the box it moves in), the global frame, and
     ``show(t, q)`` to draw one configuration (removing the previous one).
@@ -175,21 +197,7 @@ class Scene:
 
     def _box(self, q_all, extra):
         """Lower-left and upper-right corners of everything drawn, over every row of q."""
-        st = State(np.zeros(len(q_all)), q_all)
-        pts = [np.zeros((1, 2))]
-        for i, local in enumerate(self.locals):
-            pts.append(st.point(i, (0.0, 0.0)).value)
-            for p in local:
-                pts.append(st.point(i, p).value)
-        for el in self.mech.elements:          # line points, anchors given as bare solids
-            for ref in getattr(el, "refs", ()):
-                local = getattr(ref, "local", getattr(ref, "point", (0.0, 0.0)))
-                pts.append(st.point(ref.solid, local).value)
-        if len(extra):
-            pts.append(np.asarray(extra, dtype=float).reshape(-1, 2))
-        pts = np.vstack(pts)
-        pts = pts[np.isfinite(pts).all(axis=1)]
-        return pts.min(axis=0), pts.max(axis=0)
+        return extent(self.mech, q_all, extra)
 
     def show(self, t: float, q: np.ndarray) -> None:
         """Draw the configuration q (3·solids,) at time t.
@@ -219,7 +227,8 @@ class Scene:
 
 
 def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI,
-         size: tuple[float, float] = DRAW_SIZE):
+         size: tuple[float, float] = DRAW_SIZE, vectors: str | None = None,
+         guess: bool = False):
     """Draw the mechanism at time t; returns the matplotlib Figure.
 
     Solids, joints, guides, springs, actuators, torsors and the global frame, on axes
@@ -240,6 +249,17 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         Resolution [dots per inch].
     size : (float, float)
         Width and height of the figure [in] (``size`` × ``dpi`` pixels).
+    vectors : str, optional
+        Arrows to scale at time t (``pictures.vectors``): ``'v'`` the velocity or ``'a'``
+        the acceleration of every declared point of the moving solids (a kinematic run),
+        ``'F'`` the force of every joint and actuator on its solid 2 at its point (a
+        kinetostatic run); the longest arrow is 0.15 of the mechanism's size, the legend
+        under the axes says what a round length stands for. The configuration is then the
+        run's at t (at t = 0 its first row).
+    guess : bool
+        Draw the initial guess: every solid at the x, y, fi given in the model, not
+        assembled (no analysis runs, so a model that does not assemble can be seen);
+        not with a time or vectors.
 
     Returns
     -------
@@ -248,8 +268,8 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     Raises
     ------
     PictureError
-        ``t`` is negative or not a number, or the image format of ``path`` is not
-        supported.
+        ``t`` is negative or not a number, ``vectors`` is not v, a or F, ``guess`` is
+        given with a time or vectors, or the image format of ``path`` is not supported.
     ModelError
         The model has problems (``MobilityError`` for t > 0 when a degree of freedom is not
         driven).
@@ -273,18 +293,64 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     >>> draw("examples/four_bar.toml", t=0.25, path="four_bar.svg")   # doctest: +SKIP
     <Figure size 800x600 with 1 Axes>
     """
+    from .pen import VECTOR_COLORS
+    from .vectors import at_instant
     model = _model(model)
-    mech, q = pose(model, t)
+    arrows = None
+    if guess:
+        if t or vectors:
+            raise PictureError("the initial guess is the model's x, y, fi as given: draw it "
+                               "without a time or vectors")
+        mech = model.mechanism()
+        q = mech.initial_q()
+        when = "initial guess (x, y, fi as given, not assembled)"
+    elif vectors:
+        mech, q, arrows = at_instant(model, t, vectors)
+        analysis = "kinetostatic" if vectors == "F" else "kinematic"
+        when = f"t = {t:g} s ({analysis} run)"
+    else:
+        mech, q = pose(model, t)
+        when = f"t = {t:g} s (kinematic run)" if t else "assembled at t = 0"
+    lo, hi = extent(mech, q)
+    mech_size = float(max(hi - lo)) or 1.0
+    if arrows is not None:
+        arrows.scaled(mech_size)
     fig = figure(*size, dpi)
     ax = fig.add_subplot()
-    scene = Scene(ax, mech, q[None, :])
+    scene = Scene(ax, mech, q[None, :], () if arrows is None else arrows.tips)
     scene.show(t, q)
-    when = f"t = {t:g} s (kinematic run)" if t else "assembled at t = 0"
+    if arrows is not None:
+        with scene.pen.owner(f"vectors:{arrows.kind}"):
+            scene.pen.vectors(arrows.points, arrows.values, arrows.scale,
+                              VECTOR_COLORS[arrows.kind], arrows.legend(mech_size))
+    if guess:
+        unmet = _mark_unmet(scene, q, mech_size)
+        when += f"; {len(unmet)} constraint{'s' * (len(unmet) != 1)} not met" if unmet else ""
     ax.set_title(f"'{mech.name}' — {when}")
     _settle(fig, scene)
     if path is not None:
         save(fig, path)
     return fig
+
+
+def _mark_unmet(scene, q, size: float) -> list[str]:
+    """Mark the constraints the configuration q does not meet (residual above 1e-9 of the
+    mechanism's size, or 1e-9 rad): their anchor points joined by a red dotted line, their
+    names in red; returns their names."""
+    from ..analyses.native import equations
+    mech = scene.mech
+    st = State([0.0], np.asarray(q, dtype=float)[None, :])
+    residual = equations(mech, st, jacobian=False).residual[0]
+    unmet = []
+    for el, rows in zip(mech.constraints, mech.rows):
+        if np.max(np.abs(residual[rows]), initial=0.0) <= 1e-9 * max(size, 1.0):
+            continue
+        unmet.append(el.name)
+        points = [st.point(r.solid, getattr(r, "local", getattr(r, "point", (0.0, 0.0))))
+                  .value[0] for r in getattr(el, "refs", ())]
+        with scene.pen.owner(f"{el.type}:{el.name}"):
+            scene.pen.unmet(points)
+    return unmet
 
 
 def _settle(fig, scene) -> None:

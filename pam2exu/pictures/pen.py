@@ -24,6 +24,9 @@ INK = "#222222"            # joints, springs, guides
 GROUND = "#7f7f7f"         # grounded solids and supports
 ACTUATOR = "#c0392b"       # actuators
 LOAD = "#1e8449"           # applied torsors
+UNMET = "#e6194b"          # constraints an initial guess does not meet
+#: arrows of ``draw --vectors``: velocities, accelerations, reaction forces
+VECTOR_COLORS = {"v": "#0d3b8c", "a": "#7b1fa2", "F": "#d35400"}
 
 #: radius of a joint circle, as a fraction of the drawing's size
 JOINT = 0.012
@@ -31,6 +34,8 @@ JOINT = 0.012
 GUIDE = 0.12
 #: length of a force arrow and of the global frame's axes, fraction of the size
 ARROW, FRAME = 0.10, 0.08
+#: height of the legend of ``vectors``, in axes fractions (under the x axis's label)
+KEY_BELOW = -0.135
 #: gap between a symbol and its name [points]
 LABEL_OFFSET = 4.0
 #: font sizes of the names of solids and of joints and actuators [points]
@@ -431,6 +436,53 @@ class Pen:
         self._line([p, q], color=ACTUATOR, lw=9, alpha=0.45, solid_capstyle="butt",
                    zorder=Z_BAR)
         self._line([p, q], color=ACTUATOR, lw=1.5, zorder=Z_BAR)
+
+    def unmet(self, points) -> None:
+        """A constraint the drawing does not meet (an initial guess): a red dotted line
+        through its anchor points, and its name in red."""
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        if len(points) > 1:
+            self._line(points, color=UNMET, lw=1.4, linestyle=(0, (1.5, 1.5)),
+                       marker="x", markersize=5, zorder=Z_TEXT)
+        for lab in self.labels:
+            if lab["artist"].get_gid() == self._gid:
+                lab["artist"].set_color(UNMET)
+
+    def vectors(self, points, values, scale: float, color, key: tuple[float, str]):
+        """Arrows from ``points`` (n, 2) [m] along ``values`` (n, 2), ``scale`` metres of
+        drawing per unit (a quiver: its U, V are the values, its X, Y the points, its
+        scale 1 / ``scale`` in x units, the same as y units), and the
+        legend's arrow standing for ``key`` = (value, text), under the axes. Zero arrows
+        (and all when ``scale`` is 0) are left out."""
+        points, values = np.asarray(points, dtype=float), np.asarray(values, dtype=float)
+        drawn = (np.hypot(*values.T) * scale > 1e-9 * self.size if scale
+                 else np.zeros(len(values), bool))
+        # the legend: the key's arrow (its length the round one), then the text, under the
+        # x axis's label (a text of the axes, so that the layout makes room for it)
+        x0, x1 = self.ax.get_xlim()
+        arrow = key[0] * scale / (x1 - x0)
+        where = KEY_BELOW
+        self._keep(self.ax.text(arrow + 0.015 if np.any(drawn) else 0.0, where, key[1],
+                                transform=self.ax.transAxes, color=color, fontsize=9,
+                                ha="left", va="center", gid=self._gid))
+        if not np.any(drawn):
+            return None
+        points, values = points[drawn], values[drawn]
+        for p, v in zip(points, values):
+            self._mark([p, p + scale * v])
+        style = dict(color=color, width=0.004, headwidth=3.5, headlength=4.5,
+                     headaxislength=4.0, zorder=Z_LOAD)
+        q = self._keep(self.ax.quiver(points[:, 0], points[:, 1], values[:, 0], values[:, 1],
+                                      # lengths and angles in data units (equal
+                                      # scales); "xy" would divide by the size of the
+                                      # data limits, 0 for arrows from one point
+                                      angles=np.degrees(np.arctan2(values[:, 1],
+                                                                   values[:, 0])),
+                                      scale_units="x", scale=1.0 / scale,
+                                      **style))
+        self._keep(self.ax.quiverkey(q, arrow, where, key[0], " ", labelpos="E",
+                                     coordinates="axes", color=color))
+        return q
 
     # ---- free-body sketches (docs/make_free_body.py) ------------------------------------
     def arrow(self, a, b, color=INK, width: float = 2.0, head: float = 12) -> None:
