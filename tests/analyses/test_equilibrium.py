@@ -3,7 +3,8 @@
 References, each computed here without pam2exu's code:
 - a lever with a torsional spring under gravity: the hand moment balance about the pivot,
   k·fi + m g d cos(fi) = 0, solved by brentq; the pivot carries the weight;
-- a four-bar whose crank is free, held by a linear spring from the ground to the coupler:
+- a four-bar whose crank is free, held by a linear spring from the ground to the coupler
+  (examples/equilibrium/spring_four_bar.toml):
   the minimum of its potential energy V(θ) = Σ m g y_G + ½ k (ro − L0)², with the
   positions from the circle intersection of the four-bar, found by scipy's
   minimize_scalar;
@@ -12,6 +13,7 @@ References, each computed here without pam2exu's code:
 """
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -97,18 +99,13 @@ def test_lever_against_the_hand_moment_balance(guess):
         (K - M * G * D * math.sin(fi)) / L ** 2, rel=1e-6)
 
 
-def _four_bar(spring_k=400.0, free_length=0.1):
-    text = open(pam2exu.__file__.replace("pam2exu/__init__.py", "examples/four_bar.toml"),
-                encoding="utf-8").read()
-    start = text.index('[[element]]\ntype = "angular_actuator"')
-    end = text.index("[analysis]")
-    spring = (f'[[element]]\ntype = "spring"\nname = "spring"\nanc1 = "ground.S"\n'
-              f'anc2 = "coupler.P"\nC = [0.0, {spring_k}, {free_length}, 0.0]\n\n')
-    text = text[:start] + spring + text[end:]
-    text = text.replace("points = { O2 = [0.0, 0.0], O4 = [0.4, 0.0] }",
-                        "points = { O2 = [0.0, 0.0], O4 = [0.4, 0.0], S = [0.25, -0.15] }")
-    text = text.replace('type = "kinematic"', 'type = "equilibrium"')
-    return pam2exu.loads(text)
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples/equilibrium/spring_four_bar.toml"
+
+
+def _four_bar():
+    """The shipped example: examples/four_bar.toml without its motor, held by a spring
+    (k = 400 N/m, free length 0.1 m) from ground.S = (0.25, −0.15) to coupler.P."""
+    return pam2exu.load(EXAMPLE)
 
 
 def _four_bar_pose(th, a=0.10, b=0.35, c=0.30, d=0.40):
@@ -141,7 +138,7 @@ def test_four_bar_with_a_spring_at_the_minimum_of_its_potential_energy():
     ~√ε: a minimum is flat), then brentq the root of dV/dθ (central differences, step
     1e-6) there to ~1e-10 (measured: θ 2.6e-10, coupler 2e-11, rocker 7e-11 rad)."""
     k, L0 = 400.0, 0.1
-    res = _run(_four_bar(k, L0))
+    res = _run(_four_bar())
     th = res["crank.fi"][0]
     V = lambda x: _four_bar_energy(x, k, L0)
     best = minimize_scalar(V, bracket=(th - 0.3, th + 0.3), tol=1e-12)
