@@ -57,6 +57,11 @@ def _parser() -> argparse.ArgumentParser:
                      help="plot these variables against t (names or patterns, as --outputs)")
     run.add_argument("--plot-file", metavar="FIG.png",
                      help="image file of --plot (default: <model>_plot.png)")
+    run.add_argument("--x", metavar="VAR",
+                     help="the x axis of --plot: a variable such as crank.fi (default t)")
+    run.add_argument("--angles", choices=("rad", "deg"),
+                     help="unit of the angular results: rad (rad/s, rad/s²) or deg (deg/s, "
+                          "deg/s²); default: the model's [model] angles")
 
     check = sub.add_parser(
         "check", help="validate a model, print its mobility and elements",
@@ -67,9 +72,6 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("model", help="model file (TOML)")
     check.add_argument("--analysis", "-a", metavar="TYPE",
                        help="the analysis to check for (default: the model's)")
-    run.add_argument("--angles", choices=("rad", "deg"),
-                     help="unit of the angular results: rad (rad/s, rad/s²) or deg (deg/s, "
-                          "deg/s²); default: the model's [model] angles")
     check.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
     check.add_argument("--steps", type=int, metavar="N", help="number of intervals")
     check.add_argument("--backend", metavar="NAME",
@@ -108,6 +110,10 @@ def _parser() -> argparse.ArgumentParser:
     comp.add_argument("--wrap-angles", action="store_true",
                       help="compare angles (rad) modulo 2π, for exports whose angles wrap at "
                            "±π (PAM's)")
+    comp.add_argument("--angles", choices=("rad", "deg"),
+                      help="compare the angular variables in rad (default) or deg (--atol "
+                           "then in deg for them); a file in degrees is read as such either "
+                           "way")
 
     ver = sub.add_parser(
         "verify", help="run the model on two backends and compare them, variable by variable",
@@ -157,6 +163,11 @@ def _picture_parsers(sub) -> None:
                       help="image file, format from the suffix (default: <results>.png)")
     plot.add_argument("--model", metavar="MODEL",
                       help="the model, for the units of f(t) and Df(t) (rad or m)")
+    plot.add_argument("--x", metavar="VAR",
+                      help="the x axis: a variable such as crank.fi (default t)")
+    plot.add_argument("--angles", choices=("rad", "deg"),
+                      help="show the angular variables in rad or deg (default: as the file "
+                           "has them)")
     draw = sub.add_parser(
         "draw", help="draw the mechanism at a configuration (PNG, SVG, PDF)",
         description="Draw the solids and elements of a model: assembled at t = 0, or at "
@@ -210,7 +221,8 @@ def _run(args) -> int:
         warnings.simplefilter("ignore")      # warnings are carried in res.warnings
         outputs = args.outputs
         if outputs and args.plot:
-            outputs = [*outputs, *args.plot]      # the plotted variables are computed too
+            # the plotted variables (and the x axis) are computed too
+            outputs = [*outputs, *args.plot, *([args.x] if args.x else [])]
         res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
                   outputs=outputs, solver=solver, backend=args.backend, angles=args.angles)
     table = res.select(args.outputs) if args.outputs and args.plot else res
@@ -242,7 +254,7 @@ def _run_plot(args, res) -> int:
     out = args.plot_file or f"{Path(args.model).stem}_plot.png"
 
     def make():
-        plot(res, args.plot, out)
+        plot(res, args.plot, out, x=args.x)
         return out
     return _picture("plot", make, args.debug)
 
@@ -279,6 +291,9 @@ def _check(args) -> int:
               f"{job.every} sub-steps per step")
     if model.encoding != "utf-8":
         print("the file is not UTF-8: it was read as Windows-1252")
+    from .model.angles import angle_warnings
+    for problem in angle_warnings(model):
+        print(f"warning: {problem}")
     print()
     width = max([len(e.name) for e in mech.elements] + [4])
     for e in mech.elements:
@@ -295,9 +310,6 @@ def _elements(args) -> int:
     if not args.types:
         from .elements import ELEMENTS
         width = max(len(t) + len(c.alias) for t, c in ELEMENTS.items()) + 3
-    from .model.angles import angle_warnings
-    for problem in angle_warnings(model):
-        print(f"warning: {problem}")
         for kind, cls in ELEMENTS.items():
             anchors = ", ".join(reference.anchor_meaning(cls, k) for k in range(len(cls.anchors)))
             print(f"{f'{kind} [{cls.alias}]':<{width}}  {anchors}: {cls.summary}")
@@ -318,7 +330,7 @@ def _compare(args) -> int:
     try:
         table = compare(args.result, args.reference, rtol=args.rtol, atol=args.atol,
                         columns=args.columns, names=args.names, method=args.interp,
-                        wrap_angles=args.wrap_angles)
+                        wrap_angles=args.wrap_angles, angles=args.angles)
     except CompareInputError as exc:
         if args.debug:
             raise
@@ -368,7 +380,8 @@ def _plot(args) -> int:
     out = args.output or Path(args.results).with_suffix(".png").name
 
     def make():
-        plot(args.results, args.variables, out, model=args.model)
+        plot(args.results, args.variables, out, model=args.model, x=args.x,
+             angles=args.angles)
         return out
     return _picture("plot", make, args.debug)
 

@@ -29,7 +29,7 @@ from .interpolation import interpolate, interpolation_error
 from .names import listing
 from .reading import Table, load_table, names_map, time_precision
 from .table import select_columns
-from .units import declared_units, unit_of
+from .units import RADIAN_UNITS, angle_factor, declared_units, unit_of
 
 RTOL = 1e-9
 ATOL = 1e-12
@@ -200,8 +200,39 @@ def _choose(res: Table, ref: Table, columns) -> tuple[list[str], list[str], list
             [c for c in union if c not in in_res])
 
 
+def _in_radians(table: Table, note: bool = True) -> Table:
+    """The table with the columns its units say are in degrees (a CSV's units line, a
+    Results table in degrees) in radians: compare works in SI units; a note says so."""
+    done = [n for n in table.names if table.units.get(n) in RADIAN_UNITS]
+    if done:
+        table.values = table.values.copy()
+        for name in done:
+            factor, table.units[name] = angle_factor(table.units[name], "rad")
+            table.values[table.names.index(name)] *= factor
+        if note:
+            table.notes.append(f"{table.label}: {listing(done)} given in degrees, compared in "
+                               "radians")
+    return table
+
+
+def _in_degrees(res: Table, ref: Table, names: list[str]) -> None:
+    """The angular columns among ``names`` (rad, rad/s, rad/s², by either table's unit or
+    the declarations) in degrees in both tables (``compare(..., angles="deg")``)."""
+    for table in (res, ref):
+        table.values = table.values.copy()
+    for name in names:
+        unit = (res.units.get(name) or ref.units.get(name) or unit_of(name)
+                or _unit_among(name, res.names + ref.names))
+        factor, new = angle_factor(unit, "deg")
+        if factor != 1.0:
+            for table in (res, ref):
+                table.values[table.names.index(name)] *= factor
+                table.units[name] = new
+
+
 def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=None,
-            names=None, method: str = "cubic", wrap_angles: bool = False) -> Comparison:
+            names=None, method: str = "cubic", wrap_angles: bool = False,
+            angles: str | None = None) -> Comparison:
     """Compare ``result`` with ``reference`` variable by variable.
 
     Rows are matched by ``t``, to the precision each file's times carry: a time written with
@@ -235,6 +266,12 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
         modulo 2π, for exports that wrap them at ±π: the difference is reduced to (−π, π]
         before its magnitude is taken, and the scale is π. An interpolated result is
         unwrapped first.
+    angles : str, optional
+        ``"deg"``: the angular variables (rad, rad/s, rad/s²) are compared in degrees
+        (their errors, scales and ``atol`` in deg, deg/s, deg/s²). Default (or ``"rad"``):
+        in radians. Either way a table in degrees (a CSV whose units line says deg, see
+        ``units.units_line``, or a Results table in degrees) is read in radians first, so
+        a degrees file compares with a radians one.
 
     Returns
     -------
@@ -272,10 +309,18 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
                                 f"{method!r}{closest(method, METHODS)}")
     if not isinstance(wrap_angles, bool):
         raise CompareInputError(f"`wrap_angles` must be True or False, not {wrap_angles!r}")
+    if angles not in (None, "rad", "deg"):
+        raise CompareInputError(f"`angles` must be 'rad' or 'deg', not {angles!r}")
+    if angles == "deg" and wrap_angles:
+        raise CompareInputError("angles modulo 2π are compared in radians: leave out "
+                                "--angles deg (angles='deg') with --wrap-angles")
     mapping = names_map(names)
-    res = load_table(result, "result", {})              # the map is for the reference's names
-    ref = load_table(reference, "reference", mapping)
+    # the map is for the reference's names; tables in degrees are read in radians
+    res = _in_radians(load_table(result, "result", {}), note=angles != "deg")
+    ref = _in_radians(load_table(reference, "reference", mapping), note=angles != "deg")
     common, only_res, only_ref = _choose(res, ref, columns)
+    if angles == "deg":
+        _in_degrees(res, ref, common)
     ir = [res.names.index(c) for c in common]
     jr = [ref.names.index(c) for c in common]
     notes = res.notes + ref.notes

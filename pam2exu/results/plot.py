@@ -1,4 +1,5 @@
-"""Plots of result variables against time (``pam2exu plot``, ``pam2exu run --plot``).
+"""Plots of result variables against time or another variable (``pam2exu plot``,
+``pam2exu run --plot``, ``--x``).
 
 Figures are made with matplotlib's object-oriented API on the Agg canvas (``figure``): no
 pyplot, no window, no global backend state, so plotting works the same on a server, in CI
@@ -9,12 +10,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ModelError, PictureError
+from ..errors import ModelError, PictureError, closest
 from ..model import Model, load
 from .names import SPELLINGS, canonical_name
 from .reading import read_csv
 from .table import Results, select_columns
-from .units import unit_of
+from .units import in_angles, unit_of
 
 #: default resolution [dots per inch]; with ``WIDTH`` inches a plot is 880 px wide
 DPI = 100
@@ -99,13 +100,15 @@ def label(name: str, unit: str) -> str:
 
 
 def plot(source, names=None, path: str | Path | None = None, model=None,
-         title: str | None = None, dpi: float = DPI):
-    """Plot variables of a result table against t; returns the matplotlib Figure.
+         title: str | None = None, dpi: float = DPI, x: str | None = None,
+         angles: str | None = None):
+    """Plot variables of a result table against t (or ``x``); returns the matplotlib Figure.
 
     Variables with the same unit share a panel, panels in the order the variables are
     asked for; every line is labelled with its name and unit (``motor.Mz [N·m]``), the x
-    axis is ``t [s]``. ``pam2exu plot`` and ``pam2exu run --plot`` call this function.
-    The figure is on the Agg canvas: no window opens.
+    axis is ``t [s]``, or the variable ``x`` with its unit (``crank.fi [deg]``: the
+    motor torque against the crank angle). ``pam2exu plot`` and ``pam2exu run --plot``
+    call this function. The figure is on the Agg canvas: no window opens.
 
     Parameters
     ----------
@@ -125,6 +128,14 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
     dpi : float
         Resolution [dots per inch]; the image is ``WIDTH`` × (``MARGIN`` + ``PANEL`` ×
         panels) inches (8.8 × (0.9 + 2.4 × panels) in).
+    x : str, optional
+        The variable on the x axis, one column (``crank.fi``; PAM spellings accepted),
+        the axis labelled with its unit ([deg], [m], …); default ``t`` [s]. It is not
+        plotted against itself.
+    angles : str, optional
+        ``"deg"`` or ``"rad"``: the angular columns (x included) in that unit
+        (``units.in_angles``); default: as the table has them (a CSV file written in
+        degrees says so on its units line).
 
     Returns
     -------
@@ -134,8 +145,9 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
     Raises
     ------
     PictureError
-        A name matches no column (the message suggests the nearest), nothing is left to
-        plot, or the image format of ``path`` is not supported.
+        A name or ``x`` matches no column (the message suggests the nearest), ``x`` is
+        a pattern, nothing is left to plot, or the image format of ``path`` is not
+        supported.
     CompareInputError
         The CSV file is missing or unreadable.
     ModelError
@@ -149,6 +161,9 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
     >>> fig = plot(res, ["B.*", "crank.fi"])
     >>> [ax.get_ylabel() for ax in fig.axes]
     ['Fx, Fy [N]', 'crank.fi [rad]']
+    >>> fig = plot(res, "B.Fx", x="crank.fi", angles="deg")
+    >>> fig.axes[0].get_xlabel(), fig.axes[0].lines[0].get_xdata().tolist()[:2]
+    ('crank.fi [deg]', [0.0, 171.88733853924697])
     >>> plot("results.csv", "motor.Mz", "torque.png")        # doctest: +SKIP
     <Figure size 880x330 with 1 Axes>
     """
@@ -161,9 +176,13 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
         if title is None:
             title = f"{Path(source).name}" + (f" ('{model.name}')" if model else "")
     where = f"'{source}'" if not isinstance(source, Results) else "the results"
-    columns = _in_order(res.columns, names, where)
+    if angles is not None:
+        res = in_angles(_with_units(res, model), angles)
+    x = "t" if x is None else _x_column(res.columns, x, where)
+    columns = [c for c in _in_order(res.columns, names, where) if c != x]
     if not columns:
-        raise PictureError("nothing to plot: choose variables besides t")
+        raise PictureError("nothing to plot: choose variables besides t"
+                           + (f" and the x axis '{x}'" if x != "t" else ""))
     panels: dict[str, list[str]] = {}
     for c in columns:
         unit = res.units.get(c) or unit_of(c, model)
@@ -173,7 +192,7 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
     marker = "o" if len(res) == 1 else None
     for ax, (unit, cols) in zip(axes, panels.items()):
         for c in cols:
-            ax.plot(res.t, res[c], marker=marker, label=label(c, unit))
+            ax.plot(res[x], res[c], marker=marker, label=label(c, unit))
         if len(cols) == 1:
             ax.set_ylabel(label(cols[0], unit))
         else:
@@ -185,7 +204,7 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
             else:
                 ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
         ax.grid(True, alpha=0.3)
-    axes[-1].set_xlabel(label("t", "s"))
+    axes[-1].set_xlabel(label(x, res.units.get(x) or unit_of(x, model)))
     if title is None:
         title = " — ".join(x for x in (f"'{res.model}'" if res.model else "",
                                        f"{res.analysis} analysis" if res.analysis else "") if x)
@@ -194,6 +213,27 @@ def plot(source, names=None, path: str | Path | None = None, model=None,
     if path is not None:
         save(fig, path)
     return fig
+
+
+def _with_units(res: Results, model) -> Results:
+    """``res`` with the units its table lacks found from the declarations (and ``model``)."""
+    missing = {c: unit_of(c, model) for c in res.columns if not res.units.get(c)}
+    if not any(missing.values()):
+        return res
+    return Results(res.t, {c: res[c] for c in res.columns}, {**res.units, **missing},
+                   res.analysis, res.model, res.warnings, res.info)
+
+
+def _x_column(columns: list[str], x: str, where: str) -> str:
+    """The one column ``x`` names (PAM spellings accepted); PictureError naming the nearest."""
+    name = canonical_name(x) if "." in x else x
+    if name == "t" or name in columns:
+        return name
+    if any(c in x for c in "*?["):
+        raise PictureError(f"the x axis is one variable, not a pattern: got '{x}'; give a "
+                           f"full name such as crank.fi")
+    raise PictureError(f"the x axis '{x}' is not a column of {where}"
+                       f"{closest(name, ['t', *columns])}; give a full name such as crank.fi")
 
 
 def _in_order(columns: list[str], names, where: str) -> list[str]:

@@ -23,7 +23,7 @@ from ..errors import CompareInputError
 from ..model import Model, load
 from .names import canonical, clean, listing, spellings
 from .table import Results, _read_own
-from .units import unit_of
+from .units import UNITS_LINE, unit_of
 
 MAP_HEADER = ("pam_name", "pam2exu_name")
 _NUMBER = re.compile(r"[+-]?(\d*)(?:\.(\d*))?(?:[eE]([+-]?\d+))?")
@@ -268,6 +268,24 @@ def time_precision(table: Table) -> tuple[np.ndarray, str]:
     return written_precision(_cells((delimiter, lines), j))
 
 
+def written_units(path: Path, names: list[str]) -> dict[str, str]:
+    """The units the file's units line gives (``units.units_line``: the line right after the
+    header, ``# units: s,m,deg,…``, which ``Results.to_csv`` writes for a table in
+    degrees), by column name; {} without one, or when it does not have one unit per name."""
+    try:
+        with open(path, encoding="utf-8-sig", errors="replace") as fh:
+            fh.readline()
+            line = fh.readline().rstrip("\r\n")
+    except OSError:
+        return {}
+    if not line.startswith(UNITS_LINE):
+        return {}
+    text = line[len(UNITS_LINE):]
+    sep = ";" if ";" in text else "\t" if "\t" in text else ","
+    units = [u.strip() for u in text.split(sep)]
+    return dict(zip(names, units)) if len(units) == len(names) else {}
+
+
 def load_table(source, role: str, names: dict[str, str]) -> Table:
     """A path or a Results table, with its columns renamed to pam2exu's spelling."""
     if isinstance(source, Results):
@@ -278,7 +296,7 @@ def load_table(source, role: str, names: dict[str, str]) -> Table:
     elif isinstance(source, (str, Path)):
         label = str(source)
         raw, data, notes, body = _parse_csv(Path(source), role)
-        units = {}
+        units = written_units(Path(source), raw)          # a file in degrees says so
     else:
         raise CompareInputError(f"the {role} must be a CSV file path or a Results table, "
                                 f"not {type(source).__name__}")
@@ -358,6 +376,6 @@ def read_csv(path: str | Path, model=None) -> Results:
         if own is None:
             raise
         table = load_table(path, "results", {})          # the message names the file
-    units = {name: unit_of(name, model) for name in table.names}
+    units = {name: table.units.get(name) or unit_of(name, model) for name in table.names}
     return Results(table.t, dict(zip(table.names, table.values)), units,
                    model=Path(path).stem if model is None else model.name)

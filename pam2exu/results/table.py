@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import ModelError, Problem, closest
 from .info import RunInfo
 from .names import selects, spelled
+from .units import units_line
 from .writers import BOM, Exports, csv_translation
 
 
@@ -188,6 +189,7 @@ class Results(Exports):
         try:
             with open(tmp, "wb") as fh:
                 fh.write((BOM if bom else b"") + (_csv_header(self._names, sep) + "\n").encode())
+                fh.write(units_line(self._names, self.units, sep).encode())   # degrees only
                 for lines in _csv_lines(self._data.T):
                     fh.write(lines if translate is None else translate[lines])
             tmp.replace(path)

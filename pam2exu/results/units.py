@@ -150,8 +150,45 @@ def in_angles(res, angles: str | None):
     factors = {c: angle_factor(res.units.get(c, ""), angles) for c in res.columns}
     if all(f == 1.0 for f, _ in factors.values()):
         return res
-    from .table import Results
-    return Results(res.t, {c: res[c] * f if f != 1.0 else res[c]
-                           for c, (f, _) in factors.items()},
-                   {c: u for c, (_, u) in factors.items()}, res.analysis, res.model,
-                   res.warnings, res.info)
+    return type(res)(res.t, {c: res[c] * f if f != 1.0 else res[c]
+                             for c, (f, _) in factors.items()},
+                     {c: u for c, (_, u) in factors.items()}, res.analysis, res.model,
+                     res.warnings, res.info)
+
+
+#: how a result CSV in degrees starts its second line, its units line (``units_line``)
+UNITS_LINE = "# units: "
+
+
+def units_line(names: list[str], units: dict[str, str], sep: str = ",") -> str:
+    """The line under a CSV header that gives each column's unit, for a table in degrees.
+
+    A result CSV in radians (SI) is the contract's: a header and numbers; its units follow
+    from the names (``unit_of``). One with columns in degrees says so, on a comment line
+    that readers skipping '#' lines ignore and ``reading.load_table`` reads back:
+    ``# units: s,m,deg,…`` (one unit per column, '' where unknown).
+
+    Parameters
+    ----------
+    names : list of str
+        The columns, ``t`` first.
+    units : dict
+        Column → unit.
+    sep : str
+        The CSV separator.
+
+    Returns
+    -------
+    str
+        The line with its line end, or '' when no column is in degrees.
+
+    Examples
+    --------
+    >>> units_line(["t", "crank.fi", "B.Fx"], {"t": "s", "crank.fi": "deg", "B.Fx": "N"})
+    '# units: s,deg,N\\n'
+    >>> units_line(["t", "crank.fi"], {"t": "s", "crank.fi": "rad"})
+    ''
+    """
+    if not any(units.get(n) in RADIAN_UNITS for n in names):
+        return ""
+    return UNITS_LINE + sep.join(units.get(n, "") for n in names) + "\n"
