@@ -52,6 +52,9 @@ def _parser() -> argparse.ArgumentParser:
                           "CSV Excel opens in Catalan or Spanish)")
     run.add_argument("--bom", action="store_true",
                      help="start the CSV with a UTF-8 byte-order mark (for Excel)")
+    run.add_argument("--at", nargs="+", type=float, metavar="T",
+                     help="print every variable at these times [s], one block per solid and "
+                          "element (between rows: the cubic spline of compare, said so)")
     run.add_argument("--verbose", action="store_true", help="show Exudyn's solver output")
     run.add_argument("--plot", nargs="+", metavar="VAR",
                      help="plot these variables against t (names or patterns, as --outputs)")
@@ -214,6 +217,8 @@ def _run(args) -> int:
     if args.output:                              # a bad file name fails before the run
         check(args.output, sep, args.decimal, args.bom)
     model = load(args.model)
+    if args.at:                                  # times outside the run fail before it
+        _check_at(args, model)
     backend = BACKENDS.get(args.backend or model.analysis.backend)
     # the backend's settings (an unknown name: run's model error names the known ones)
     solver = backend.create().Settings(verbose=1 if args.verbose else 0) if backend else None
@@ -237,13 +242,34 @@ def _run(args) -> int:
             print(f"wrote the extremes to {write_extremes(table, extremes_path(path))}")
         for w in res.warnings:
             print(f"warning: {w}", file=sys.stderr)
-    else:
+    elif not args.at:
         print(table.summary())
+    if args.at:                                  # every variable at those times
+        from .results.instant import kinds_of, report
+        print(report(table, args.at, kinds_of(model)))
     if extremes:
         print(extremes)
     if args.plot:
         return _run_plot(args, res)
     return 0
+
+
+def _check_at(args, model) -> None:
+    """ModelError (exit 2) for a ``--at`` time outside the run's interval, 0 … t_end (only 0
+    for an analysis at t = 0)."""
+    from .errors import Problem
+    from .registry import analysis_type
+    kind = analysis_type(args.analysis or model.analysis.type)
+    end = args.t_end if args.t_end is not None else model.analysis.t_end
+    if kind is None or not isinstance(end, (int, float)):
+        return                                   # run reports the settings
+    end = 0.0 if kind.at_start else float(end)
+    bad = [t for t in args.at if not 0.0 <= t <= end]
+    if bad:
+        times = (f"the {kind.name} analysis solves t = 0 only" if kind.at_start else
+                 f"give times in the run's interval, t = 0 … {end:g} s")
+        raise ModelError(Problem("--at", f"t = {bad[0]:g} s is outside the run: {times}"),
+                         model.source)
 
 
 def _run_plot(args, res) -> int:

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import ModelError, Problem, closest
 from .info import RunInfo
+from .instant import Instant, at
 from .names import selects, spelled
 from .units import units_line
 from .writers import BOM, Exports, csv_translation
@@ -299,6 +300,10 @@ class Results(Exports):
             out.append(f"power balance {info['power_balance_error']:.2g} W "
                        f"(finite-difference tolerance {info['power_balance_tolerance']:.2g} W)")
         return out
+
+    def at(self, t: float) -> Instant:
+        """Every column at time t by solid and element: the row, else a spline (``instant.at``)."""
+        return at(self, t)
 
     def __repr__(self) -> str:
         return (f"<Results {self.analysis} '{self.model}': {len(self)} rows × "
