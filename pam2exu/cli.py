@@ -187,6 +187,8 @@ def _picture_parsers(sub) -> None:
     draw.add_argument("--guess", action="store_true",
                       help="draw the initial guess (x, y, fi as given, not assembled), the "
                            "constraints it does not meet in red")
+    draw.add_argument("--ic", action="store_true",
+                      help="mark each moving solid's instantaneous centre of rotation at T")
     anim = sub.add_parser(
         "animate", help="animate the model's kinematic run (GIF; MP4 with ffmpeg)",
         description="An animation of the kinematic run over the model's interval, with the "
@@ -419,7 +421,8 @@ def _draw(args) -> int:
     out = args.output or Path(args.model).with_suffix(".png").name
 
     def make():
-        draw(args.model, t=args.t, path=out, vectors=args.vectors, guess=args.guess)
+        draw(args.model, t=args.t, path=out, vectors=args.vectors, guess=args.guess,
+             ic=args.ic)
         return out
     return _picture("draw", make, args.debug)
 

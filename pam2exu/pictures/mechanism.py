@@ -21,6 +21,9 @@ from .pen import PALETTE, Pen
 #: figure sizes [in]: a drawing, an animation (smaller: every frame is stored)
 DRAW_SIZE = (8.0, 6.0)
 ANIMATION_SIZE = (6.4, 4.8)
+#: instantaneous centres farther than this many sizes out of the mechanism's box are not
+#: drawn (``draw(ic=True)``): the drawing would shrink to nothing
+FAR_CENTRE = 1.5
 #: margin around the box the mechanism moves in, fraction of its larger side
 MARGIN = 0.12
 #: room the axis labels and the title take from the figure [in] (width, height)
@@ -228,7 +231,7 @@ class Scene:
 
 def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI,
          size: tuple[float, float] = DRAW_SIZE, vectors: str | None = None,
-         guess: bool = False):
+         guess: bool = False, ic: bool = False):
     """Draw the mechanism at time t; returns the matplotlib Figure.
 
     Solids, joints, guides, springs, actuators, torsors and the global frame, on axes
@@ -259,7 +262,12 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     guess : bool
         Draw the initial guess: every solid at the x, y, fi given in the model, not
         assembled (no analysis runs, so a model that does not assemble can be seen);
-        not with a time or vectors.
+        not with a time, vectors or centres.
+    ic : bool
+        Mark each moving solid's instantaneous centre of rotation at t (``I crank``; from a
+        kinematic run, ``points.instantaneous_centre``); a solid that translates has none,
+        one farther than ``FAR_CENTRE`` sizes from the mechanism is left out and named in
+        the title.
 
     Returns
     -------
@@ -294,11 +302,11 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     <Figure size 800x600 with 1 Axes>
     """
     from .pen import VECTOR_COLORS
-    from .vectors import at_instant
+    from .vectors import at_instant, centres
     model = _model(model)
     arrows = None
     if guess:
-        if t or vectors:
+        if t or vectors or ic:
             raise PictureError("the initial guess is the model's x, y, fi as given: draw it "
                                "without a time or vectors")
         mech = model.mechanism()
@@ -313,12 +321,26 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         when = f"t = {t:g} s (kinematic run)" if t else "assembled at t = 0"
     lo, hi = extent(mech, q)
     mech_size = float(max(hi - lo)) or 1.0
+    extra = []
     if arrows is not None:
         arrows.scaled(mech_size)
+        extra.append(arrows.tips)
+    shown, far = [], []
+    if ic:
+        _, _, found = centres(model, t)
+        for name, p in found:
+            off = np.maximum(np.maximum(lo - p, p - hi), 0.0)
+            (shown if max(off) <= FAR_CENTRE * mech_size else far).append((name, p))
+        extra += [p[None, :] for _, p in shown]
+        when += "; centres I" + (f" ({', '.join(n for n, _ in far)}: far off)" if far else "")
     fig = figure(*size, dpi)
     ax = fig.add_subplot()
-    scene = Scene(ax, mech, q[None, :], () if arrows is None else arrows.tips)
+    scene = Scene(ax, mech, q[None, :], np.vstack(extra) if extra else ())
     scene.show(t, q)
+    index = {s.name: i for i, s in enumerate(mech.solids)}
+    for name, p in shown:
+        with scene.pen.owner(f"centre:{name}"):
+            scene.pen.centre(p, index[name], name)
     if arrows is not None:
         with scene.pen.owner(f"vectors:{arrows.kind}"):
             scene.pen.vectors(arrows.points, arrows.values, arrows.scale,

@@ -437,6 +437,17 @@ class Pen:
                    zorder=Z_BAR)
         self._line([p, q], color=ACTUATOR, lw=1.5, zorder=Z_BAR)
 
+    def centre(self, p, solid: int, name: str) -> None:
+        """A solid's instantaneous centre of rotation: a ringed cross in its colour, named
+        ``I <solid>``."""
+        p, r, color = np.asarray(p, dtype=float), 1.1 * self.r, self.color(solid)
+        self._circle(p, r, facecolor="white", edgecolor=color, lw=1.4, zorder=Z_LOAD)
+        self._line([p - [1.8 * r, 0.0], p + [1.8 * r, 0.0], [np.nan, np.nan],
+                    p - [0.0, 1.8 * r], p + [0.0, 1.8 * r]], color=color, lw=1.2,
+                   zorder=Z_LOAD)
+        self.label(p, f"I {name}", None, color, reach=1.8 * r, fontsize=ELEMENT_FONT,
+                   fontstyle="italic")
+
     def unmet(self, points) -> None:
         """A constraint the drawing does not meet (an initial guess): a red dotted line
         through its anchor points, and its name in red."""

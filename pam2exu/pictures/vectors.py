@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kinematics import State, column, perp, rotate
+from ..kinematics import State, perp
+from ..points import fixed_solids, instantaneous_centre, point_motion
 from ..results.plot import PictureError
 
 #: the longest arrow, as a fraction of the mechanism's size (the larger side of its box)
@@ -25,17 +26,6 @@ KINDS = {
     "a": ("kinematic", "acceleration of each point"),
     "F": ("kinetostatic", "force of each joint and actuator on its solid 2, at its point"),
 }
-
-
-def point_velocity(v, dfi, As):
-    """v_P = v + Dfi Ω A s (Ω: a turn of +90°)."""
-    return np.asarray(v, dtype=float) + np.asarray(dfi, dtype=float)[..., None] * perp(As)
-
-
-def point_acceleration(a, dfi, ddfi, As):
-    """a_P = a + DDfi Ω A s − Dfi² A s."""
-    dfi, ddfi = (np.asarray(x, dtype=float)[..., None] for x in (dfi, ddfi))
-    return np.asarray(a, dtype=float) + ddfi * perp(As) - dfi ** 2 * np.asarray(As)
 
 
 def in_global(components, direction):
@@ -117,23 +107,19 @@ def at_instant(model, t: float, kind: str):
     res, k = _row(model, t, "kinematic", _pose_columns(mech)
                   + [f"{s.name}.{r}" for s in mech.solids for r in rates])
     q = np.array([res[c][k] for c in _pose_columns(mech)])
-    grounded = {el.ref1.solid for el in mech.elements if el.grounds}
     points, values, names = [], [], []
     for i, s in enumerate(mech.solids):
-        if i in grounded:
+        if i in fixed_solids(mech):
             continue
-        get = lambda r: float(res[f"{s.name}.{r}"][k])          # noqa: E731
+        get = lambda *rs: np.array([[float(res[f"{s.name}.{r}"][k]) for r in rs]])  # noqa: E731
         local = {n: tuple(float(c) for c in p) for n, p in s.points.items()} or {"": (0, 0)}
         for name, p in local.items():
-            As = rotate(np.array([q[column(i, 2)]]), np.asarray(p))[0]
-            origin = np.array([q[column(i, 0)], q[column(i, 1)]])
-            if kind == "v":
-                value = point_velocity([get("Dx"), get("Dy")], get("Dfi"), As)
-            else:
-                value = point_acceleration([get("DDx"), get("DDy")], get("Dfi"),
-                                           get("DDfi"), As)
-            points.append(origin + As)
-            values.append(value)
+            x, v, a = point_motion(get("x", "y"), get("Dx", "Dy"),
+                                   get("DDx", "DDy") if kind == "a" else None,
+                                   get("fi")[0], get("Dfi")[0],
+                                   get("DDfi")[0] if kind == "a" else None, p)
+            points.append(x[0])
+            values.append((v if kind == "v" else a)[0])
             names.append(f"{s.name}.{name}" if name else s.name)
     unit = "m/s" if kind == "v" else "m/s²"
     return mech, q, Arrows(kind, np.array(points).reshape(-1, 2),
@@ -157,3 +143,23 @@ def _forces(model, mech, t):
         values.append(in_global(c, np.asarray(direction, dtype=float)[0]))
     return mech, q, Arrows("F", np.array(points).reshape(-1, 2),
                            np.array(values).reshape(-1, 2), [el.name for el in carriers], "N")
+
+
+def centres(model, t: float):
+    """(mechanism, q, [(solid, I (2,))]) at time t: the instantaneous centre of every solid
+    not fixed (``points.instantaneous_centre``, from a kinematic run as for ``v``); a solid
+    that translates at t has none (left out)."""
+    mech = model.mechanism()
+    res, k = _row(model, t, "kinematic", _pose_columns(mech)
+                  + [f"{s.name}.{r}" for s in mech.solids for r in ("Dx", "Dy", "Dfi")])
+    q = np.array([res[c][k] for c in _pose_columns(mech)])
+    out = []
+    for i, s in enumerate(mech.solids):
+        if i in fixed_solids(mech):
+            continue
+        get = lambda *rs: np.array([[float(res[f"{s.name}.{r}"][k]) for r in rs]])  # noqa: E731
+        centre = instantaneous_centre(get("x", "y"), get("Dx", "Dy"), get("Dfi")[0],
+                                      mech.scale())[0]
+        if np.all(np.isfinite(centre)):
+            out.append((s.name, centre))
+    return mech, q, out

@@ -14,8 +14,7 @@ from pam2exu.cli import main
 from pam2exu.kinematics import rotate
 from pam2exu.pictures import draw
 from pam2exu.pictures.mechanism import extent
-from pam2exu.pictures.vectors import KEY, LONGEST, point_acceleration, point_velocity, \
-    round_length
+from pam2exu.pictures.vectors import KEY, LONGEST, round_length
 
 W = 2 * math.pi                 # the four-bar's crank speed [rad/s]
 
@@ -102,21 +101,7 @@ def test_point_vectors_of_the_four_bar(examples, kind):
                       f"arrow of {length:g} m = {length / scale:.3g} {unit}"]
 
 
-def test_point_formulas():
-    """v_P and a_P against the derivatives of R(t) + A(fi(t)) s by central differences."""
-    s = np.array([0.3, -0.2])
-    R = lambda t: np.array([np.sin(t), t ** 2])                 # noqa: E731
-    fi = lambda t: 0.7 * t + 0.4 * t ** 3                        # noqa: E731
-    P = lambda t: R(t) + rotate(np.array([fi(t)]), s)[0]          # noqa: E731
-    t, h = 0.8, 1e-4
-    v = np.array([np.cos(t), 2 * t])
-    a = np.array([-np.sin(t), 2.0])
-    dfi, ddfi = 0.7 + 1.2 * t ** 2, 2.4 * t
-    As = rotate(np.array([fi(t)]), s)[0]
-    np.testing.assert_allclose(point_velocity(v, dfi, As), (P(t + h) - P(t - h)) / (2 * h),
-                               atol=1e-8)
-    np.testing.assert_allclose(point_acceleration(a, dfi, ddfi, As),
-                               (P(t + h) - 2 * P(t) + P(t - h)) / h ** 2, atol=1e-6)
+def test_round_length():
     assert round_length(0.037) == 0.02 and round_length(0.05) == 0.05
     assert round_length(9.9) == 5.0
 
@@ -218,3 +203,28 @@ def test_cli_draw_vectors(examples, tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["draw", str(examples / "four_bar.toml"), "--vectors", "w"])
     assert "invalid choice: 'w'" in capsys.readouterr().err
+
+
+def test_instantaneous_centres_of_the_four_bar(examples):
+    """draw(ic=True) at t = 0.1 s: the coupler's centre is where the crank's line O2A meets
+    the rocker's line O4B (closed form from the run's positions), the crank's and rocker's
+    at their pivots O2 = (0, 0) and O4 = (0.4, 0)."""
+    from matplotlib.lines import Line2D
+    t = 0.1
+    fig = draw(examples / "four_bar.toml", t=t, ic=True)
+    marks = {}
+    for a in fig.axes[0].get_children():
+        if isinstance(a, Circle) and (a.get_gid() or "").startswith("centre:"):
+            marks[a.get_gid()[7:]] = np.array(a.center)
+    model = pam2exu.load(examples / "four_bar.toml")
+    steps = math.ceil(model.analysis.steps * t / model.analysis.t_end - 1e-9)
+    res = pam2exu.run(model, analysis="kinematic", t_end=t, steps=steps,
+                      outputs=["crank.fi", "rocker.fi"])
+    e1 = np.array([math.cos(res["crank.fi"][-1]), math.sin(res["crank.fi"][-1])])
+    e2 = np.array([math.cos(res["rocker.fi"][-1]), math.sin(res["rocker.fi"][-1])])
+    # s e1 = (0.4, 0) + u e2
+    s, _ = np.linalg.solve(np.column_stack([e1, -e2]), [0.4, 0.0])
+    np.testing.assert_allclose(marks["coupler"], s * e1, atol=1e-9)
+    np.testing.assert_allclose(marks["crank"], (0.0, 0.0), atol=1e-12)
+    np.testing.assert_allclose(marks["rocker"], (0.4, 0.0), atol=1e-12)
+    assert {"I crank", "I coupler", "I rocker"} <= {x.get_text() for x in fig.axes[0].texts}
