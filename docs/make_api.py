@@ -153,8 +153,8 @@ def is_element(obj) -> bool:
 
 
 #: base classes whose methods are documented as their subclass's own (``Results``' other
-#: forms live in pam2exu/results/writers.py)
-MIXINS = ("Exports",)
+#: forms live in pam2exu/results/writers.py, its values at one time in results/instant.py)
+MIXINS = ("Exports", "Instants")
 
 
 def members(cls) -> list[tuple[str, object]]:

@@ -227,9 +227,10 @@ def _run(args) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # warnings are carried in res.warnings
         outputs = args.outputs
-        if outputs and args.plot:
-            # the plotted variables (and the x axis) are computed too
-            outputs = [*outputs, *args.plot, *([args.x] if args.x else [])]
+        if args.plot:
+            # the plotted variables (and the x axis) are computed too; "*" is the default
+            # columns, to which a plot may add opt-in ones (coupler.P.x)
+            outputs = [*(outputs or ["*"]), *args.plot, *([args.x] if args.x else [])]
         res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
                   outputs=outputs, solver=solver, backend=args.backend, angles=args.angles)
     table = res.select(args.outputs) if args.outputs and args.plot else res

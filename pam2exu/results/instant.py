@@ -167,6 +167,54 @@ def at(res, t: float, kinds: dict | None = None) -> Instant:
                    errors=dict(zip(res.columns, map(float, error))), **common)
 
 
+class Instants:
+    """``Results``' values at one time (``at``); uses ``t``, ``columns``, ``units`` and the
+    table's rows."""
+
+    def at(self, t: float, kinds: dict | None = None) -> Instant:
+        """Every column at time t, grouped by solid and element: the row at a grid time,
+        else the cubic spline of ``pam2exu compare`` (and the text says so).
+
+        Parameters
+        ----------
+        t : float
+            The time [s], within the table's times.
+        kinds : dict, optional
+            Solid or element name → what it is, for the titles of the blocks
+            (``instant.kinds_of(model)``).
+
+        Returns
+        -------
+        Instant
+            Column → value (a dict-like), with ``row`` (the row at a grid time, else None),
+            ``between`` (the two rows it is interpolated between), ``errors`` (each value's
+            estimated interpolation error), ``owners()``, ``group(name)``; printed, one
+            block per solid and element with values and units.
+
+        Raises
+        ------
+        ValueError
+            t is not a number or outside the table's times.
+
+        Examples
+        --------
+        >>> from pam2exu.results import Results
+        >>> res = Results([0.0, 0.5, 1.0], {"crank.fi": [0.0, 1.0, 4.0], "B.Fx": [1.0, 2.0, 3.0]},
+        ...               {"crank.fi": "rad", "B.Fx": "N"}, "kinematic", "demo")
+        >>> res.at(0.5)["crank.fi"], res.at(0.5).group("B")
+        (1.0, {'Fx': 2.0})
+        >>> print(res.at(0.5))
+        demo, kinematic analysis: values at t = 0.5 s (row 1 of the table)
+        <BLANKLINE>
+        crank
+          fi                    1  rad
+        <BLANKLINE>
+        B
+          Fx                    2  N
+        """
+        return at(self, t, kinds)
+
+
 def kinds_of(model) -> dict[str, str]:
     """Name → ``"solid"`` or the element's type, for the titles of ``Instant`` blocks."""
     return {**{s.name: "solid" for s in model.solids},

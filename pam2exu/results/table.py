@@ -13,13 +13,13 @@ import numpy as np
 
 from ..errors import ModelError, Problem, closest
 from .info import RunInfo
-from .instant import Instant, at
+from .instant import Instants
 from .names import selects, spelled
 from .units import units_line
 from .writers import BOM, Exports, csv_translation
 
 
-class Results(Exports):
+class Results(Exports, Instants):
     """Columns ``<name>.<variable>`` over time, stored as one array.
 
     What ``pam2exu.run`` returns (and ``read_csv`` reads). ``res["crank.fi"]`` is a NumPy
@@ -300,10 +300,6 @@ class Results(Exports):
             out.append(f"power balance {info['power_balance_error']:.2g} W "
                        f"(finite-difference tolerance {info['power_balance_tolerance']:.2g} W)")
         return out
-
-    def at(self, t: float) -> Instant:
-        """Every column at time t by solid and element: the row, else a spline (``instant.at``)."""
-        return at(self, t)
 
     def __repr__(self) -> str:
         return (f"<Results {self.analysis} '{self.model}': {len(self)} rows × "

@@ -220,3 +220,19 @@ def test_which_solids_are_couplers():
     assert len(couplers(model.mechanism())) == 1           # a force element is no joint
     model.add("pin_slot", name="slot", anc1="ground", anc2="coupler.P")
     assert couplers(model.mechanism()) == []
+
+
+def test_cli_plots_a_coupler_curve(examples, tmp_path, capsys):
+    """``run --plot coupler.P.y --x coupler.P.x`` without --outputs: the plotted point columns
+    are computed besides the default ones (one command for a coupler curve)."""
+    from pam2exu.cli import main
+    out = tmp_path / "curve.png"
+    assert main(["run", str(examples / "four_bar.toml"), "--steps", "20", "--plot",
+                 "coupler.P.y", "--x", "coupler.P.x", "--plot-file", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert out.stat().st_size > 0
+    names = [line.split()[0] for line in printed.splitlines()[3:] if line.strip()]
+    names = names[:names.index("checks:")]
+    default = pam2exu.run(examples / "four_bar.toml", steps=4).columns
+    assert [n for n in names if not is_opt_in(n)] == default
+    assert [n for n in names if is_opt_in(n)] == ["coupler.P.x", "coupler.P.y"]
