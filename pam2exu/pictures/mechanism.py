@@ -79,9 +79,10 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
     model = _model(model)
     mech = model.mechanism()
     if analysis == "assembly":
-        res = run(model, analysis="assembly", outputs=list(_POSE[:3]))
+        res = run(model, analysis="assembly", outputs=list(_POSE[:3]), angles="rad")
     else:
-        res = run(model, analysis="kinematic", t_end=t_end, steps=steps, outputs=list(_POSE))
+        res = run(model, analysis="kinematic", t_end=t_end, steps=steps, outputs=list(_POSE),
+                  angles="rad")
     q = np.column_stack([res[f"{s.name}.{k}"] for s in mech.solids for k in ("x", "y", "fi")])
     return mech, np.array(res.t), q
 

@@ -79,9 +79,11 @@ def _row(model, t: float, analysis: str, outputs):
     a = model.analysis
     if t > 0:
         steps = max(1, math.ceil(a.steps * t / a.t_end - 1e-9))
-        res = run(model, analysis=analysis, t_end=float(t), steps=steps, outputs=outputs)
+        res = run(model, analysis=analysis, t_end=float(t), steps=steps, outputs=outputs,
+                  angles="rad")
         return res, -1
-    res = run(model, analysis=analysis, t_end=a.t_end / a.steps, steps=1, outputs=outputs)
+    res = run(model, analysis=analysis, t_end=a.t_end / a.steps, steps=1, outputs=outputs,
+              angles="rad")
     return res, 0
 
 

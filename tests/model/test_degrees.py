@@ -207,3 +207,20 @@ def test_verify_compares_a_degrees_model_in_radians():
     assert found.ok
     assert found.comparison["crank.fi"].unit == "rad"
     assert found.reference["motor.f(t)"][-1] == pytest.approx(2 * math.pi, rel=1e-14)
+
+
+def test_pictures_of_a_degrees_model_are_those_of_the_radians_model(tmp_path):
+    """draw's configurations come from runs in radians whatever the model's angles."""
+    from pam2exu.pictures.mechanism import pose
+    from pam2exu.pictures.vectors import at_instant
+    rad_model = pam2exu.load(FOUR_BAR)
+    deg_model = _in_degrees(rad_model)
+    for t in (0.0, 0.3):
+        (_, q_rad), (_, q_deg) = pose(rad_model, t), pose(deg_model, t)
+        np.testing.assert_allclose(q_deg, q_rad, rtol=0, atol=1e-12)
+    _, q_rad, arrows_rad = at_instant(rad_model, 0.3, "v")
+    _, q_deg, arrows_deg = at_instant(deg_model, 0.3, "v")
+    np.testing.assert_allclose(q_deg, q_rad, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(arrows_deg.values, arrows_rad.values, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(arrows_deg.points, arrows_rad.points,
+                               rtol=0, atol=1e-12)
