@@ -43,12 +43,15 @@ def run(model, analysis=None, **settings):
     analysis : str, optional
         ``'assembly'`` (positions at t = 0, free degrees of freedom allowed),
         ``'quasi_static'`` (positions and static reactions), ``'kinematic'`` (positions,
-        velocities, accelerations) or ``'kinetostatic'`` (kinematic, plus every reaction
-        and actuator force by inverse dynamics). Default: the model's analysis type.
+        velocities, accelerations), ``'kinetostatic'`` (kinematic, plus every reaction
+        and actuator force by inverse dynamics), and the extensions ``'clearance'``
+        (docs/clearance.md), ``'equilibrium'`` (free degrees of freedom at rest) and
+        ``'dynamic'`` (free degrees of freedom in motion; docs/analyses.md). Default: the
+        model's analysis type.
     **settings
         Keyword overrides of the model's settings: ``t_end``, ``steps``, ``outputs``,
-        ``solver`` and ``backend``, described below. None (the default of each) keeps the
-        model's.
+        ``solver``, ``backend``, ``angles`` and ``tolerance``, described below. None (the
+        default of each) keeps the model's.
     t_end : float, optional
         End of the interval [0, t_end] [s].
     steps : int, optional
@@ -65,6 +68,10 @@ def run(model, analysis=None, **settings):
     backend : str, optional
         What solves the positions (``pam2exu.registry.BACKENDS``): ``'exudyn'`` (the
         default); an unknown name is a ModelError listing the known ones.
+    tolerance : float, optional
+        ``'dynamic'`` only: the error allowed in the time integration, per unit of each
+        coordinate and rate (tolerance · (1 + |value|), SI units); default 1e-8. The
+        estimate achieved is ``res.info["integration_error"]``.
 
     Returns
     -------

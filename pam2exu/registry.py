@@ -113,6 +113,10 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
                  summary="the free degrees of freedom in stable static equilibrium at t = 0 "
                  "(shared/spec/dynamics.md)",
                  function="pam2exu.analyses.equilibrium:equilibrium"),
+    AnalysisType("dynamic", "dinamica", _ALL, driven=False, at_start=False,
+                 summary="forward dynamics: the free degrees of freedom move under the "
+                 "loads, to [analysis] tolerance (shared/spec/dynamics.md)",
+                 function="pam2exu.analyses.dynamic:dynamic"),
 )}
 
 #: the backends; the first is the default

@@ -103,27 +103,32 @@ def test_law_table_matches_the_contract():
 
 def test_solid_and_analysis_keys_match_the_contract():
     solid_keys = [k for r in _rows("Solids") for k in r[0].split(", ")]
-    assert solid_keys == [f.name for f in dataclasses.fields(Solid) if f.name != "position"]
+    assert solid_keys == [f.name for f in dataclasses.fields(Solid)
+                          if f.name != "position" and f.name not in Solid.EXTENSIONS]
     assert [r[0] for r in _rows("Analysis")] == [f.name for f in dataclasses.fields(Analysis)
                                                  if f.name not in Analysis.EXTENSIONS]
-    assert Analysis.EXTENSIONS == ("backend",)       # documented in docs/model-format.md
+    # documented in docs/model-format.md; tolerance is shared/spec/dynamics.md's
+    assert Analysis.EXTENSIONS == ("backend", "tolerance")
+    assert Solid.EXTENSIONS == ("Dx", "Dy", "Dfi")                   # dynamics.md
 
 
 def test_levels_of_the_reference_are_those_the_analyses_use():
     """Which analyses give each kind of output (the contract's analysis table: assembly
     gives only the solids' x, y, fi; clearance.md: clearance gives the solids' x, y, fi and
-    its clearance parameters; dynamics.md: equilibrium gives quasi_static's outputs), as
-    the registry declares and the pages say."""
-    expected = {POSITION: "quasi_static, kinematic, kinetostatic, equilibrium",
-                VELOCITY: "kinematic, kinetostatic", ACCELERATION: "kinematic, kinetostatic",
-                FORCE: "quasi_static, kinetostatic, equilibrium", CLEARANCE: "clearance"}
+    its clearance parameters; dynamics.md: equilibrium gives quasi_static's outputs, dynamic
+    kinetostatic's), as the registry declares and the pages say."""
+    expected = {POSITION: "quasi_static, kinematic, kinetostatic, equilibrium, dynamic",
+                VELOCITY: "kinematic, kinetostatic, dynamic",
+                ACCELERATION: "kinematic, kinetostatic, dynamic",
+                FORCE: "quasi_static, kinetostatic, equilibrium, dynamic",
+                CLEARANCE: "clearance"}
     for level, analyses in expected.items():
         assert reference._analyses(level) == analyses
         assert set(analyses.split(", ")) == {
             a.name for a in ANALYSES.values() if level in a.levels
             and (a.element_outputs or level == CLEARANCE)}
     assert reference._analyses(POSITION, "solid") == (
-        "assembly, quasi_static, kinematic, kinetostatic, clearance, equilibrium")
+        "assembly, quasi_static, kinematic, kinetostatic, clearance, equilibrium, dynamic")
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)

@@ -15,7 +15,7 @@ from .job import prepare
 
 
 def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
-        backend=None, angles=None):
+        backend=None, angles=None, tolerance=None):
     """Run an analysis and return its Results.
 
     ``pam2exu.run`` is this function, with ``t_end``, ``steps``, ``outputs`` and ``solver``
@@ -44,6 +44,9 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
         The unit of the angular columns (fi, Dfi, DDfi, f(t) of an angular actuator,
         fi_rel, …): ``'rad'`` or ``'deg'`` (deg, deg/s, deg/s²); default: the model's
         ``[model] angles``.
+    tolerance : float, optional
+        The dynamic analysis's integration tolerance (``Analysis.tolerance``); default: the
+        model's [analysis] tolerance.
 
     Returns
     -------
@@ -76,7 +79,7 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
     """
     job = None
     try:
-        job = prepare(model, analysis, t_end, steps, outputs, solver, backend)
+        job = prepare(model, analysis, t_end, steps, outputs, solver, backend, tolerance)
         if angles not in (None, *ANGLE_UNITS):
             raise ModelError(f"angles must be 'rad' or 'deg' (the unit of the angular "
                              f"results), got {angles!r}", job.mech.model.source)

@@ -44,6 +44,8 @@ class Job:
     motion: tuple | None = None
     #: what the analysis is doing, for the message of an unexpected failure
     stage: str = "checking the analysis settings"
+    #: the dynamic analysis's integration tolerance (``Analysis.tolerance``)
+    tolerance: float = 1e-8
 
 
 def available_columns(mech, analysis: str) -> dict[str, Var]:
@@ -86,14 +88,15 @@ def derived_columns(mech) -> list[tuple[str, Var]]:
 
 
 def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
-            backend=None) -> Job:
+            backend=None, tolerance=None) -> Job:
     """Load and validate the model, apply the overrides, choose the columns and the backend
     (``solver``: the backend's settings, default ``backend.Settings()``)."""
     if not isinstance(model, Model):
         model = load(model)
     settings = replace(model.analysis, **{k: v for k, v in
                                           dict(type=analysis, t_end=t_end, steps=steps,
-                                               outputs=outputs, backend=backend).items()
+                                               outputs=outputs, backend=backend,
+                                               tolerance=tolerance).items()
                                           if v is not None})
     problems = [Problem("[analysis]", m) for m in settings.problems()]
     if problems:
@@ -121,7 +124,7 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
     engine = registry.BACKENDS[settings.backend].create()
     job = Job(mech, kind.name, plan.times, columns, {c: available[c].unit for c in columns},
               levels, engine, solver if solver is not None else engine.Settings(),
-              every=plan.every, motion=plan.motion)
+              every=plan.every, motion=plan.motion, tolerance=settings.tolerance)
     if plan.every > 1:
         job.info["substeps"] = plan.every
     return job

@@ -69,8 +69,9 @@ class Backend(Protocol):
         ``solve_positions(..., rates=True)`` returns velocities and accelerations too.
     moves_free_solids : bool
         ``solve_positions(..., forces=True)`` moves the free degrees of freedom to a static
-        equilibrium (the ``equilibrium`` analysis needs it); otherwise it only gives the
-        multipliers at positions the constraints fix.
+        equilibrium (the ``equilibrium`` analysis needs it; otherwise it only gives the
+        multipliers at positions the constraints fix), and ``integrate(mech, times, q0,
+        qd0, substeps, verbose)`` integrates the equations of motion (``dynamic``).
     """
 
     name: ClassVar[str]

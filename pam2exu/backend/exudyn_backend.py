@@ -30,3 +30,9 @@ class Exudyn:
         error = None if system.error is None else str(system.error)
         return Positions(q, solved, error, system.coordinates(), lam,
                          system.newton_iterations)
+
+    def integrate(self, mech, times, q0, qd0, substeps, verbose=0):
+        """``backend.integrate.integrate``: Exudyn's trapezoidal rule (``SolveDynamic``)
+        from (q0, q̇0) through ``times``, ``substeps`` steps per interval."""
+        from .integrate import integrate
+        return integrate(mech, times, q0, qd0, substeps, verbose=verbose)

@@ -138,12 +138,18 @@ class ExudynSystem:
     start : array, optional
         x, y, fi of every solid to start Newton's iteration from (default: the solids'
         x, y, fi in the model); used to restart a run part-way.
+    start_rates : array, optional
+        Their rates at the start (initial velocities of a time integration; default 0).
+    ground_fixed : bool
+        Model a solid held by a fixed link as Exudyn ground also with the forces (a time
+        integration, whose fixed links' reactions come from the native pass).
     """
 
     items = items
 
     def __init__(self, mech, forces: bool = False, velocity_forces: bool = True,
-                 anchor_stiffness: float = 0.0, start=None):
+                 anchor_stiffness: float = 0.0, start=None, start_rates=None,
+                 ground_fixed: bool = False):
         exu.config.printToConsole = False
         self.mech = mech
         self.forces, self.velocity_forces = forces, velocity_forces
@@ -152,10 +158,11 @@ class ExudynSystem:
         # constraints-only systems model a solid held by a fixed link as Exudyn ground at
         # its pose: fewer coordinates and equations (the fixed link's reaction is not
         # needed from Exudyn then)
-        self.grounded = set() if forces else {el.ref1.solid for el in mech.elements
-                                              if el.grounds}
+        self.grounded = set() if forces and not ground_fixed else {
+            el.ref1.solid for el in mech.elements if el.grounds}
         self.nodes, self.bodies = [], []
         self.start = mech.initial_q() if start is None else np.asarray(start, dtype=float)
+        rates = None if start_rates is None else np.asarray(start_rates, dtype=float)
         for i, s in enumerate(mech.solids):
             self.begin(s)
             x, y, fi = (float(v) for v in self.start[pose(i)])
@@ -167,7 +174,9 @@ class ExudynSystem:
                     referenceRotation=[[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]])))
                 continue
             node = mbs.AddNode(items.NodeRigidBody2D(
-                referenceCoordinates=[0.0, 0.0, 0.0], initialCoordinates=[x, y, fi]))
+                referenceCoordinates=[0.0, 0.0, 0.0], initialCoordinates=[x, y, fi],
+                **({} if rates is None else
+                   {"initialVelocities": [float(v) for v in rates[pose(i)]]})))
             mass, inertia = (float(s.mass), float(s.inertia)) if forces else (0.0, 0.0)
             gx, gy = (float(c) for c in s.cog)
             self.nodes.append(node)

@@ -31,9 +31,11 @@ def degrees_to_radians(value: float) -> float:
 
 
 def solid_in_radians(solid: Solid) -> Solid:
-    """A copy of a degrees solid with ``fi`` and its lines' ``angle`` in radians."""
+    """A copy of a degrees solid with ``fi``, its lines' ``angle`` and ``Dfi`` (deg/s) in
+    radians."""
     out = copy.copy(solid)
     out.fi = degrees_to_radians(solid.fi)
+    out.Dfi = degrees_to_radians(solid.Dfi)
     out.lines = {name: {**line, **({"angle": degrees_to_radians(line["angle"])}
                                    if "angle" in line else {})}
                  for name, line in solid.lines.items()}

@@ -12,8 +12,9 @@ from .variation import KEYS as _VARIATION_KEYS
 from .variation import Variation
 
 _MODEL_KEYS = ("name", "gravity", "angles")
-_SOLID_KEYS = ("name", "x", "y", "fi", "mass", "inertia", "cog", "points", "lines")
-_ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs", "backend")
+_SOLID_KEYS = ("name", "x", "y", "fi", "mass", "inertia", "cog", "points", "lines", "Dx", "Dy",
+               "Dfi")
+_ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs", "backend", "tolerance")
 _TABLES = ("model", "solid", "element", "variation", "analysis")
 
 

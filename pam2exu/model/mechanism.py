@@ -125,6 +125,17 @@ class Mechanism:
         import numpy as np
         return np.array([float(v) for s in self.solids for v in (s.x, s.y, s.fi)])
 
+    def initial_qd(self):
+        """The initial-velocity guess q̇0 from the solids' Dx, Dy, Dfi (``dynamic``).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (nq,): Dx [m/s], Dy [m/s], Dfi [rad/s] of each solid in order.
+        """
+        import numpy as np
+        return np.array([float(v) for s in self.solids for v in (s.Dx, s.Dy, s.Dfi)])
+
     def scale(self) -> float:
         """A length typical of the mechanism [m]: the largest point or pose offset, at least 1e-3.
 

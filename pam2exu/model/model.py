@@ -17,6 +17,9 @@ from .solid import Scope, Solid, solid_problems
 from .variation import KEYS as VARIATION_KEYS
 from .variation import Variation, variation_problems
 
+#: the loosest integration tolerance of the dynamic analysis (its error per unit of value)
+MAX_TOLERANCE = 1e-2
+
 
 @dataclass
 class Analysis:
@@ -43,6 +46,10 @@ class Analysis:
     backend : str
         What solves the positions: ``'exudyn'`` (the default; ``pam2exu.registry.BACKENDS``
         lists the backends).
+    tolerance : float
+        Accuracy required of the ``dynamic`` analysis's time integration: its error at
+        most tolerance · (1 + |value|) on every coordinate and rate, SI units
+        (shared/spec/dynamics.md); 0 < tolerance ≤ 1e-2. Other analyses ignore it.
 
     Examples
     --------
@@ -55,9 +62,10 @@ class Analysis:
     steps: int = 100
     outputs: list[str] | None = None
     backend: str = registry.DEFAULT_BACKEND
+    tolerance: float = 1e-8
 
     #: keys beyond the contract's [analysis] table (docs/model-format.md says so)
-    EXTENSIONS = ("backend",)
+    EXTENSIONS = ("backend", "tolerance")
 
     def __post_init__(self):
         self._canonical_type()
@@ -105,6 +113,9 @@ class Analysis:
                 or not all(isinstance(o, str) for o in self.outputs)):
 
             out.append("outputs must be a list of names or patterns, e.g. [\"crank.*\", \"Fx\"]")
+        if not _number(self.tolerance) or not 0 < self.tolerance <= MAX_TOLERANCE:
+            out.append(f"tolerance must be a number in (0, {MAX_TOLERANCE:g}], the error "
+                       f"allowed per unit of a coordinate or rate, got {self.tolerance!r}")
         return out
 
 

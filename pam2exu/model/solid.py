@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 from ..elements.base import ACCELERATION, POSITION, VELOCITY, Var
 from .. import limits
@@ -34,6 +34,10 @@ class Solid:
         Moment of inertia about the centre of mass G [kg·m²], ≥ 0.
     cog : (float, float)
         Centre of mass G in the local frame [m].
+    Dx, Dy, Dfi : float
+        Initial-velocity guess of the ``dynamic`` analysis: the rates of x, y [m/s] and
+        fi [rad/s] at t = 0 (shared/spec/dynamics.md); the velocities nearest to them that
+        satisfy the velocity equations are used. Default 0.
     points : dict
         ``{name: [x, y]}`` in the local frame [m]; anchors ``"<solid>.<point>"``.
     lines : dict
@@ -61,6 +65,12 @@ class Solid:
     cog: Any = (0.0, 0.0)
     points: dict = field(default_factory=dict)
     lines: dict = field(default_factory=dict)
+    Dx: float = 0.0
+    Dy: float = 0.0
+    Dfi: float = 0.0
+
+    #: keys beyond the contract's [[solid]] table (shared/spec/dynamics.md)
+    EXTENSIONS: ClassVar[tuple[str, ...]] = ("Dx", "Dy", "Dfi")
     #: 1-based position in the file's [[solid]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False)
 
@@ -201,7 +211,8 @@ def _pair(v) -> bool:
 #: a solid's numbers: (key, range, unit)
 _SOLID_NUMBERS = (("x", limits.LENGTH, "m"), ("y", limits.LENGTH, "m"),
                   ("fi", limits.ANGLE, "rad"), ("mass", limits.VALUE, "kg"),
-                  ("inertia", limits.VALUE, "kg·m²"))
+                  ("inertia", limits.VALUE, "kg·m²"), ("Dx", limits.VALUE, "m/s"),
+                  ("Dy", limits.VALUE, "m/s"), ("Dfi", limits.VALUE, "rad/s"))
 
 
 def range_problems(what: str, value, limit: float, unit: str) -> list[str]:

@@ -50,6 +50,11 @@ class RunInfo(MutableMapping):
     stiffness_eigenvalue : float
         equilibrium: the smallest eigenvalue of the reduced tangent stiffness, angles scaled
         by the length scale (> 0: stable) [N/m].
+    integration_error : float
+        dynamic: the estimate of the time integration's error reached, per unit of value
+        (|error| / (1 + |value|), largest over coordinates, rates and rows) [-].
+    integration_steps : int
+        dynamic: the steps of the finest Exudyn run of a segment.
     undefined : str
         Columns asked for that are NaN by definition at some rows, and why (an
         instantaneous centre where its solid translates: ``points.columns``).
@@ -81,6 +86,8 @@ class RunInfo(MutableMapping):
     power_balance: str | None = None
     undefined: str | None = None
     stiffness_eigenvalue: float | None = None
+    integration_error: float | None = None
+    integration_steps: int | None = None
 
     def _field(self, key: str) -> str:
         if key not in _NAMES:

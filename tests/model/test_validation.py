@@ -563,7 +563,8 @@ def test_torsor_axes():
     ('type = "kinematics"', r"\[analysis\]: unknown analysis type 'kinematics' \(did you mean "
                             r"'kinematic'\?\); known types: assembly, quasi_static, kinematic, "
                             r"kinetostatic"),
-    ('type = "dynamic"', r"\[analysis\]: unknown analysis type 'dynamic'"),
+    ('type = "dynamics"', r"\[analysis\]: unknown analysis type 'dynamics' \(did you mean "
+                          r"'dynamic'\?\)"),
     ("t_end = 0.0", r"\[analysis\]: t_end must be a positive number of seconds, got 0\.0"),
     ("t_end = -1.0", r"t_end must be a positive number of seconds, got -1\.0"),
     ('t_end = "1"', r"t_end must be a positive number of seconds, got '1'"),
@@ -577,6 +578,9 @@ def test_torsor_axes():
                            r"known backends: exudyn"),
     ("backend = 1", r"\[analysis\]: unknown backend '1'; known backends: exudyn"),
     ("outputs = [1, 2]", r"outputs must be a list of names or patterns"),
+    ("tolerance = 0.0", r"\[analysis\]: tolerance must be a number in \(0, 0.01\], the error "
+                        r"allowed per unit of a coordinate or rate, got 0.0"),
+    ('tolerance = "fine"', r"tolerance must be a number in \(0, 0.01\]"),
 ])
 def test_bad_analysis(body, match):
     with pytest.raises(ModelError, match=match):
@@ -585,11 +589,13 @@ def test_bad_analysis(body, match):
 
 def test_analysis_defaults_and_values():
     assert vars(loads(SOLIDS).analysis) == {"type": "kinematic", "t_end": 1.0, "steps": 100,
-                                            "outputs": None, "backend": "exudyn"}
+                                            "outputs": None, "backend": "exudyn",
+                                            "tolerance": 1e-8}
     model = loads(SOLIDS + '\n[analysis]\ntype = "assembly"\nt_end = 2\nsteps = 7\n'
                            'outputs = ["crank.*", "Fx"]\nbackend = "exudyn"\n')
     assert vars(model.analysis) == {"type": "assembly", "t_end": 2, "steps": 7,
-                                    "outputs": ["crank.*", "Fx"], "backend": "exudyn"}
+                                    "outputs": ["crank.*", "Fx"], "backend": "exudyn",
+                                    "tolerance": 1e-8}
 
 
 # ---- files and sources -------------------------------------------------------------------
@@ -717,7 +723,8 @@ def test_shipped_example_loads():
     assert model["rod"].fi == -0.2 and model["rod"].cog == [0.15, 0.0]
     assert model["motor"].time_law() == pam2exu.Law("polynomial", (0.0, 10.0, 0.0, 0.0))
     assert vars(model.analysis) == {"type": "kinetostatic", "t_end": 0.6283185307179586,
-                                    "steps": 200, "outputs": None, "backend": "exudyn"}
+                                    "steps": 200, "outputs": None, "backend": "exudyn",
+                                    "tolerance": 1e-8}
     assert model.problems() == []
     assert model.source == str(ROOT / "examples" / "slider_crank.toml")
 

@@ -1,0 +1,282 @@
+"""Forward dynamics (shared/spec/dynamics.md, ``dynamic``): let go of the mechanism.
+
+The degrees of freedom no actuator drives move under gravity, the torsors, the springs and
+dampers and the inertia of every solid; the driven ones follow their laws. Exudyn's
+``SolveDynamic`` integrates the translated model (``backend.integrate``). Its generalized-α
+rule is of order 2, so two runs at h and h/2 extrapolate (Richardson) to order 3 at least
+(measured 3.3 on the pendulum of the tests), and three runs give two such values whose
+difference estimates the error of the better one (Romberg). The step is halved until that
+estimate meets ``tolerance`` · (1 + |value|) on every coordinate and rate.
+
+The native pass then does what Exudyn does not: the extrapolated state is projected back
+onto the constraints (positions and velocities, a correction of the integration error's
+size), the accelerations and multipliers come from the equations of motion
+
+    [M  C_qᵀ] [q̈]   [Q(q, q̇, t) − b(q, q̇)]
+    [C_q  0 ] [μ] = [γ(q, q̇, t)          ],
+
+and the reactions from the same formulas as ``kinetostatic`` (``force_pass.over_time``),
+so every row satisfies every solid's Newton–Euler equations.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import ModelError
+from ..kinematics import State, pose
+from . import force_pass, native
+from .assembly import GUESS_STIFFNESS
+from .job import Job, check_mobility, collect, warn
+from .kinetostatic import kinetostatic
+from .positions import assemble, check_residual
+
+#: the coarsest run takes at least this many steps over the interval
+FIRST_STEPS = 64
+#: the finest run may take at most this many steps over the interval; beyond, the results
+#: are those of the finest run, with a warning giving the estimate reached
+MOST_STEPS = 2 ** 21
+#: the order the Richardson step leaves (generalized-α's h³ term remains): two values
+#: extrapolated from h and h/2 differ by (2^ORDER − 1) times the error of the later one
+ORDER = 3
+#: Gauss–Newton iterations of the projection onto the position constraints
+PROJECTIONS = 3
+
+
+class AccuracyWarning(UserWarning):
+    """The dynamic analysis could not meet its tolerance within ``MOST_STEPS``."""
+
+
+def dynamic(job: Job):
+    """Every output of ``kinetostatic``, the free degrees of freedom integrated in time
+    from the assembly and the nearest consistent velocities (shared/spec/dynamics.md).
+
+    A fully driven model gives the kinetostatic results. ``res.info``: the error estimate
+    reached (``integration_error``), the steps of the finest run (``integration_steps``).
+    """
+    mech, t = job.mech, job.times
+    mob = check_mobility(job, mech.initial_q(), need_driven=False)
+    if mob.dof == 0:
+        return kinetostatic(job)
+    if not job.backend.moves_free_solids:
+        raise ModelError(
+            f"the {job.backend.name} backend cannot integrate the motion of free solids "
+            f"({', '.join(repr(n) for n in mob.free_solids)}): run the dynamic analysis on "
+            "the exudyn backend (backend = \"exudyn\", --backend exudyn)")
+    redundant = mob.redundant > 0
+    q0 = assemble(job, redundant, GUESS_STIFFNESS)
+    require_inertia(mech, float(t[0]), q0)
+    qd0 = nearest_velocities(mech, float(t[0]), q0, mech.initial_qd())
+    job.stage = "integrating the equations of motion with Exudyn's dynamic solver"
+    q, qd = motion(job, q0, qd0)
+    job.stage = "projecting the integrated states onto the constraints"
+    q, qd = project(mech, t, q, qd)
+    check_residual(mech, t, q, job)
+    job.stage = "computing accelerations and multipliers (equations of motion)"
+    qdd = accelerations(mech, t, q, qd)
+    job.stage = "computing the reactions (the kinetostatic formulas)"
+    # C_q is not square with free degrees of freedom: the multipliers by least squares,
+    # exact here since the accelerations make the equations consistent
+    out, _ = force_pass.over_time(mech, t, q, True, qd, qdd)
+    return collect(job, q, qd, qdd, extra=out)
+
+
+# ---- the motion, by Exudyn, to the tolerance ---------------------------------------------
+
+def motion(job: Job, q0: np.ndarray, qd0: np.ndarray):
+    """(q, q̇) at every time of the job, segment by segment between the laws' breakpoints
+    (where the velocities jump: ``impulse``), each one to the tolerance (``romberg``)."""
+    mech, t = job.mech, job.times
+    dt = float(t[1] - t[0])
+    # a breakpoint within round-off of a row is that row's time
+    breaks = sorted({float(t[np.argmin(np.abs(t - b))])
+                     if np.min(np.abs(t - b)) <= 1e-9 * dt else float(b)
+                     for el in mech.drivers for b in el.time_law().breakpoints()
+                     if t[0] < b < t[-1]})
+    breaks = [b for b in breaks if t[0] < b < t[-1]]
+    q, qd = np.full((len(t), mech.nq), np.nan), np.full((len(t), mech.nq), np.nan)
+    worst, steps = 0.0, 0
+    start, state = float(t[0]), (q0, qd0)
+    for end in [*breaks, float(t[-1])]:
+        inside = np.nonzero((t > start) & (t <= end))[0]
+        if start == float(t[0]):
+            q[0], qd[0] = state
+        pieces = _pieces(t, inside, start, end)
+        for times, rows in pieces:
+            found, estimate, n = romberg(job, times, *state)
+            q[rows], qd[rows] = found[0][1:len(rows) + 1], found[1][1:len(rows) + 1]
+            worst, steps = max(worst, estimate), max(steps, n)
+            state = (found[0][-1], found[1][-1])
+        if end < float(t[-1]):
+            state = (state[0], impulse(mech, end, *state))
+            at = np.nonzero(np.abs(t - end) <= 1e-12 * max(1.0, abs(end)))[0]
+            if at.size:                      # a row at the breakpoint: the values after
+                q[at], qd[at] = state
+        start = end
+    job.info["integration_error"] = worst
+    job.info["integration_steps"] = steps
+    if worst > job.tolerance:
+        warn(job, f"the time integration reached an error estimate of {worst:.2g} per unit "
+                  f"of value, not the tolerance {job.tolerance:g}: Exudyn's generalized-α "
+                  f"would need more than {MOST_STEPS:,} steps here. Ask for a looser "
+                  "tolerance, or a shorter interval", AccuracyWarning)
+    return q, qd
+
+
+def _pieces(t: np.ndarray, inside: np.ndarray, start: float, end: float):
+    """The runs that cover (start, end]: equally spaced times from ``start`` through the
+    output rows ``inside``, and the rows they fill (a run from ``start`` to the first row
+    when ``start`` is a breakpoint between rows, and one from the last row to ``end``)."""
+    out = []
+    rows = list(inside)
+    if rows and not math.isclose(t[rows[0]] - start, t[1] - t[0], rel_tol=1e-9) \
+            and t[rows[0]] - start < t[1] - t[0]:
+        out.append((np.array([start, t[rows[0]]]), rows[:1]))
+        start, rows = float(t[rows[0]]), rows[1:]
+    if rows:
+        out.append((np.r_[start, t[rows]], rows))
+        start = float(t[rows[-1]])
+    if end > start + 1e-9 * (t[1] - t[0]):
+        out.append((np.array([start, end]), []))
+    return out
+
+
+def romberg(job: Job, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray):
+    """((q, q̇) at ``times``, error estimate, steps of the finest run): runs with s, 2s, 4s …
+    steps per interval, each pair extrapolated (R = y_h/2 + (y_h/2 − y_h)/3), until two
+    successive R differ by at most (2^ORDER − 1) · tolerance · (1 + |R|) (their difference
+    over 2^ORDER − 1 estimates the error of the later one)."""
+    n = len(times) - 1
+    s = max(1, math.ceil(FIRST_STEPS / n))
+    runs = [_run(job, times, q0, qd0, s), _run(job, times, q0, qd0, 2 * s)]
+    best = None
+    while True:
+        coarse, fine = runs[-2], runs[-1]
+        R = tuple(b + (b - a) / 3.0 for a, b in zip(coarse, fine))
+        if best is not None:
+            estimate = max(float(np.max(np.abs(r - p) / (2 ** ORDER - 1) / (1.0 + np.abs(r))))
+                           for r, p in zip(R, best))
+            if estimate <= job.tolerance or 2 * s * n * 2 > MOST_STEPS:
+                return R, estimate, 2 * s * n
+        best = R
+        s *= 2
+        runs.append(_run(job, times, q0, qd0, 2 * s))
+
+
+def _run(job: Job, times, q0, qd0, substeps: int):
+    """(q, q̇) of one Exudyn run; SolverError naming the time where it stopped."""
+    from ..errors import SolverError
+    found = job.backend.integrate(job.mech, times, q0, qd0, substeps, verbose=job.solver.verbose)
+    if found.error is not None:
+        rows = ~np.isfinite(found.q).all(axis=1)
+        at = float(times[int(np.argmax(rows))]) if rows.any() else float(times[-1])
+        raise SolverError(
+            f"t={at:g}: Exudyn's dynamic solver failed ({found.error}) with "
+            f"{substeps} steps per interval of {times[1] - times[0]:g} s. The motion may "
+            "reach a singular position, or move too fast for the step: try more steps or a "
+            "shorter interval", time=at)
+    return found.q, found.qd
+
+
+# ---- the native pass: consistent states, accelerations, impulses -----------------------
+
+def mass_matrix(mech, st: State) -> np.ndarray:
+    """M (n, nq, nq): Σ m J_Gᵀ J_G + J_G e_fi e_fiᵀ per solid (J_G: ∂r_G/∂(x, y, fi))."""
+    M = np.zeros((st.n, mech.nq, mech.nq))
+    for i, s in enumerate(mech.solids):
+        m, J = float(s.mass), float(s.inertia)
+        if m == 0 and J == 0:
+            continue
+        block = st.point(i, [float(c) for c in s.cog]).jac[i]
+        cols = pose(i)
+        M[:, cols, cols] += m * np.einsum("ndk,ndl->nkl", block, block)
+        M[:, cols.stop - 1, cols.stop - 1] += J
+    return M
+
+
+def accelerations(mech, t, q, qd) -> np.ndarray:
+    """q̈ (n, nq) from [[M, C_qᵀ], [C_q, 0]] [q̈; μ] = [Q − b; γ], b the inertia terms at
+    q̈ = 0 (least squares where redundant constraints make it singular)."""
+    st = State(t, q, qd)
+    M = mass_matrix(mech, st)
+    b, _ = force_pass.inertia_forces(mech, st, np.zeros_like(q))
+    Q = force_pass.applied_forces(mech, st, damping=True).force
+    eq = native.equations(mech, st)
+    A = _saddle(M, eq.jacobian)
+    rhs = np.concatenate([Q - b, eq.gamma], axis=1)
+    return _solve(A, rhs)[:, :mech.nq]
+
+
+def impulse(mech, t: float, q: np.ndarray, qd_before: np.ndarray) -> np.ndarray:
+    """q̇⁺ after a breakpoint at t: min (q̇⁺ − q̇⁻)ᵀ M (q̇⁺ − q̇⁻) subject to the velocity
+    equations after it, [[M, C_qᵀ], [C_q, 0]] [q̇⁺; μ] = [M q̇⁻; −C_t⁺]."""
+    st = State([t], q[None])
+    M = mass_matrix(mech, st)
+    eq = native.equations(mech, st)
+    rhs = np.concatenate([M[0] @ qd_before, -eq.c_t[0]])[None]
+    return _solve(_saddle(M, eq.jacobian), rhs)[0, :mech.nq]
+
+
+def nearest_velocities(mech, t: float, q: np.ndarray, guess: np.ndarray) -> np.ndarray:
+    """q̇ = q̇_g − C_q⁺ (C_q q̇_g + C_t): the velocities that satisfy the velocity equations
+    nearest to the guess in the Euclidean norm (SI units)."""
+    eq = native.equations(mech, State([t], q[None]))
+    J = eq.jacobian[0]
+    return guess - np.linalg.pinv(J, rcond=1e-12) @ (J @ guess + eq.c_t[0])
+
+
+def project(mech, t, q, qd):
+    """(q, q̇) moved by least norm onto C(q, t) = 0 (Gauss–Newton) and then onto
+    C_q q̇ + C_t = 0: corrections of the size of the integration error."""
+    q, qd = q.copy(), qd.copy()
+    for _ in range(PROJECTIONS):
+        eq = native.equations(mech, State(t, q))
+        q -= np.einsum("nqm,nm->nq", np.linalg.pinv(eq.jacobian, rcond=1e-12), eq.residual)
+    eq = native.equations(mech, State(t, q))
+    defect = np.einsum("nmq,nq->nm", eq.jacobian, qd) + eq.c_t
+    qd -= np.einsum("nqm,nm->nq", np.linalg.pinv(eq.jacobian, rcond=1e-12), defect)
+    return q, qd
+
+
+def require_inertia(mech, t: float, q: np.ndarray) -> None:
+    """ModelError naming the solids of a free motion that moves no mass and no inertia
+    (Zᵀ M Z singular, Z a basis of the motions the constraints allow)."""
+    st = State([t], q[None])
+    J = native.equations(mech, st).jacobian[0]
+    _, sv, Vt = np.linalg.svd(J)
+    rank = int(np.sum(sv > 1e-9 * sv[0])) if sv.size else 0
+    Z = Vt[rank:].T
+    if Z.shape[1] == 0:
+        return
+    scale = np.tile([1.0, 1.0, mech.scale()], len(mech.solids))
+    M = mass_matrix(mech, st)[0] / np.outer(scale, scale)
+    values, vectors = np.linalg.eigh(Z.T @ (M * np.outer(scale, scale)) @ Z)
+    size = max(float(np.max(np.abs(M))), np.finfo(float).tiny)
+    if values[0] > 1e-12 * size:
+        return
+    mode = Z @ vectors[:, 0]
+    moved = [s.name for i, s in enumerate(mech.solids)
+             if np.max(np.abs(mode[pose(i)] * scale[pose(i)])) > 1e-6 * np.max(np.abs(mode * scale))]
+    raise ModelError(
+        f"a free motion of the solids {', '.join(repr(n) for n in moved)} moves no mass and "
+        "no inertia, so its acceleration is not defined: give those solids a mass or an "
+        "inertia, or drive the motion with an actuator")
+
+
+def _saddle(M: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """[[M, Jᵀ], [J, 0]] per step."""
+    n, m, nq = J.shape
+    A = np.zeros((n, nq + m, nq + m))
+    A[:, :nq, :nq] = M
+    A[:, :nq, nq:] = np.swapaxes(J, 1, 2)
+    A[:, nq:, :nq] = J
+    return A
+
+
+def _solve(A: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x with A x = rhs per step; least squares (min norm) where A is singular."""
+    try:
+        return np.linalg.solve(A, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return np.einsum("nij,nj->ni", np.linalg.pinv(A, rcond=1e-12), rhs)

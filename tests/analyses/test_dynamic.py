@@ -1,0 +1,237 @@
+"""The dynamic analysis (shared/spec/dynamics.md, ``dynamic``).
+
+References, each computed here without pam2exu's code:
+- a free compound pendulum (I_O θ̈ = −m g d cos θ, θ from the +x axis): its period for any
+  amplitude θ0 from the hanging position, T = 4 √(I_O / (m g d)) K(sin²(θ0/2)) (scipy's
+  complete elliptic integral), the small-amplitude limit 2π √(I_O / (m g d)), its energy,
+  and scipy's DOP853 on its equation (rtol 1e-13);
+- the pivot force of the pendulum, m a_G − m g, with a_G from θ, θ̇, θ̈;
+- a pendulum hanging from a slider that a linear actuator drives (bezier_c2): its one-DOF
+  equation I_O θ̈ = m d sin θ ẍ_s − m g d cos θ integrated by DOP853;
+- a fully driven model gives the kinetostatic results.
+"""
+import math
+import warnings
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.special import ellipk
+
+import pam2exu
+from pam2exu.laws import Law
+
+G, M, D, IG = 9.81, 2.0, 0.25, 0.02
+IO = IG + M * D * D
+
+PENDULUM = f"""
+[model]
+name = "pendulum"
+gravity = {G}
+
+[[solid]]
+name = "ground"
+
+[[solid]]
+name = "lever"
+fi = @FI@
+Dx = @DX@
+Dfi = @DFI@
+mass = {M}
+inertia = {IG}
+cog = [{D}, 0.0]
+points = {{ O = [0.0, 0.0], A = [0.5, 0.0] }}
+
+[[element]]
+type = "fixed"
+name = "base"
+anc1 = "ground"
+
+[[element]]
+type = "revolute"
+name = "pivot"
+anc1 = "ground"
+anc2 = "lever.O"
+
+[analysis]
+type = "dynamic"
+"""
+
+
+def pendulum(fi, dfi=0.0, dx=0.0):
+    return pam2exu.loads(PENDULUM.replace("@FI@", repr(fi)).replace("@DFI@", repr(dfi))
+                         .replace("@DX@", repr(dx)))
+
+
+def _run(model, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return pam2exu.run(model, **kw)
+
+
+def _period(amplitude):
+    """T = 4 √(I_O/(m g d)) K(k²), k = sin(θ0/2), θ0 the amplitude from hanging."""
+    return 4.0 * math.sqrt(IO / (M * G * D)) * ellipk(math.sin(amplitude / 2) ** 2)
+
+
+@pytest.mark.parametrize("amplitude, tolerance", [(1e-3, 1e-10), (2.5, 1e-8)])
+def test_free_pendulum_returns_after_its_period(amplitude, tolerance):
+    """Released at rest θ0 from hanging: one period later, back at rest at θ0."""
+    T = _period(amplitude)
+    if amplitude < 0.01:       # the small-amplitude limit, to 4e-8 relative here
+        assert T == pytest.approx(2 * math.pi * math.sqrt(IO / (M * G * D)), rel=1e-7)
+    start = -math.pi / 2 + amplitude
+    res = _run(pendulum(start), t_end=T, steps=40, tolerance=tolerance)
+    assert res.info["integration_error"] <= tolerance
+    assert res["lever.fi"][-1] == pytest.approx(start, abs=tolerance * (1 + abs(start)))
+    assert res["lever.Dfi"][-1] == pytest.approx(0.0, abs=tolerance)
+    half = res["lever.fi"][20]                                   # t = T/2: the far side
+    assert half == pytest.approx(-math.pi / 2 - amplitude, abs=tolerance * (1 + abs(half)))
+
+
+@pytest.mark.parametrize("tolerance", [1e-6, 1e-8, 1e-10])
+def test_free_pendulum_against_an_independent_integration(tolerance):
+    """Every row within the tolerance of DOP853 on θ̈ = −m g d cos θ / I_O, the energy
+    constant to the tolerance, θ̈ from the equation itself, and the pivot force m a_G − m g
+    (measured at 1e-8: θ 1.7e-9, θ̇ 1.5e-8 with |θ̇| ≤ 4 rad/s)."""
+    res = _run(pendulum(0.3), t_end=2.0, steps=50, tolerance=tolerance)
+    ref = solve_ivp(lambda t, y: [y[1], -M * G * D * math.cos(y[0]) / IO], (0, 2.0),
+                    [0.3, 0.0], method="DOP853", rtol=1e-13, atol=1e-14, t_eval=res.t)
+    th, w, a = res["lever.fi"], res["lever.Dfi"], res["lever.DDfi"]
+    assert np.all(np.abs(th - ref.y[0]) <= tolerance * (1 + np.abs(ref.y[0])))
+    assert np.all(np.abs(w - ref.y[1]) <= tolerance * (1 + np.abs(ref.y[1])))
+    np.testing.assert_allclose(a, -M * G * D * np.cos(th) / IO, rtol=1e-12, atol=1e-12)
+    energy = 0.5 * IO * w ** 2 + M * G * D * np.sin(th)
+    assert np.max(np.abs(energy - energy[0])) <= tolerance * (1 + abs(energy[0])) * 10
+    aGx = D * (-np.sin(th) * a - np.cos(th) * w ** 2)
+    aGy = D * (np.cos(th) * a - np.sin(th) * w ** 2)
+    np.testing.assert_allclose(res["pivot.Fx"], M * aGx, atol=1e-10)
+    np.testing.assert_allclose(res["pivot.Fy"], M * aGy + M * G, atol=1e-10)
+    np.testing.assert_allclose(res["lever.x"], 0.0, atol=1e-12)       # on its pivot
+
+
+def test_initial_velocities_are_the_nearest_consistent_ones():
+    """Dx = 1 m/s cannot hold at a pivot: the nearest velocities keep Dfi and drop Dx."""
+    res = _run(pendulum(-math.pi / 2, dfi=2.0, dx=1.0), t_end=0.1, steps=4)
+    assert res["lever.Dfi"][0] == pytest.approx(2.0, abs=1e-15)
+    assert res["lever.Dx"][0] == pytest.approx(0.0, abs=1e-15)
+    assert res["lever.Dy"][0] == pytest.approx(0.0, abs=1e-15)
+
+
+SLIDER = f"""
+[model]
+name = "pendulum on a slider"
+gravity = {G}
+
+[[solid]]
+name = "ground"
+points = {{ O = [0.0, 0.0] }}
+
+[[solid]]
+name = "slider"
+x = 0.5
+mass = 1.0
+inertia = 0.01
+
+[[solid]]
+name = "lever"
+x = 0.5
+fi = -1.2
+mass = {M}
+inertia = {IG}
+cog = [{D}, 0.0]
+
+[[element]]
+type = "fixed"
+anc1 = "ground"
+
+[[element]]
+type = "prismatic"
+name = "rail"
+anc1 = "ground"
+anc2 = "slider"
+
+[[element]]
+type = "linear_actuator"
+name = "drive"
+anc1 = "ground.O"
+anc2 = "slider"
+law = "bezier_c2"
+C = [0.2, 0.7, 0.5, 0.9]
+
+[[element]]
+type = "revolute"
+name = "hinge"
+anc1 = "slider"
+anc2 = "lever"
+
+[analysis]
+type = "dynamic"
+t_end = 1.0
+steps = 50
+"""
+
+
+def test_pendulum_on_a_driven_slider_against_its_one_dof_equation():
+    law = Law("bezier_c2", [0.2, 0.7, 0.5, 0.9])
+    res = _run(pam2exu.loads(SLIDER))
+
+    def rhs(t, y):
+        xdd = law(np.array([t]))[2][0]
+        return [y[1], (M * D * math.sin(y[0]) * xdd - M * G * D * math.cos(y[0])) / IO]
+
+    ref = solve_ivp(rhs, (0, 1.0), [-1.2, 0.0], method="DOP853", rtol=1e-13, atol=1e-14,
+                    t_eval=res.t)
+    np.testing.assert_allclose(res["slider.x"], law(res.t)[0], atol=1e-12)
+    assert np.max(np.abs(res["lever.fi"] - ref.y[0])) <= 1e-8 * 3
+    assert np.max(np.abs(res["lever.Dfi"] - ref.y[1])) <= 1e-8 * 10
+
+
+def test_a_fully_driven_model_gives_the_kinetostatic_results():
+    path = pam2exu.__file__.replace("pam2exu/__init__.py", "examples/four_bar.toml")
+    res = _run(path, analysis="dynamic", steps=20)
+    ref = _run(path, analysis="kinetostatic", steps=20)
+    assert res.columns == ref.columns
+    np.testing.assert_array_equal(res.to_numpy(), ref.to_numpy())
+
+
+def test_a_free_motion_without_mass_is_an_error_naming_the_solids():
+    text = PENDULUM.replace(f"mass = {M}", "mass = 0.0").replace(f"inertia = {IG}",
+                                                                  "inertia = 0.0")
+    model = pam2exu.loads(text.replace("@FI@", "0.3").replace("@DFI@", "0.0")
+                          .replace("@DX@", "0.0"))
+    with pytest.raises(pam2exu.ModelError, match="free motion of the solids 'lever' moves no mass and no inertia"):
+        pam2exu.run(model)
+
+
+def test_the_natural_backend_refuses_free_solids_naming_them():
+    with pytest.raises(pam2exu.ModelError, match="natural backend cannot integrate.*'lever'"):
+        pam2exu.run(pendulum(0.3), backend="natural", t_end=0.1, steps=2)
+
+
+def test_a_ramp_jolts_the_pendulum_by_the_least_kinetic_energy_impulse():
+    """A ramp's velocity jumps by v = 0.8 m/s at t = 0.2 s and back at 0.7 s: the plastic
+    impulse of the contract changes θ̇ by m d sin θ Δẋ / I_O (the least (Δq̇)ᵀ M Δq̇ with the
+    slider's new velocity); the rows at 0.2 and 0.7 s report the values after the jump."""
+    res = _run(pam2exu.loads(SLIDER.replace('"bezier_c2"', '"ramp"')))
+    law = Law("ramp", [0.2, 0.7, 0.5, 0.9])
+    v = 0.8
+
+    def swing(t, y, xdd=0.0):
+        return [y[1], (M * D * math.sin(y[0]) * xdd - M * G * D * math.cos(y[0])) / IO]
+
+    y, t_eval = [-1.2, 0.0], res.t
+    ref = np.empty((2, len(t_eval)))
+    for a, b, jump in ((0.0, 0.2, v), (0.2, 0.7, -v), (0.7, 1.0, 0.0)):
+        rows = (t_eval >= a - 1e-12) & (t_eval <= b + 1e-12)
+        part = solve_ivp(swing, (a, b), y, method="DOP853", rtol=1e-13, atol=1e-14,
+                         dense_output=True)
+        ref[:, rows] = part.sol(np.clip(t_eval[rows], a, b))
+        y = part.sol(b)
+        y = [y[0], y[1] + M * D * math.sin(y[0]) * jump / IO]
+        after = np.nonzero(np.abs(t_eval - b) < 1e-12)[0]
+        ref[:, after] = np.array(y)[:, None]
+    np.testing.assert_allclose(res["slider.x"], law(res.t)[0], atol=1e-12)
+    np.testing.assert_allclose(res["slider.Dx"][10:35], v, atol=1e-12)   # 0.2 ≤ t < 0.7
+    assert np.max(np.abs(res["lever.fi"] - ref[0])) <= 3e-8
+    assert np.max(np.abs(res["lever.Dfi"] - ref[1])) <= 1e-7
