@@ -40,6 +40,10 @@ def _parser() -> argparse.ArgumentParser:
                             f"{DEFAULT_BACKEND})")
     run.add_argument("--t-end", type=float, metavar="T", help="end of the interval [s]")
     run.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
+    run.add_argument("--tolerance", type=float, metavar="TOL",
+                     help="dynamic: the time integration's error allowed per unit of each "
+                          "coordinate and rate (default: the model's [analysis] tolerance, "
+                          "else 1e-8)")
     run.add_argument("--outputs", nargs="+", metavar="PAT",
                      help="columns to keep: names, 'solid.*', '*.Fx' or bare 'Fx'")
     run.add_argument("-o", "--output", metavar="OUT.csv",
@@ -232,7 +236,8 @@ def _run(args) -> int:
             # columns, to which a plot may add opt-in ones (coupler.P.x)
             outputs = [*(outputs or ["*"]), *args.plot, *([args.x] if args.x else [])]
         res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
-                  outputs=outputs, solver=solver, backend=args.backend, angles=args.angles)
+                  outputs=outputs, solver=solver, backend=args.backend, angles=args.angles,
+                  tolerance=args.tolerance)
     table = res.select(args.outputs) if args.outputs and args.plot else res
     from .results.extremes import extremes_path, extremes_table, write_extremes
     extremes = extremes_table(table)             # a clearance run's, else ""

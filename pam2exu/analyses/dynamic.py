@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, SolverError
 from ..kinematics import State, pose
 from . import force_pass, native
 from .assembly import GUESS_STIFFNESS
@@ -146,37 +146,47 @@ def romberg(job: Job, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray):
     """((q, q̇) at ``times``, error estimate, steps of the finest run): runs with s, 2s, 4s …
     steps per interval, each pair extrapolated (R = y_h/2 + (y_h/2 − y_h)/3), until two
     successive R differ by at most (2^ORDER − 1) · tolerance · (1 + |R|) (their difference
-    over 2^ORDER − 1 estimates the error of the later one)."""
+    over 2^ORDER − 1 estimates the error of the later one). A run Exudyn cannot finish
+    (a step too long for its Newton iteration) starts the sequence again from twice its
+    steps."""
     n = len(times) - 1
     s = max(1, math.ceil(FIRST_STEPS / n))
-    runs = [_run(job, times, q0, qd0, s), _run(job, times, q0, qd0, 2 * s)]
-    best = None
+    runs, best = [], None
     while True:
-        coarse, fine = runs[-2], runs[-1]
-        R = tuple(b + (b - a) / 3.0 for a, b in zip(coarse, fine))
-        if best is not None:
-            estimate = max(float(np.max(np.abs(r - p) / (2 ** ORDER - 1) / (1.0 + np.abs(r))))
-                           for r, p in zip(R, best))
-            if estimate <= job.tolerance or 2 * s * n * 2 > MOST_STEPS:
-                return R, estimate, 2 * s * n
-        best = R
+        found = _run(job, times, q0, qd0, s, last=s * n * 2 > MOST_STEPS)
+        if found is None:                     # too long a step: start again, finer
+            runs, best = [], None
+            s *= 2
+            continue
+        runs.append(found)
+        if len(runs) >= 2:
+            coarse, fine = runs[-2], runs[-1]
+            R = tuple(b + (b - a) / 3.0 for a, b in zip(coarse, fine))
+            if best is not None:
+                estimate = max(float(np.max(np.abs(r - p) / (2 ** ORDER - 1)
+                                            / (1.0 + np.abs(r)))) for r, p in zip(R, best))
+                if estimate <= job.tolerance or s * n * 2 > MOST_STEPS:
+                    return R, estimate, s * n
+            best = R
         s *= 2
-        runs.append(_run(job, times, q0, qd0, 2 * s))
 
 
-def _run(job: Job, times, q0, qd0, substeps: int):
-    """(q, q̇) of one Exudyn run; SolverError naming the time where it stopped."""
-    from ..errors import SolverError
-    found = job.backend.integrate(job.mech, times, q0, qd0, substeps, verbose=job.solver.verbose)
-    if found.error is not None:
-        rows = ~np.isfinite(found.q).all(axis=1)
-        at = float(times[int(np.argmax(rows))]) if rows.any() else float(times[-1])
-        raise SolverError(
-            f"t={at:g}: Exudyn's dynamic solver failed ({found.error}) with "
-            f"{substeps} steps per interval of {times[1] - times[0]:g} s. The motion may "
-            "reach a singular position, or move too fast for the step: try more steps or a "
-            "shorter interval", time=at)
-    return found.q, found.qd
+def _run(job: Job, times, q0, qd0, substeps: int, last: bool):
+    """(q, q̇) of one Exudyn run, None if it failed; on the ``last`` run allowed, a
+    SolverError naming the time where it stopped."""
+    found = job.backend.integrate(job.mech, times, q0, qd0, substeps,
+                                  verbose=job.solver.verbose)
+    if found.error is None:
+        return found.q, found.qd
+    if not last:
+        return None
+    rows = ~np.isfinite(found.q).all(axis=1)
+    at = float(times[int(np.argmax(rows))]) if rows.any() else float(times[-1])
+    raise SolverError(
+        f"t={at:g}: Exudyn's dynamic solver failed ({found.error}) even with "
+        f"{substeps} steps per interval of {times[1] - times[0]:g} s. The motion may reach "
+        "a singular position where the mechanism locks or branches: check the model "
+        "there (pam2exu draw MODEL --t T), or end the interval before it", time=at)
 
 
 # ---- the native pass: consistent states, accelerations, impulses -----------------------

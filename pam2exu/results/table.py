@@ -281,9 +281,9 @@ class Results(Exports, Instants):
         Returns
         -------
         list of str
-            The constraint residual [m], Exudyn's multipliers against the native
-            equilibrium (quasi_static, relative), the power balance (kinetostatic, [W]);
-            only those in ``info``.
+            The constraint residual [m], Exudyn's multipliers against the native equilibrium
+            (quasi_static, relative), the power balance (kinetostatic, [W]), the reduced
+            stiffness (equilibrium), the integration error (dynamic); those in ``info``.
 
         Examples
         --------
@@ -299,6 +299,12 @@ class Results(Exports, Instants):
         if "power_balance_error" in info:
             out.append(f"power balance {info['power_balance_error']:.2g} W "
                        f"(finite-difference tolerance {info['power_balance_tolerance']:.2g} W)")
+        if "stiffness_eigenvalue" in info:
+            value = info["stiffness_eigenvalue"]
+            out.append(f"reduced stiffness {value:.3g} N/m ({'' if value > 0 else 'not '}stable)")
+        if "integration_error" in info:
+            out.append(f"integration error estimate {info['integration_error']:.1e} "
+                       f"(per unit of value, {info['integration_steps']} steps)")
         return out
 
     def __repr__(self) -> str:

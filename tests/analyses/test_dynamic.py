@@ -235,3 +235,28 @@ def test_a_ramp_jolts_the_pendulum_by_the_least_kinetic_energy_impulse():
     np.testing.assert_allclose(res["slider.Dx"][10:35], v, atol=1e-12)   # 0.2 ≤ t < 0.7
     assert np.max(np.abs(res["lever.fi"] - ref[0])) <= 3e-8
     assert np.max(np.abs(res["lever.Dfi"] - ref[1])) <= 1e-7
+
+
+def test_a_free_four_bar_keeps_its_energy():
+    """The four-bar of examples/equilibrium/spring_four_bar.toml let go from its motor's
+    pose (no damper, no torsor): T + V constant to the tolerance, T = ½ q̇ᵀ M q̇ and V of
+    gravity and the spring computed here from the result columns."""
+    path = pam2exu.__file__.replace("pam2exu/__init__.py",
+                                    "examples/equilibrium/spring_four_bar.toml")
+    model = pam2exu.load(path)
+    res = _run(model, analysis="dynamic", t_end=0.5, steps=25, tolerance=1e-8)
+    mech = model.mechanism()
+    energy = np.zeros(len(res))
+    for s in mech.solids:
+        x, y, fi = (res[f"{s.name}.{k}"] for k in ("x", "y", "fi"))
+        dx, dy, dfi = (res[f"{s.name}.D{k}"] for k in ("x", "y", "fi"))
+        gx, gy = s.cog
+        c, n = np.cos(fi), np.sin(fi)
+        vx = dx - dfi * (n * gx + c * gy)
+        vy = dy + dfi * (c * gx - n * gy)
+        energy += 0.5 * s.mass * (vx ** 2 + vy ** 2) + 0.5 * s.inertia * dfi ** 2
+        energy += s.mass * G * (y + n * gx + c * gy)
+    k, free = 400.0, 0.1
+    energy += 0.5 * k * (res["spring.ro"] - free) ** 2
+    assert np.ptp(energy) <= 1e-8 * (1 + abs(energy[0]))
+    assert np.ptp(res["crank.fi"]) > 0.5                     # it moved
