@@ -260,3 +260,48 @@ def test_a_free_four_bar_keeps_its_energy():
     energy += 0.5 * k * (res["spring.ro"] - free) ** 2
     assert np.ptp(energy) <= 1e-8 * (1 + abs(energy[0]))
     assert np.ptp(res["crank.fi"]) > 0.5                     # it moved
+
+
+def test_the_reactions_pass_the_free_body_checks():
+    """Each moving solid of the free four-bar, from the result columns alone: the revolute
+    forces (Fx, Fy: solid 1 on solid 2 at the joint, model-format.md), the spring's Força
+    (> 0 pulls P towards S) and the weight give m a_G and, about G, I_G θ̈."""
+    path = pam2exu.__file__.replace("pam2exu/__init__.py",
+                                    "examples/equilibrium/spring_four_bar.toml")
+    model = pam2exu.load(path)
+    res = _run(model, analysis="dynamic", t_end=0.3, steps=15, tolerance=1e-8)
+    solids = {s.name: s for s in model.mechanism().solids}
+
+    def at(name, local):
+        x, y, fi = (res[f"{name}.{k}"] for k in ("x", "y", "fi"))
+        c, s = np.cos(fi), np.sin(fi)
+        return np.array([x + c * local[0] - s * local[1], y + s * local[0] + c * local[1]])
+
+    def accel_G(name):
+        s = solids[name]
+        fi, w, a = (res[f"{name}.{k}"] for k in ("fi", "Dfi", "DDfi"))
+        c, n = np.cos(fi), np.sin(fi)
+        r = np.array([c * s.cog[0] - n * s.cog[1], n * s.cog[0] + c * s.cog[1]])
+        return (np.array([res[f"{name}.DDx"], res[f"{name}.DDy"]])
+                + a * np.array([-r[1], r[0]]) - w ** 2 * r)
+
+    def joint(name):
+        return np.array([res[f"{name}.Fx"], res[f"{name}.Fy"]])
+
+    P, S = at("coupler", solids["coupler"].points["P"]), np.array([[0.25], [-0.15]])
+    spring = res["spring.Força"] * (S - P) / np.linalg.norm(S - P, axis=0)  # on the coupler
+    loads = {   # name: [(force on the solid, where)]
+        "crank": [(joint("O2"), at("crank", (0.0, 0.0))), (-joint("A"), at("crank", (0.1, 0)))],
+        "coupler": [(joint("A"), at("coupler", (0.0, 0.0))),
+                    (-joint("B"), at("coupler", (0.35, 0.0))), (spring, P)],
+        "rocker": [(joint("B"), at("rocker", (0.3, 0.0))), (joint("O4"), at("rocker", (0, 0)))],
+    }
+    for name, forces in loads.items():
+        s = solids[name]
+        G_ = at(name, s.cog)
+        weight = np.array([np.zeros(len(res)), -s.mass * G * np.ones(len(res))])
+        total = sum(f for f, _ in forces) + weight
+        moment = sum((p - G_)[0] * f[1] - (p - G_)[1] * f[0] for f, p in forces)
+        scale = max(np.max(np.abs(f)) for f, _ in forces)
+        np.testing.assert_allclose(total, s.mass * accel_G(name), atol=1e-9 * scale)
+        np.testing.assert_allclose(moment, s.inertia * res[f"{name}.DDfi"], atol=1e-9 * scale * 0.4)
