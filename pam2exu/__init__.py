@@ -15,6 +15,7 @@ from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
 from .errors import (MobilityError, ModelError, OutputError, Pam2ExuError, SolverError,
                      TranslationError)
+from .analyses.energy import energy
 from .export import export
 from .errors import ConditionWarning, ConsistencyWarning, RedundancyWarning, VariationWarning
 from .model import Law, Model, Solid, load, loads
@@ -140,8 +141,8 @@ def run(model, analysis=None, **settings):
     return _run(model, analysis=analysis, **settings)
 
 
-__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "Results", "read_csv", "compare",
-           "Comparison", "verify", "Verification", "export", "plot", "draw", "animate",
+__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "Results", "read_csv",
+           "compare", "Comparison", "verify", "Verification", "export", "plot", "draw", "animate",
            "ELEMENTS", "Fixed", "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor",
            "Spring", "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError",
            "ModelError", "MobilityError", "SolverError", "TranslationError",

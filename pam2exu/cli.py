@@ -66,6 +66,9 @@ def _parser() -> argparse.ArgumentParser:
                      help="image file of --plot (default: <model>_plot.png)")
     run.add_argument("--x", metavar="VAR",
                      help="the x axis of --plot: a variable such as crank.fi (default t)")
+    run.add_argument("--energy", metavar="FIG.png",
+                     help="kinetostatic, dynamic: plot the energy account (kinetic, "
+                          "potential, work of actuators and torsors, dissipated, balance)")
     run.add_argument("--angles", choices=("rad", "deg"),
                      help="unit of the angular results: rad (rad/s, rad/s²) or deg (deg/s, "
                           "deg/s²); default: the model's [model] angles")
@@ -257,9 +260,21 @@ def _run(args) -> int:
         print(report(table, args.at, kinds_of(model)))
     if extremes:
         print(extremes)
-    if args.plot:
-        return _run_plot(args, res)
-    return 0
+    code = _run_plot(args, res) if args.plot else 0
+    return code or (_run_energy(args, model, res) if args.energy else 0)
+
+
+def _run_energy(args, model, res) -> int:
+    """``run --energy FIG``: the run's energy account (``analyses.energy``), plotted."""
+    from .analyses.energy import account
+    from .results.plot import plot
+    acc = account(model, res)
+    print(f"energy: largest |balance| {max(abs(acc['energy.balance'])):.2g} J")
+
+    def make():
+        plot(acc, None, args.energy)
+        return args.energy
+    return _picture("energy", make, args.debug)
 
 
 def _check_at(args, model) -> None:
