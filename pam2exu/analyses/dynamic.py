@@ -96,14 +96,12 @@ def motion(job: Job, q0: np.ndarray, qd0: np.ndarray):
                      if t[0] < b < t[-1]})
     breaks = [b for b in breaks if t[0] < b < t[-1]]
     q, qd = np.full((len(t), mech.nq), np.nan), np.full((len(t), mech.nq), np.nan)
+    q[0], qd[0] = q0, qd0
     worst, steps = 0.0, 0
     start, state = float(t[0]), (q0, qd0)
     for end in [*breaks, float(t[-1])]:
         inside = np.nonzero((t > start) & (t <= end))[0]
-        if start == float(t[0]):
-            q[0], qd[0] = state
-        pieces = _pieces(t, inside, start, end)
-        for times, rows in pieces:
+        for times, rows in _pieces(t, inside, start, end):
             found, estimate, n = romberg(job, times, *state)
             q[rows], qd[rows] = found[0][1:len(rows) + 1], found[1][1:len(rows) + 1]
             worst, steps = max(worst, estimate), max(steps, n)
