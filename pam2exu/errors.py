@@ -113,7 +113,7 @@ class MobilityError(ModelError):
 
     A ``ModelError`` (CLI exit code 2): the quasi_static, kinematic and kinetostatic analyses
     (and ``export``) need every degree of freedom driven by an actuator or a fixed link; the
-    assembly analysis accepts free degrees of freedom. The message names the solids that can
+    assembly, equilibrium and dynamic analyses accept free degrees of freedom. The message names the solids that can
     still move. (Constraints that contradict each other are found by the solver instead: a
     ``SolverError`` naming the constraints that cannot all hold.)
 

@@ -423,8 +423,9 @@ def require_driven(mech, mob: Mobility, analysis: str) -> None:
         f"{analysis} analysis",
         f"the mechanism has {mob.dof} free degree(s) of freedom that no actuator drives: "
         f"solid(s) {solids} can still move. Add an angular_actuator or linear_actuator "
-        f"(or a fixed link) for each free degree of freedom, or run an assembly analysis, "
-        f"which accepts free degrees of freedom."), mech.model.source)
+        f"(or a fixed link) for each free degree of freedom, or run an analysis that "
+        f"lets them go: assembly (the pose nearest the guess), equilibrium (at rest under "
+        f"the loads) or dynamic (in motion)."), mech.model.source)
 
 
 def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
