@@ -12,6 +12,9 @@ model's plain data). The tests (tests/analyses/) and the benchmark
   equations (``newton_euler``), the model as TOML (``model_toml``).
 - ``revolute``: Newton–Euler for mechanisms of revolute joints and angular motors
   (``revolute_newton_euler``, checked by its power balance).
+- ``andrews``: Andrews' squeezing mechanism, the IVP test set's published state at 0.03 s
+  and its equations integrated by DOP853 (tests/analyses/test_andrews.py,
+  benchmarks/dynamics.py).
 
 This package sits at the repository root and is not installed with pam2exu. pytest finds it
 through ``pythonpath = ["."]`` (pyproject.toml); benchmarks/speed_vs_error.py puts the
