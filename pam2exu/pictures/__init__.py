@@ -3,7 +3,10 @@
 Plots of result variables against time are ``pam2exu.results.plot``. The user guide is
 docs/pictures.md.
 """
-from .mechanism import Scene, animate, configurations, draw, pose
+from .animation import animate
+from .mechanism import draw
 from .pen import Pen
+from .poses import configurations, pose
+from .scene import Scene
 
 __all__ = ["draw", "animate", "configurations", "pose", "Scene", "Pen"]
