@@ -15,7 +15,6 @@ from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot
                        Revolute, Spring, Torsor, TorsionalSpring, Transmission)
 from .errors import (MobilityError, ModelError, OutputError, Pam2ExuError, SolverError,
                      TranslationError)
-from .analyses.energy import energy
 from .export import export
 from .errors import ConditionWarning, ConsistencyWarning, RedundancyWarning, VariationWarning
 from .model import Law, Model, Solid, load, loads
@@ -139,6 +138,45 @@ def run(model, analysis=None, **settings):
     """
     from .analyses import run as _run
     return _run(model, analysis=analysis, **settings)
+
+
+def energy(model, analysis=None, **settings):
+    """The energy account of a kinetostatic or dynamic run of a model; returns a Results
+    table of ``energy.kinetic``, ``energy.potential``, ``energy.actuators``,
+    ``energy.torsors``, ``energy.dissipated`` and ``energy.balance`` [J].
+
+    The works and the dissipation are counted from t = 0 (Simpson's rule over the rows);
+    ``balance`` = (T + V) − (T0 + V0) − the works + the dissipation is zero up to that
+    quadrature. ``pam2exu run MODEL --energy FIG.png`` plots it (docs/analyses.md).
+
+    Parameters
+    ----------
+    model : Model, str or Path
+        A model, or the path of a model file.
+    analysis : str, optional
+        ``'kinetostatic'`` or ``'dynamic'`` (default: the model's, which must be one).
+    **settings
+        ``run``'s keyword overrides (``t_end``, ``steps``, ``tolerance``, …).
+
+    Returns
+    -------
+    Results
+        One column per quantity, on the run's times.
+
+    Raises
+    ------
+    ModelError
+        The analysis gives no rates or forces (assembly, quasi_static, kinematic,
+        clearance, equilibrium), and ``run``'s errors.
+
+    Examples
+    --------
+    >>> account = pam2exu.energy("examples/slider_crank.toml")      # doctest: +SKIP
+    >>> float(abs(account["energy.balance"]).max()) < 1e-5             # doctest: +SKIP
+    True
+    """
+    from .analyses.energy import energy as _energy
+    return _energy(model, analysis, **settings)
 
 
 __all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "Results", "read_csv",
