@@ -120,7 +120,8 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         when = f"t = {t:g} s ({analysis} run)"
     else:
         mech, q = pose(model, t)
-        when = f"t = {t:g} s (kinematic run)" if t else "assembled at t = 0"
+        run_kind = "dynamic" if model.analysis.type == "dynamic" else "kinematic"
+        when = f"t = {t:g} s ({run_kind} run)" if t else "assembled at t = 0"
     lo, hi = extent(mech, q)
     mech_size = float(max(hi - lo)) or 1.0
     extra = []

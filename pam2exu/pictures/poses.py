@@ -1,7 +1,8 @@
 """The configurations a picture shows, taken from the analyses.
 
 ``configurations`` runs the assembly (one row at t = 0, free degrees of freedom allowed) or a
-kinematic run over [0, t_end] (Exudyn's static solver, on the branch the mechanism starts on)
+kinematic run over [0, t_end] (Exudyn's static solver, on the branch the mechanism starts on;
+a dynamic run for a model whose analysis is dynamic)
 and returns the mechanism, the times and x, y, fi of every solid; ``pose`` is one of them at
 a time t, with the model's step length so that it follows the same branch as ``run``. Both
 ask for radians whatever the model is written in. ``draw`` (``mechanism.py``) and
@@ -25,9 +26,10 @@ def _model(model):
 
 
 def configurations(model, t_end: float | None = None, steps: int | None = None,
-                   analysis: str = "kinematic") -> tuple[object, np.ndarray, np.ndarray]:
+                   analysis: str | None = None) -> tuple[object, np.ndarray, np.ndarray]:
     """(mechanism, t (n,), q (n, 3·solids)) of a run: the assembly (one row at t = 0), or
-    the positions of a kinematic run over [0, t_end] in ``steps`` intervals.
+    the positions of a kinematic run over [0, t_end] in ``steps`` intervals (a dynamic run
+    for a model whose analysis is ``dynamic``: its free solids move under the loads).
 
     Parameters
     ----------
@@ -37,9 +39,11 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
         End of the interval [s] (default: the model's t_end); not used by an assembly.
     steps : int, optional
         Number of intervals (default: the model's steps); not used by an assembly.
-    analysis : str
-        ``'kinematic'`` (default; needs every degree of freedom driven) or
-        ``'assembly'`` (t = 0 only; free degrees of freedom allowed).
+    analysis : str, optional
+        ``'kinematic'`` (needs every degree of freedom driven), ``'dynamic'`` (free degrees
+        of freedom move) or ``'assembly'`` (t = 0 only; free degrees of freedom allowed).
+        Default: ``'dynamic'`` for a model whose [analysis] type is dynamic, else
+        ``'kinematic'``.
 
     Returns
     -------
@@ -61,18 +65,20 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
     from ..analyses import run
     model = _model(model)
     mech = model.mechanism()
+    if analysis is None:
+        analysis = "dynamic" if model.analysis.type == "dynamic" else "kinematic"
     if analysis == "assembly":
         res = run(model, analysis="assembly", outputs=list(_POSE[:3]), angles="rad")
     else:
-        res = run(model, analysis="kinematic", t_end=t_end, steps=steps, outputs=list(_POSE),
+        res = run(model, analysis=analysis, t_end=t_end, steps=steps, outputs=list(_POSE),
                   angles="rad")
     q = np.column_stack([res[f"{s.name}.{k}"] for s in mech.solids for k in ("x", "y", "fi")])
     return mech, np.array(res.t), q
 
 
 def pose(model, t: float = 0.0):
-    """(mechanism, q) at time t: the assembly at t = 0, else a kinematic run from 0 to t
-    with the model's step length.
+    """(mechanism, q) at time t: the assembly at t = 0, else a kinematic run (dynamic, for a
+    dynamic model) from 0 to t with the model's step length.
 
     Parameters
     ----------

@@ -1,0 +1,40 @@
+"""Pictures of a dynamic model (issue 15 item 5): draw and animate let its free solids move.
+
+Reference: the dynamic run itself (pam2exu.run), whose positions at the drawn time the
+picture's pose must equal; a kinematic run of the same model is refused (a free degree of
+freedom), which is what draw and animate did before.
+"""
+import numpy as np
+import pytest
+
+import pam2exu
+from pam2exu.pictures import configurations, pose
+
+ROOT = pam2exu.__file__.replace("pam2exu/__init__.py", "")
+
+
+def _dynamic_four_bar():
+    text = open(ROOT + "examples/equilibrium/spring_four_bar.toml", encoding="utf-8").read()
+    return pam2exu.loads(text.replace('type = "equilibrium"',
+                                      'type = "dynamic"\nt_end = 0.2\nsteps = 10'))
+
+
+def test_the_pose_of_a_dynamic_model_is_its_dynamic_run():
+    model = _dynamic_four_bar()
+    res = pam2exu.run(model)
+    mech, q = pose(model, 0.2)
+    expected = [res[f"{s.name}.{k}"][-1] for s in mech.solids for k in ("x", "y", "fi")]
+    np.testing.assert_allclose(q, expected, atol=1e-12)
+    assert abs(q[5] - res["crank.fi"][0]) > 0.1                 # it fell
+    with pytest.raises(pam2exu.MobilityError):
+        configurations(model, analysis="kinematic")
+
+
+def test_animate_and_draw_a_dynamic_model(tmp_path):
+    model = _dynamic_four_bar()
+    mech, t, q = configurations(model)
+    assert len(t) == 11
+    pam2exu.animate(model, tmp_path / "fall.gif", steps=10)
+    assert (tmp_path / "fall.gif").stat().st_size > 1000
+    fig = pam2exu.draw(model, t=0.2, path=tmp_path / "fall.png")
+    assert "dynamic run" in fig.axes[0].get_title()
