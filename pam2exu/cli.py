@@ -154,6 +154,10 @@ def _parser() -> argparse.ArgumentParser:
     exp.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
     exp.add_argument("--forces", action="store_true",
                      help="include masses, gravity, springs and loads (same positions)")
+    exp.add_argument("-a", "--analysis", metavar="NAME", help="default: the model's [analysis] "
+                     "type; dynamic (a DOF free): the SolveDynamic script")
+    exp.add_argument("--tolerance", type=float, metavar="TOL",
+                     help="the dynamic analysis's tolerance (default: the model's)")
 
     _picture_parsers(sub)
     return p
@@ -461,7 +465,7 @@ def _animate(args) -> int:
 def _export(args) -> int:
     from .export import export
     path = export(args.model, args.output, t_end=args.t_end, steps=args.steps,
-                  forces=args.forces)
+                  forces=args.forces, analysis=args.analysis, tolerance=args.tolerance)
     print(f"wrote {path}; run it with: python {path} [OUT.csv]")
     return 0
 

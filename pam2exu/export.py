@@ -14,38 +14,9 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
+from .law_code import LAW_CODE
+
 __all__ = ["LAW_CODE", "export", "script"]
-
-
-def _transition(name: str, shape: str, doc: str) -> str:
-    return f'''def {name}(t, C1, C2, C3, C4):
-    """f = C3 + (C4 - C3) s(u), s(u) = {doc}, u = (t - C1)/(C2 - C1)
-    on C1 <= t < C2; C3 before C1, C4 from C2 on."""
-    if t < C1:
-        return C3
-    if t >= C2:
-        return C4
-    u = (t - C1) / (C2 - C1)
-    return C3 + (C4 - C3) * {shape}
-'''
-
-
-#: law name -> its definition in the script, a function of t and C1 ... C4 (the formulas of
-#: pam2exu.laws, as a reader would write them)
-LAW_CODE = {
-    "polynomial": '''def polynomial(t, C1, C2, C3, C4):
-    """f = C1 + C2 t + C3 t^2 + C4 t^3."""
-    return C1 + t * (C2 + t * (C3 + t * C4))
-''',
-    "harmonic": '''def harmonic(t, C1, C2, C3, C4):
-    """f = C1 + C2 cos(C3 t + C4)."""
-    return C1 + C2 * np.cos(C3 * t + C4)
-''',
-    "ramp": _transition("ramp", "u", "u"),
-    "bezier_c1": _transition("bezier_c1", "(u * u * (3.0 - 2.0 * u))", "3u^2 - 2u^3"),
-    "bezier_c2": _transition("bezier_c2", "(u * u * u * (10.0 + u * (-15.0 + 6.0 * u)))",
-                             "6u^5 - 15u^4 + 10u^3"),
-}
 
 #: why the script sets a solver option (a comment after it)
 _OPTION_NOTES = {
@@ -144,7 +115,8 @@ sys.exit(0 if solved == steps + 1 else 1)
 
 
 def script(model, t_end: float | None = None, steps: int | None = None,
-           forces: bool = False, file: str = "script.py") -> str:
+           forces: bool = False, file: str = "script.py", analysis: str | None = None,
+           tolerance: float | None = None) -> str:
     """The source of the standalone Exudyn script of a model (see ``export``).
 
     Parameters
@@ -160,6 +132,14 @@ def script(model, t_end: float | None = None, steps: int | None = None,
     file : str
         The script's file name, used in its docstring and for its default CSV file
         (``<stem>.csv``).
+    analysis : str, optional
+        The analysis whose positions the script gives (default: the model's [analysis]
+        type). ``'dynamic'`` (``dinamica``) with a degree of freedom free: the forward
+        dynamics script (``export_dynamic``; ``forces`` does not apply, the masses and
+        forces are always in); any other, or a fully driven model: the positions by
+        Exudyn's static solver.
+    tolerance : float, optional
+        The dynamic analysis's tolerance (default: the model's [analysis] tolerance).
 
     Returns
     -------
@@ -196,6 +176,11 @@ def script(model, t_end: float | None = None, steps: int | None = None,
     from .backend.script import ScriptSystem, code
     from .backend.system import SolveSettings, solver_options
 
+    if _analysis(model, analysis) == "dynamic":
+        from .export_dynamic import dynamic_script
+        source = dynamic_script(model, t_end, steps, file, tolerance)
+        if source is not None:
+            return source                 # else fully driven: the kinematic positions
     # the job and the checks of a kinematic run: same interval, same mobility errors
     job = prepare(model, "kinematic", t_end, steps, ["*.x", "*.y", "*.fi"])
     # the user's times (a run solves long steps in sub-steps, the script does not)
@@ -210,6 +195,20 @@ def script(model, t_end: float | None = None, steps: int | None = None,
                 + f"simulationSettings.{path} = {code(value)}"
                 for path, value in options.items()))
             + _results(mech, system))
+
+
+def _analysis(model, analysis: str | None) -> str:
+    """The analysis's name (an alias resolved): ``analysis``, else the model's type."""
+    from . import registry
+    from .model import Model, load
+    if analysis is None:
+        analysis = (model if isinstance(model, Model) else load(model)).analysis.type
+    kind = registry.analysis_type(analysis)
+    if kind is None:
+        from .errors import ModelError
+        raise ModelError(f"unknown analysis {analysis!r}: known are "
+                         + ", ".join(registry.ANALYSES))
+    return kind.name
 
 
 def _header(mech, system, times, forces: bool, file: str) -> str:
@@ -277,7 +276,8 @@ def _fill(opening: str, entries: list[str], closing: str) -> str:
 
 
 def export(model, path, t_end: float | None = None, steps: int | None = None,
-           forces: bool = False) -> Path:
+           forces: bool = False, analysis: str | None = None,
+           tolerance: float | None = None) -> Path:
     """Write a model as a standalone Exudyn script; returns its path.
 
     The script (imports: ``exudyn``, ``numpy``) builds the Exudyn system pam2exu builds, one
@@ -300,6 +300,12 @@ def export(model, path, t_end: float | None = None, steps: int | None = None,
     forces : bool
         Include masses, gravity, springs, dampers' stiffness and loads (the system of the
         quasi-static analysis); positions are the same, the constraints alone decide them.
+    analysis : str, optional
+        Default: the model's [analysis] type. ``'dynamic'`` with a degree of freedom left
+        free writes the forward-dynamics script instead (docs/export.md, "Dynamic models"):
+        Exudyn's SolveDynamic with the step count of the analysis, Richardson-extrapolated.
+    tolerance : float, optional
+        The dynamic analysis's tolerance (default: the model's [analysis] tolerance).
 
     Returns
     -------
@@ -326,5 +332,6 @@ def export(model, path, t_end: float | None = None, steps: int | None = None,
     solid; they equal ``pam2exu.run(model, analysis="kinematic")`` to round-off.
     """
     path = Path(path)
-    path.write_text(script(model, t_end, steps, forces, file=path.name), encoding="utf-8")
+    path.write_text(script(model, t_end, steps, forces, file=path.name, analysis=analysis,
+                           tolerance=tolerance), encoding="utf-8")
     return path

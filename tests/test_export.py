@@ -80,8 +80,10 @@ def test_script_of_a_redundant_mechanism(data, tmp_path):
     assert max_difference(header, rows, res) <= 1e-10
 
 
-def test_script_imports_only_exudyn_numpy_and_the_standard_library(examples):
-    tree = ast.parse(script(examples / "all_elements.toml", forces=True))
+def check_imports(source: str) -> None:
+    """The script imports exudyn, numpy and the standard library only, and its code (its
+    docstring and comments aside) never names pam2exu."""
+    tree = ast.parse(source)
     modules = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -95,6 +97,10 @@ def test_script_imports_only_exudyn_numpy_and_the_standard_library(examples):
     assert "exported by pam2exu" in docstring.value.value
     assert "pam2exu" not in ast.unparse(tree)          # the code, without comments
     assert "pickle" not in modules
+
+
+def test_script_imports_only_exudyn_numpy_and_the_standard_library(examples):
+    check_imports(script(examples / "all_elements.toml", forces=True))
 
 
 @pytest.mark.parametrize("forces", [False, True], ids=["constraints", "forces"])

@@ -37,6 +37,25 @@ class Trajectory:
     error: str | None = None
 
 
+def settings(mech, start: float, end: float, steps: int, verbose: int = 0) -> dict:
+    """The SimulationSettings of one run, {dotted path: value} (the exported dynamic
+    script writes the same ones, ``export_dynamic``)."""
+    return {
+        "solution.file.write": False,
+        "solution.sensors.writePeriod": 0.0,       # every step: rows picked by index
+        "timeIntegration.startTime": start,
+        "timeIntegration.endTime": end,
+        "timeIntegration.numberOfSteps": steps,
+        "timeIntegration.verboseMode": verbose,
+        "timeIntegration.newton.relativeTolerance": 1e-12,
+        "timeIntegration.newton.absoluteTolerance": 1e-14 * max(1.0, mech.scale()),
+        "timeIntegration.newton.useModifiedNewton": False,
+        "timeIntegration.adaptiveStep": False,
+        "timeIntegration.generalizedAlpha.spectralRadius": SPECTRAL_RADIUS,
+        "linearSolver.solverType": exu.LinearSolverType.EigenDense,
+    }
+
+
 def integrate(mech, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray, substeps: int,
               verbose: int = 0) -> Trajectory:
     """x, y, fi and their rates at ``times`` (equally spaced, times[0] the start), by
@@ -56,18 +75,13 @@ def integrate(mech, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray, substeps
         for i, node in enumerate(system.nodes) if node is not None}
     mbs.Assemble()
     ss = exu.SimulationSettings()
-    ss.solution.file.write = False
-    ss.solution.sensors.writePeriod = 0.0          # every step: rows picked by index below
-    ss.timeIntegration.startTime = float(times[0])
-    ss.timeIntegration.endTime = float(times[-1])
-    ss.timeIntegration.numberOfSteps = (n - 1) * substeps
-    ss.timeIntegration.verboseMode = verbose
-    ss.timeIntegration.newton.relativeTolerance = 1e-12
-    ss.timeIntegration.newton.absoluteTolerance = 1e-14 * max(1.0, mech.scale())
-    ss.timeIntegration.newton.useModifiedNewton = False
-    ss.timeIntegration.adaptiveStep = False
-    ss.timeIntegration.generalizedAlpha.spectralRadius = SPECTRAL_RADIUS
-    ss.linearSolver.solverType = exu.LinearSolverType.EigenDense
+    for path, value in settings(mech, float(times[0]), float(times[-1]),
+                                (n - 1) * substeps, verbose).items():
+        *parents, leaf = path.split(".")
+        target = ss
+        for name in parents:
+            target = getattr(target, name)
+        setattr(target, leaf, value)
     error = None
     exu.config.printToConsole = verbose > 0
     try:
@@ -104,6 +118,13 @@ def _rows(out: np.ndarray, data, solid: int, times: np.ndarray, substeps: int) -
     out[rows, pose(solid)] = picked[rows, 1:4]
 
 
+def _offset(law, shift: float):
+    """f(t) + shift as an offset user function (Exudyn checks its four arguments)."""
+    def offset(mbs, t, itemNumber, lOffset):
+        return law(t, xp=SymbolicNamespace)[0] + shift
+    return offset
+
+
 def _drive(system: ExudynSystem, t0: float) -> list:
     """Make every actuator follow its law at the integrator's time; returns what must be
     kept alive while it runs (the compiled functions)."""
@@ -114,11 +135,8 @@ def _drive(system: ExudynSystem, t0: float) -> list:
         if parameter != "offset":
             stepped.append((obj, parameter, law, shift))
             continue
-
-        def offset(mbs, t, itemNumber, lOffset, law=law, shift=shift):
-            return law(t, xp=SymbolicNamespace)[0] + shift
-
-        function = CreateSymbolicUserFunction(mbs, offset, "offsetUserFunction", obj)
+        function = CreateSymbolicUserFunction(mbs, _offset(law, shift), "offsetUserFunction",
+                                              obj)
         mbs.SetObjectParameter(obj, "offsetUserFunction", function)
         keep.append(function)
     if stepped:

@@ -143,13 +143,16 @@ class ScriptSystem(ExudynSystem):
 
     items = RecordingItems()
 
-    def __init__(self, mech, forces: bool = False):
+    def __init__(self, mech, forces: bool = False, **options):
+        """``options``: ExudynSystem's others (velocity_forces False unless given; a
+        time integration's ``start``, ``start_rates`` and ``ground_fixed``)."""
         self.blocks: list[tuple[list[str], list[str]]] = []
         self.driver_owners: list = []
         self.used: set[str] = set()
         self.kinds: set[str] = set()
         self._owner, self._hint = None, None
-        super().__init__(mech, forces=forces, velocity_forces=False)
+        self.integrated = options.get("start_rates") is not None
+        super().__init__(mech, forces=forces, **{"velocity_forces": False, **options})
 
     def new_system(self):
         return RecordingSystem(self)
@@ -179,6 +182,10 @@ class ScriptSystem(ExudynSystem):
                               if el.grounds and el.ref1.solid == i)
                 lines.append(f"#     held by the fixed link '{holder}': Exudyn ground at "
                              "this pose")
+            elif self.integrated:
+                lines.append("#     node coordinates are PAM's x, y, fi (reference 0); initial "
+                             "values: the assembly at t = 0 and the nearest consistent "
+                             "velocities, computed by pam2exu's dynamic analysis")
             else:
                 lines.append("#     node coordinates are PAM's x, y, fi (reference 0, initial "
                              "values the initial guess)")
