@@ -845,6 +845,32 @@ def _mass_formula_section() -> list[str]:
              "the equations of motion pair it with Φ_z."), ""]
 
 
+DYNAMICS = """\
+## Forward dynamics in natural coordinates
+
+The `dynamic` analysis on this backend (`--backend natural`,
+`pam2exu/backend/natural/dynamics.py`) integrates the equations of motion with the constant
+M above:
+
+```text
+M z̈ + Φ_zᵀ μ = Q(z, ż, t),   Φ(z, t) = 0
+[M   Φ_zᵀ] [z̈]   [Q]
+[Φ_z  0  ] [μ] = [γ]          (index 1: Φ_z z̈ = γ, the γ of the table above)
+```
+
+Q is the virtual work of the loads on z: a force F at the point s of a solid is (F, a F −
+b Ω F) on its base point and base vector, a moment M is M Ω v / |v|² on v (`Loads`), so
+Q_z = Σ Pᵀ Q_p + Vᵀ Q_v; gravity acts at fixed (a, b) and is a constant vector, the springs
+and dampers are evaluated at each state (a damper's rate from ż). scipy's DOP853 integrates
+y = (z, ż) (Radau if a run would take more than 20,000 steps: a stiff model). Index 1 alone
+lets the constraints drift, so after every accepted step, and at every output time (from the
+method's dense output), the state is projected back onto Φ = 0 (least-norm Gauss–Newton) and
+Φ_z ż = g′. The accuracy is on demand: runs at rtol = atol = 0.1 · tolerance, then 16 times
+smaller, until two successive runs differ by at most tolerance · (1 + |value|) on every
+x, y, fi and rate; the finer one is kept. The analysis does the rest (law breakpoints'
+impulses, accelerations, reactions), as for Exudyn, so `pam2exu verify MODEL -a dynamic`
+compares two independent integrations (rule in [verify.md](verify.md))."""
+
 VERIFY = """\
 ## Reading `pam2exu verify`
 
@@ -914,6 +940,7 @@ def render(w: Worked | None = None) -> str:
     out += _gamma_section()
     out += _pose_section(w)
     out += _mass_formula_section()
+    out += [DYNAMICS, ""]
     out += [VERIFY, ""]
     out += [SIDE.format(m=w.mech.n_equations, nq=w.mech.nq, nz=w.form.nz), ""]
     text = "\n".join(out)

@@ -12,6 +12,13 @@ forces err by about κ·δ: ``analyses.branch`` warns with κ²·tol). S_u is th
 variable's unit: L for lengths and 1 for angles (Newton's tolerance is absolute); for the
 other units the largest value of its family in either run (m/s with rad/s × L, N with
 N·m / L, …), accelerations at least ω²·L (ω the largest angular velocity; rad/s² ≥ ω²).
+
+A ``dynamic`` run is two time integrations, each within its tolerance T
+(``[analysis] tolerance``) of the exact motion per unit of value: their difference is
+allowed, besides, INTEGRATION · T · (1 + S), S the column's own scale for positions and
+rates (the promise is per coordinate and rate) and its unit's S_u for accelerations and
+forces (computed from them by the equations of motion: an error there is a share of the
+largest values of its kind, as in the rest of the rule).
 """
 from __future__ import annotations
 
@@ -41,6 +48,8 @@ UNITS = {"m": ("position", 1), "rad": ("position", 0), "m/s": ("velocity", 1),
 POWERS = {"position": 1, "velocity": 2, "acceleration": 2, "force": 2}
 #: condition numbers are computed at most at this many rows of each run
 SAMPLES = 400
+#: a dynamic run: the margin over the two integrations' tolerance T (each within T)
+INTEGRATION = 10.0
 
 
 @dataclass(frozen=True)
@@ -48,7 +57,9 @@ class Rule:
     """The tolerance of a verification: a variable of unit u agrees when its largest
     difference is at most rtol_p · S_u, rtol_p = max(FLOOR, SAFETY · max(tolerances) · κ^p),
     p = 1 for positions and 2 for the rest; S_u = L for m, 1 for rad, else the family's
-    scale times L^k (docs/verify.md).
+    scale times L^k (docs/verify.md). A dynamic run allows at least INTEGRATION · T ·
+    (1 + S), T its integration tolerance, S the variable's scale for positions and rates
+    and S_u for accelerations and forces.
 
     Attributes
     ----------
@@ -61,12 +72,15 @@ class Rule:
     scales : dict
         Family (``position``, ``velocity``, …) → its scale per unit of L^k [SI unit / m^k]:
         1 for positions, else the largest |value| of the family in either run.
+    integration : float
+        T, the integration tolerance of a ``dynamic`` run (0 for the other analyses) [–].
     """
 
     tolerances: dict
     condition: float
     length: float
     scales: dict
+    integration: float = 0.0
 
     def rtol(self, family: str) -> float:
         """The relative tolerance of a family: max(FLOOR, SAFETY · max(tolerances) · κ^p).
@@ -119,8 +133,14 @@ class Rule:
             The tolerance [unit].
         """
         if unit not in UNITS:
-            return self.rtol("force") * scale
-        return self.rtol(UNITS[unit][0]) * self.scale(unit)
+            static = self.rtol("force") * scale
+        else:
+            static = self.rtol(UNITS[unit][0]) * self.scale(unit)
+        if not self.integration:
+            return static
+        family = UNITS.get(unit, ("force", 0))[0]
+        size = scale if family in ("position", "velocity") else self.scale(unit)
+        return max(static, INTEGRATION * self.integration * (1.0 + size))
 
     def lines(self) -> list[str]:
         """The rule's numbers, one line each, for the header of the table.
@@ -134,12 +154,16 @@ class Rule:
         families = ", ".join(f"{f} {self.rtol(f):.2g}" for f in POWERS)
         units = ", ".join(f"{u} {self.scale(u):.3g}" for u in UNITS
                           if self.scales.get(UNITS[u][0]))
+        dynamic = [f"two time integrations, each within T = {self.integration:g} per unit of "
+                   f"value: at least {INTEGRATION:g} · T · (1 + S), S the variable's own "
+                   "scale for positions and rates, its unit's for accelerations and forces"
+                   ] if self.integration else []
         return [f"solver tolerances (relative to L = {self.length:g} m): {tols}; worst "
                 f"condition number κ = {self.condition:.3g}",
                 f"rtol = max({FLOOR:g}, {SAFETY:g} · {max(self.tolerances.values()):g} · κ^p), "
                 f"p = 1 for positions, 2 otherwise: {families}",
                 f"a variable agrees when max |difference| ≤ rtol · S, S the scale of its unit: "
-                f"{units}"]
+                f"{units}", *dynamic]
 
 
 @dataclass
@@ -218,7 +242,7 @@ class Verification:
 
 
 def verify(model, analysis=None, steps=None, t_end=None, backends=BACKENDS_COMPARED,
-           outputs=None, solvers=None) -> Verification:
+           outputs=None, solvers=None, tolerance=None) -> Verification:
     """Run one analysis of a model on two backends and compare them variable by variable.
 
     The first backend's run is the reference. A variable agrees when its largest difference
@@ -242,6 +266,9 @@ def verify(model, analysis=None, steps=None, t_end=None, backends=BACKENDS_COMPA
         Names or patterns of the columns to compare (default: every column).
     solvers : dict, optional
         Backend name → its settings (``Settings`` of the backend); default: its defaults.
+    tolerance : float, optional
+        The integration tolerance of a ``dynamic`` analysis (default: the model's); the
+        rule then allows ``INTEGRATION`` · tolerance · (1 + S).
 
     Returns
     -------
@@ -273,10 +300,13 @@ def verify(model, analysis=None, steps=None, t_end=None, backends=BACKENDS_COMPA
         model = load(model)
     solvers = {b: (solvers or {}).get(b) or BACKENDS[b].create().Settings() for b in backends}
     runs = [_run(model, b, solvers[b], analysis=analysis, steps=steps, t_end=t_end,
-                 outputs=outputs) for b in backends]
+                 outputs=outputs, tolerance=tolerance) for b in backends]
     mech = model.mechanism()
+    dynamic = runs[0].info.get("integration_error") is not None
     rule = Rule({b: float(solvers[b].tolerance) for b in backends},
-                max(_condition(mech, r) for r in runs), mech.scale(), _scales(runs, mech.scale()))
+                max(_condition(mech, r) for r in runs), mech.scale(), _scales(runs, mech.scale()),
+                float(tolerance if tolerance is not None else model.analysis.tolerance)
+                if dynamic else 0.0)
     return Verification(backends, runs[0], runs[1], rule, agreement(runs[1], runs[0], rule,
                                                                      backends))
 

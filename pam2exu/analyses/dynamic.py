@@ -17,6 +17,9 @@ size), the accelerations and multipliers come from the equations of motion
 
 and the reactions from the same formulas as ``kinetostatic`` (``force_pass.over_time``),
 so every row satisfies every solid's Newton–Euler equations.
+
+A backend with its own adaptive integrator (``Backend.motion``: the natural backend's, in
+natural coordinates) replaces the Romberg sequence; the rest is the same.
 """
 from __future__ import annotations
 
@@ -59,7 +62,7 @@ def dynamic(job: Job):
     mob = check_mobility(job, mech.initial_q(), need_driven=False)
     if mob.dof == 0:
         return kinetostatic(job)
-    if not job.backend.moves_free_solids:
+    if not getattr(job.backend, "integrates", False):
         raise ModelError(
             f"the {job.backend.name} backend cannot integrate the motion of free solids "
             f"({', '.join(repr(n) for n in mob.free_solids)}): run the dynamic analysis on "
@@ -68,7 +71,7 @@ def dynamic(job: Job):
     q0 = assemble(job, redundant, GUESS_STIFFNESS)
     require_inertia(mech, float(t[0]), q0)
     qd0 = nearest_velocities(mech, float(t[0]), q0, mech.initial_qd())
-    job.stage = "integrating the equations of motion with Exudyn's dynamic solver"
+    job.stage = f"integrating the equations of motion ({job.backend.label})"
     q, qd = motion(job, q0, qd0)
     job.stage = "projecting the integrated states onto the constraints"
     q, qd = project(mech, t, q, qd)
@@ -116,8 +119,10 @@ def motion(job: Job, q0: np.ndarray, qd0: np.ndarray):
     job.info["integration_steps"] = steps
     if worst > job.tolerance:
         warn(job, f"the time integration reached an error estimate of {worst:.2g} per unit "
-                  f"of value, not the tolerance {job.tolerance:g}: Exudyn's generalized-α "
-                  f"would need more than {MOST_STEPS:,} steps here. Ask for a looser "
+                  f"of value, not the tolerance {job.tolerance:g}: "
+                  + (f"{job.backend.label} cannot integrate more accurately here"
+                     if hasattr(job.backend, "motion") else "Exudyn's generalized-α would "
+                     f"need more than {MOST_STEPS:,} steps here") + ". Ask for a looser "
                   "tolerance, or a shorter interval", AccuracyWarning)
     return q, qd
 
@@ -146,7 +151,12 @@ def romberg(job: Job, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray):
     successive R differ by at most (2^ORDER − 1) · tolerance · (1 + |R|) (their difference
     over 2^ORDER − 1 estimates the error of the later one). A run Exudyn cannot finish
     (a step too long for its Newton iteration) starts the sequence again from twice its
-    steps."""
+    steps. A backend with its own adaptive integrator (``Backend.motion``) meets the
+    tolerance itself."""
+    if hasattr(job.backend, "motion"):
+        q, qd, estimate, steps = job.backend.motion(job.mech, times, q0, qd0, job.tolerance,
+                                                    verbose=job.solver.verbose)
+        return (q, qd), estimate, steps
     n = len(times) - 1
     s = max(1, math.ceil(FIRST_STEPS / n))
     runs, best = [], None

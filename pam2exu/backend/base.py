@@ -70,8 +70,17 @@ class Backend(Protocol):
     moves_free_solids : bool
         ``solve_positions(..., forces=True)`` moves the free degrees of freedom to a static
         equilibrium (the ``equilibrium`` analysis needs it; otherwise it only gives the
-        multipliers at positions the constraints fix), and ``integrate(mech, times, q0,
-        qd0, substeps, verbose)`` integrates the equations of motion (``dynamic``).
+        multipliers at positions the constraints fix).
+    integrates : bool
+        It integrates the equations of motion (``dynamic``), by one of two methods:
+        ``integrate(mech, times, q0, qd0, substeps, verbose)`` with a fixed step
+        (``substeps`` equal steps per interval of the equally spaced ``times``; a
+        ``Trajectory`` of q, q̇; the analysis refines it by Romberg), or, when the backend
+        has it, ``motion(mech, times, q0, qd0, tolerance, verbose) -> (q, qd, estimate,
+        steps)``: an adaptive integrator that meets ``tolerance`` · (1 + |value|) on every
+        x, y, fi and rate itself; q, qd (len(times), nq) at ``times`` (the first row the
+        start), ``estimate`` the error estimate reached per unit of value, ``steps`` the
+        steps of its finest run.
     """
 
     name: ClassVar[str]
@@ -80,6 +89,7 @@ class Backend(Protocol):
     Settings: ClassVar[type]
     gives_rates: ClassVar[bool]
     moves_free_solids: ClassVar[bool]
+    integrates: ClassVar[bool]
 
     def solve_positions(self, mech, times: np.ndarray, start: np.ndarray, settings, *,
                         redundant: bool = False, forces: bool = False,

@@ -15,6 +15,7 @@ class Exudyn:
     Settings = SolveSettings
     gives_rates = False
     moves_free_solids = True
+    integrates = True
 
     def solve_positions(self, mech, times, start, settings, *, redundant=False, forces=False,
                         anchor_stiffness=0.0, rates=False) -> Positions:

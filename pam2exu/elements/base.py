@@ -302,7 +302,8 @@ class Element:
     def natural_loads(self, nl) -> None:
         """Apply this element's forces, computed from natural coordinates, to ``nl`` (a
         ``backend.natural.loads.Loads``: ``nl.point``, ``nl.direction``, ``nl.angle`` give
-        where things are, ``nl.force`` and ``nl.moment`` apply). Constraint elements: none."""
+        where things are, ``nl.point_rate`` and ``nl.angle_rate`` how fast they move (zero
+        at rest), ``nl.force`` and ``nl.moment`` apply). Constraint elements: none."""
 
     # ---- pictures ----------------------------------------------------------------------
     def draw(self, pen, st: State) -> None:

@@ -180,12 +180,16 @@ class Spring(_SpringDamper):
             markerNumbers=markers, springForceUserFunction=law))
 
     def natural_loads(self, nl):
-        """F = C1 + C2 (ro − C3) pulls P towards Q and Q towards P (no damper: static)."""
-        c1, c2, c3, _ = constants(self.C)
+        """F = C1 + C2 (ro − C3) + C4 Dro pulls P towards Q and Q towards P (Dro = 0 at
+        rest: the static check)."""
+        c1, c2, c3, c4 = constants(self.C)
         P, Q = (nl.point(r.solid, r.local) for r in self.refs)
         gap = Q - P
         ro = np.hypot(gap[:, 0], gap[:, 1])
-        pull = ((c1 + c2 * (ro - c3)) / ro)[:, None] * gap
+        rate = nl.point_rate(self.ref2.solid, self.ref2.local) - \
+            nl.point_rate(self.ref1.solid, self.ref1.local)
+        dro = np.sum(gap * rate, axis=1) / ro
+        pull = ((c1 + c2 * (ro - c3) + c4 * dro) / ro)[:, None] * gap
         nl.force(self.ref1.solid, self.ref1.local, pull)
         nl.force(self.ref2.solid, self.ref2.local, -pull)
 
@@ -232,10 +236,12 @@ class TorsionalSpring(_SpringDamper):
                     kind="load")
 
     def natural_loads(self, nl):
-        """Parell = C1 + C2 (fi2 − fi1 − C3): counter-clockwise on solid 1, clockwise on 2."""
-        c1, c2, c3, _ = constants(self.C)
+        """Parell = C1 + C2 (fi2 − fi1 − C3) + C4 (Dfi2 − Dfi1): counter-clockwise on solid 1,
+        clockwise on 2 (the rates are zero at rest: the static check)."""
+        c1, c2, c3, c4 = constants(self.C)
         s1, s2 = (r.solid for r in self.refs)
-        torque_ = c1 + c2 * (nl.angle(s2) - nl.angle(s1) - c3)
+        torque_ = c1 + c2 * (nl.angle(s2) - nl.angle(s1) - c3) + \
+            c4 * (nl.angle_rate(s2) - nl.angle_rate(s1))
         nl.moment(s1, torque_)
         nl.moment(s2, -torque_)
 

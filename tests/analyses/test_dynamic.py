@@ -204,11 +204,6 @@ def test_a_free_motion_without_mass_is_an_error_naming_the_solids():
         pam2exu.run(model)
 
 
-def test_the_natural_backend_refuses_free_solids_naming_them():
-    with pytest.raises(pam2exu.ModelError, match="natural backend cannot integrate.*'lever'"):
-        pam2exu.run(pendulum(0.3), backend="natural", t_end=0.1, steps=2)
-
-
 @pytest.mark.parametrize("C1, C2", [(0.2, 0.7), (0.215, 0.705)])    # on rows, between rows
 def test_a_ramp_jolts_the_pendulum_by_the_least_kinetic_energy_impulse(C1, C2):
     """A ramp's velocity jumps by v at C1 and back at C2: the plastic impulse of the

@@ -18,6 +18,7 @@ from ...errors import SolverError
 from ...kinematics import ANGLES, PER_SOLID, column
 from ..base import Positions
 from .formulation import Coordinate, Formulation, Frame
+from .dynamics import motion
 from .loads import multipliers
 from .anchored import anchored
 from .solver import MAX_SUBSTEPS, NaturalSettings, Solver
@@ -34,7 +35,9 @@ class Natural:
     Settings = NaturalSettings
     #: it can return velocities and accelerations with the positions
     gives_rates = True
+    #: no static equilibrium of free solids; their motion: ``motion`` (``dynamics``)
     moves_free_solids = False
+    integrates = True
 
     def __init__(self):
         self._forms: dict = {}
@@ -120,6 +123,11 @@ class Natural:
             k = int(np.argmax(phi))
             text += f" (largest natural-coordinate residual {phi[k]:.3g}, {form.labels[k]})"
         return text
+
+    def motion(self, mech, times, q0, qd0, tolerance, verbose=0):
+        """See ``Backend.motion``: M z̈ + Φ_zᵀ μ = Q, Φ = 0 at index 1, integrated by
+        DOP853 (Radau if stiff) with projections, to the tolerance (``dynamics.motion``)."""
+        return motion(self, self.formulation(mech), mech, times, q0, qd0, tolerance, verbose)
 
     # ---- back to x, y, fi ---------------------------------------------------------------------
     def to_q(self, form: Formulation, mech, z: np.ndarray, start: np.ndarray) -> np.ndarray:

@@ -349,6 +349,19 @@ class Formulation:
             M += m * P.T @ P + m * (P.T @ G + G.T @ P) + jp / (f.d[0] ** 2 + f.d[1] ** 2) * V.T @ V
         return M
 
+    def affine(self, solid: int, local, kind: str = "point") -> tuple:
+        """(A (2, nz), c (2,)): a solid's point ``local`` (kind ``point``), local vector
+        (``direction``), base point (``p``) or base vector (``v``) is A z + c (kept: the
+        dynamic analysis asks for the same ones at every state)."""
+        cache = self.__dict__.setdefault("_affine", {})
+        key = (solid, None if local is None else (float(local[0]), float(local[1])), kind)
+        if key not in cache:
+            f = self.frames[solid]
+            vec = {"point": f.point, "direction": f.direction}[kind](local) \
+                if kind in ("point", "direction") else getattr(f, kind)
+            cache[key] = (self.matrix(vec), self.constants(vec))
+        return cache[key]
+
     def matrix(self, vec: Vec) -> np.ndarray:
         """(2, nz): the coefficients of a linear Vec (its constant left out)."""
         out = np.zeros((2, self.nz))

@@ -5,7 +5,11 @@ Each force acts on one solid, whose points are r(s) = p + a v + b Ω v (``Frame`
 F at s does the virtual work F·(δp + a δv + b Ω δv), so it is (F, a F − b Ω F) on the
 solid's (p, v); a moment M does M δfi = M (Ω v)·δv / |v|². On x, y, fi (p = R + A s_p,
 v = A d): Q_xy = Q_p, Q_fi = Q_p·Ω(p − R) + Q_v·Ω v. The multipliers then follow from
-pam2exu's own Cqᵀ λ = −Q (least squares, minimum norm), in its row order.
+pam2exu's own Cqᵀ λ = −Q (least squares, minimum norm), in its row order. On z itself
+(the dynamic analysis, ``dynamics``): Q_z = Σ Pᵀ Q_p + Vᵀ Q_v, with ṗ = P ż and v̇ = V ż.
+
+Given the rates ż, the dampers (C4) see the rates of the points and angles
+(``point_rate``, ``angle_rate``); without them every rate is zero (static).
 """
 from __future__ import annotations
 
@@ -24,29 +28,46 @@ class Loads:
         (n, nz) natural coordinates.
     q : numpy.ndarray
         (n, nq) the same configurations as x, y, fi.
+    zd : numpy.ndarray, optional
+        (n, nz) their rates ż (the dampers' forces); None: at rest.
     """
 
-    def __init__(self, form, z: np.ndarray, q: np.ndarray):
+    def __init__(self, form, z: np.ndarray, q: np.ndarray, zd: np.ndarray | None = None):
         self.form, self.q, self.n = form, q, q.shape[0]
-        self.zx = np.c_[z, np.ones(self.n)]
+        self.z = np.asarray(z, dtype=float)
+        self.zd = zd
         ns = len(form.frames)
         self.Qp, self.Qv = np.zeros((self.n, ns, 2)), np.zeros((self.n, ns, 2))
 
-    def _value(self, vec) -> np.ndarray:
-        """A linear Vec at the configurations, (n, 2)."""
-        return self.zx @ np.c_[self.form.matrix(vec), self.form.constants(vec)].T
+    def _value(self, solid: int, local, kind: str) -> np.ndarray:
+        """A point or vector of a solid (``Formulation.affine``) at the configurations, (n, 2)."""
+        A, c = self.form.affine(solid, local, kind)
+        return self.z @ A.T + c
 
     def point(self, solid: int, local) -> np.ndarray:
         """Where the point ``local`` of the solid is, (n, 2)."""
-        return self._value(self.form.frames[solid].point(local))
+        return self._value(solid, local, "point")
 
     def direction(self, solid: int, local) -> np.ndarray:
         """The solid's local vector ``local`` in the global basis, (n, 2)."""
-        return self._value(self.form.frames[solid].direction(local))
+        return self._value(solid, local, "direction")
 
     def angle(self, solid: int) -> np.ndarray:
         """The solid's angle fi, (n,)."""
         return self.q[:, column(solid, 2)]
+
+    def point_rate(self, solid: int, local) -> np.ndarray:
+        """The velocity of the point ``local`` of the solid, (n, 2) (zero at rest)."""
+        if self.zd is None:
+            return np.zeros((self.n, 2))
+        return self.zd @ self.form.affine(solid, local)[0].T
+
+    def angle_rate(self, solid: int) -> np.ndarray:
+        """The solid's angular velocity, v × v̇ / |v|², (n,) (zero at rest)."""
+        if self.zd is None:
+            return np.zeros(self.n)
+        v, vd = self._value(solid, None, "v"), self.zd @ self.form.affine(solid, None, "v")[0].T
+        return (v[:, 0] * vd[:, 1] - v[:, 1] * vd[:, 0]) / np.sum(v * v, axis=1)
 
     def force(self, solid: int, local, force) -> None:
         """A force (n, 2) at the point ``local`` of the solid: (F, a F − b Ω F) on (p, v)."""
@@ -58,7 +79,7 @@ class Loads:
 
     def moment(self, solid: int, moment) -> None:
         """A moment (n,) on the solid: M Ω v / |v|² on v."""
-        v = self._value(self.form.frames[solid].v)
+        v = self._value(solid, None, "v")
         self.Qv[:, solid] += np.asarray(moment, dtype=float)[:, None] * perp(v) / \
             np.sum(v * v, axis=1, keepdims=True)
 
@@ -69,11 +90,19 @@ class Loads:
                 weight = np.broadcast_to([0.0, -float(s.mass) * g], (self.n, 2))
                 self.force(i, (float(s.cog[0]), float(s.cog[1])), weight)
 
+    def on_coordinates(self) -> np.ndarray:
+        """Q (n, nz) on the natural coordinates: Σ Pᵀ Q_p + Vᵀ Q_v over the solids."""
+        out = np.zeros((self.n, self.form.nz))
+        for i in range(len(self.form.frames)):
+            out += self.Qp[:, i] @ self.form.affine(i, None, "p")[0] + \
+                self.Qv[:, i] @ self.form.affine(i, None, "v")[0]
+        return out
+
     def on_pose(self) -> np.ndarray:
         """Q (n, nq) on x, y, fi of every solid."""
         out = np.zeros_like(self.q)
-        for i, f in enumerate(self.form.frames):
-            p, v = self._value(f.p), self._value(f.v)
+        for i in range(len(self.form.frames)):
+            p, v = self._value(i, None, "p"), self._value(i, None, "v")
             arm = p - self.q[:, pose(i)][:, :2]
             out[:, pose(i)][:, :2] = self.Qp[:, i]
             out[:, column(i, 2)] = (np.sum(self.Qp[:, i] * perp(arm), axis=1)

@@ -1,0 +1,211 @@
+"""The dynamic analysis on the natural backend (backend/natural/dynamics.py): the equations
+of motion M z̈ + Φ_zᵀ μ = Q, Φ = 0 in natural coordinates, integrated by DOP853 with
+projections to the tolerance.
+
+References, each computed here without pam2exu's code: scipy's DOP853 (rtol 1e-13) on the
+one-DOF equations of a free compound pendulum (I_O θ̈ = −m g d cos θ), of the same with a
+torsional spring-damper at its pivot (− k (θ − θ0) − c θ̇), and of a pendulum hanging from a
+slider driven by bezier_c2 (I_O θ̈ = m d sin θ ẍ_s − m g d cos θ); the energy T + V of the
+free four-bar from the result columns; and the Exudyn backend's integration of the same
+models (``pam2exu.verify``: two integrations within the verify rule, docs/verify.md).
+"""
+import math
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import pam2exu
+from pam2exu.cli import main
+from pam2exu.laws import Law
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "analyses"))
+from test_dynamic import D, G, IG, IO, M, PENDULUM, SLIDER, pendulum  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+FOUR_BAR = ROOT / "examples/equilibrium/spring_four_bar.toml"
+
+
+def _run(model, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return pam2exu.run(model, backend="natural", **kw)
+
+
+def _within(value, ref, tolerance):
+    """Largest |value − ref| / (tolerance (1 + |ref|)): at most 1 passes."""
+    return float(np.max(np.abs(value - ref) / (tolerance * (1 + np.abs(ref)))))
+
+
+@pytest.mark.parametrize("tolerance", [1e-6, 1e-8, 1e-10])
+def test_free_pendulum_against_its_one_dof_equation(tolerance):
+    """Every row within tolerance (1 + |value|) of DOP853 on θ̈ = −m g d cos θ / I_O
+    (measured at 1e-8: θ 6.9e-11, θ̇ 1.2e-10 relative), the estimate below the tolerance,
+    θ̈ from the equation and the pivot on the ground."""
+    res = _run(pendulum(0.3), t_end=2.0, steps=50, tolerance=tolerance)
+    ref = solve_ivp(lambda t, y: [y[1], -M * G * D * math.cos(y[0]) / IO], (0, 2.0),
+                    [0.3, 0.0], method="DOP853", rtol=1e-13, atol=1e-14, t_eval=res.t)
+    assert res.info["integration_error"] <= tolerance
+    assert _within(res["lever.fi"], ref.y[0], tolerance) <= 1
+    assert _within(res["lever.Dfi"], ref.y[1], tolerance) <= 1
+    th = res["lever.fi"]
+    np.testing.assert_allclose(res["lever.DDfi"], -M * G * D * np.cos(th) / IO, atol=1e-12)
+    np.testing.assert_allclose(res["lever.x"], 0.0, atol=1e-12)
+    assert np.ptp(th) > 3                                          # it swung
+
+
+def test_torsional_spring_damper_at_the_pivot():
+    """C4 of a torsional spring-damper (ground, lever) brakes the natural integration as
+    I_O θ̈ = −m g d cos θ − k (θ − θ0) − c θ̇ says (the dampers see the rates)."""
+    k, theta0, c = 3.0, -1.0, 0.4
+    text = PENDULUM.replace("@FI@", "0.3").replace("@DFI@", "0.0").replace("@DX@", "0.0")
+    text = text.replace("[analysis]", f"""[[element]]
+type = "torsional_spring"
+name = "hinge_spring"
+anc1 = "ground"
+anc2 = "lever"
+C = [0.0, {k}, {theta0}, {c}]
+
+[analysis]""")
+    tolerance = 1e-8
+    res = _run(pam2exu.loads(text), t_end=1.5, steps=30, tolerance=tolerance)
+
+    def rhs(t, y):
+        return [y[1], (-M * G * D * math.cos(y[0]) - k * (y[0] - theta0) - c * y[1]) / IO]
+
+    ref = solve_ivp(rhs, (0, 1.5), [0.3, 0.0], method="DOP853", rtol=1e-13, atol=1e-14,
+                    t_eval=res.t)
+    assert _within(res["lever.fi"], ref.y[0], tolerance) <= 1
+    assert _within(res["lever.Dfi"], ref.y[1], tolerance) <= 1
+
+
+def test_free_four_bar_keeps_its_energy():
+    """spring_four_bar.toml let go (no damper): T + V from the columns constant to the
+    tolerance (measured 1.1e-11 relative at 1e-8)."""
+    model = pam2exu.load(FOUR_BAR)
+    tolerance = 1e-8
+    res = _run(model, analysis="dynamic", t_end=0.5, steps=25, tolerance=tolerance)
+    energy = np.zeros(len(res))
+    for s in model.mechanism().solids:
+        x, y, fi = (res[f"{s.name}.{k}"] for k in ("x", "y", "fi"))
+        dx, dy, dfi = (res[f"{s.name}.D{k}"] for k in ("x", "y", "fi"))
+        gx, gy = s.cog
+        c, n = np.cos(fi), np.sin(fi)
+        vx, vy = dx - dfi * (n * gx + c * gy), dy + dfi * (c * gx - n * gy)
+        energy += 0.5 * s.mass * (vx ** 2 + vy ** 2) + 0.5 * s.inertia * dfi ** 2
+        energy += s.mass * G * (y + n * gx + c * gy)
+    energy += 0.5 * 400.0 * (res["spring.ro"] - 0.1) ** 2
+    assert np.ptp(energy) <= tolerance * (1 + abs(energy[0]))
+    assert np.ptp(res["crank.fi"]) > 0.5
+
+
+def test_pendulum_on_a_driven_slider_against_its_one_dof_equation():
+    """The actuator's law drives the distance equation (f, f', f'' from the law): the slider
+    follows it exactly, the lever its one-DOF equation within the tolerance."""
+    law = Law("bezier_c2", [0.2, 0.7, 0.5, 0.9])
+    tolerance = 1e-8
+    res = _run(pam2exu.loads(SLIDER), tolerance=tolerance)
+
+    def rhs(t, y):
+        xdd = law(np.array([t]))[2][0]
+        return [y[1], (M * D * math.sin(y[0]) * xdd - M * G * D * math.cos(y[0])) / IO]
+
+    ref = solve_ivp(rhs, (0, 1.0), [-1.2, 0.0], method="DOP853", rtol=1e-13, atol=1e-14,
+                    t_eval=res.t)
+    np.testing.assert_allclose(res["slider.x"], law(res.t)[0], atol=1e-12)
+    np.testing.assert_allclose(res["slider.Dx"], law(res.t)[1], atol=1e-12)
+    assert _within(res["lever.fi"], ref.y[0], tolerance) <= 1
+    assert _within(res["lever.Dfi"], ref.y[1], tolerance) <= 1
+
+
+def test_a_ramp_jolts_the_pendulum_by_the_plastic_impulse():
+    """The law breakpoints' impulses are the analysis's (m d sin θ Δẋ / I_O at 0.2 and 0.7 s);
+    each segment's end is the state before the jump (the law's rate just before it),
+    every row within the tolerance of DOP853 segment by segment (measured 7.6e-11 rad,
+    5.5e-10 rad/s)."""
+    tolerance, v = 1e-8, 0.8
+    res = _run(pam2exu.loads(SLIDER.replace('"bezier_c2"', '"ramp"')), tolerance=tolerance)
+
+    def swing(t, y):
+        return [y[1], -M * G * D * math.cos(y[0]) / IO]
+
+    y, t_eval = [-1.2, 0.0], res.t
+    ref = np.empty((2, len(t_eval)))
+    for a, b, jump in ((0.0, 0.2, v), (0.2, 0.7, -v), (0.7, 1.0, 0.0)):
+        rows = (t_eval >= a - 1e-12) & (t_eval <= b + 1e-12)
+        part = solve_ivp(swing, (a, b), y, method="DOP853", rtol=1e-13, atol=1e-14,
+                         dense_output=True)
+        ref[:, rows] = part.sol(np.clip(t_eval[rows], a, b))
+        y = part.sol(b)
+        y = [y[0], y[1] + M * D * math.sin(y[0]) * jump / IO]
+        ref[:, np.abs(t_eval - b) < 1e-12] = np.array(y)[:, None]
+    assert _within(res["lever.fi"], ref[0], tolerance) <= 1
+    assert _within(res["lever.Dfi"], ref[1], tolerance) <= 1
+
+
+def test_radau_when_dop853_takes_too_many_steps(monkeypatch):
+    """A run of DOP853 beyond STIFF_STEPS steps (a stiff model) goes on with Radau, to the
+    same tolerance (forced here on the pendulum)."""
+    import pam2exu.backend.natural.dynamics as nd
+    monkeypatch.setattr(nd, "STIFF_STEPS", 5)
+    res = _run(pendulum(0.3), t_end=1.0, steps=20, tolerance=1e-6)
+    ref = solve_ivp(lambda t, y: [y[1], -M * G * D * math.cos(y[0]) / IO], (0, 1.0),
+                    [0.3, 0.0], method="DOP853", rtol=1e-13, atol=1e-14, t_eval=res.t)
+    assert _within(res["lever.fi"], ref.y[0], 1e-6) <= 1
+    assert _within(res["lever.Dfi"], ref.y[1], 1e-6) <= 1
+
+
+@pytest.mark.parametrize("case", ["four_bar", "slider", "damped_four_bar"])
+def test_natural_and_exudyn_agree_within_the_verify_rule(case):
+    """Two independent integrations (Exudyn's generalized-α refined by Romberg, natural
+    coordinates by DOP853) agree within 10 T (1 + S) (docs/verify.md); measured on the
+    free four-bar at T = 1e-8: at most 0.6 % of the allowed difference."""
+    if case == "slider":
+        model = pam2exu.loads(SLIDER)
+        v = pam2exu.verify(model, analysis="dynamic", steps=25)
+    else:
+        model = pam2exu.load(FOUR_BAR)
+        if case == "damped_four_bar":        # a damper on the spring (C4 = 2 N·s/m)
+            spring = next(e for e in model.elements if e.name == "spring")
+            spring.C = [0.0, 400.0, 0.1, 2.0]
+        v = pam2exu.verify(model, analysis="dynamic", steps=15, t_end=0.3)
+    assert v.ok, v.verdict()
+    assert v.rule.integration == 1e-8
+    row = v.comparison["crank.fi" if case != "slider" else "lever.fi"]
+    assert 0 < row.max_abs_error <= row.tolerance
+
+
+def test_verify_catches_a_wrong_damper():
+    """The rule is not loose: C4 = 2 on one backend's spring and 2.002 on the other's is a
+    disagreement (a 0.1 % change of one force)."""
+    model = pam2exu.load(FOUR_BAR)
+    spring = next(e for e in model.elements if e.name == "spring")
+    spring.C = [0.0, 400.0, 0.1, 2.0]
+    ref = pam2exu.run(model, analysis="dynamic", steps=15, t_end=0.3)
+    spring.C = [0.0, 400.0, 0.1, 2.002]
+    other = pam2exu.run(model, analysis="dynamic", steps=15, t_end=0.3, backend="natural")
+    from pam2exu.verify import Rule, agreement, _scales
+    good = pam2exu.verify(model, analysis="dynamic", steps=15, t_end=0.3)
+    rule = Rule(good.rule.tolerances, good.rule.condition, good.rule.length,
+                _scales([ref, other], good.rule.length), good.rule.integration)
+    table = agreement(other, ref, rule, ("exudyn", "natural"))
+    assert not table.passed and "crank.fi" in table.failed
+
+
+def test_cli_verify_dynamic_exits_0(capsys):
+    code = main(["verify", str(FOUR_BAR), "-a", "dynamic", "--steps", "20", "--t-end", "0.3"])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "two time integrations, each within T = 1e-08" in out
+    assert "AGREE: natural and exudyn agree" in out
+
+
+def test_equilibrium_still_refuses_free_solids_on_natural():
+    """Only the motion is integrated: the natural backend has no static equilibrium of free
+    solids (tests/analyses/test_equilibrium.py has the message)."""
+    model = pam2exu.load(FOUR_BAR)
+    with pytest.raises(pam2exu.ModelError, match="natural backend cannot solve a static"):
+        pam2exu.run(model, backend="natural")
