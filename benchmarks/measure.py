@@ -56,13 +56,16 @@ class Plan:
     backend_repeats: int = 4                 # its repeats (chain: 3 up to N = 8, then 2)
     memory_steps: int = 1000000              # four-bar steps of the memory runs
     clearance_repeats: int = 3               # section 7: repeats of each clearance way
+    dynamic_tolerances: tuple = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)   # section 8
+    dynamic_repeats: int = 3                 # its repeats (one for a run over 20 s)
 
 
 FULL = Plan()
 QUICK = Plan(steps=(1000,), big_steps=0, tolerances=(1e-6, 1e-13), repeats=2, big_repeats=1,
              compare_steps=(2000,), compare_repeats=5, chain_sizes=(1, 2, 4, 8),
              chain_steps=200, long_turns=10, long_steps=10000, backend_steps=5000,
-             backend_repeats=1, memory_steps=20000, clearance_repeats=1)
+             backend_repeats=1, memory_steps=20000, clearance_repeats=1,
+             dynamic_tolerances=(1e-4, 1e-6), dynamic_repeats=1)
 
 
 # ---- timing --------------------------------------------------------------------------------

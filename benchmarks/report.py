@@ -13,6 +13,7 @@ from pam2exu.backend.system import DENSE_UP_TO
 from .cases import CHAIN, CHAIN_LAW, TWO_PI
 from .measure import DEFAULT_TOLERANCE, KINDS, fit_exponent, warning_summary
 from .clearance import clearance_section
+from .dynamics import dynamic_section
 from .report_backends import backends_section
 
 
@@ -73,9 +74,11 @@ def chain_fits(chain_rows):
 
 
 def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows, newton,
-                 profiles, sections, elapsed, side=None, memory=None, clearance=None):
+                 profiles, sections, elapsed, side=None, memory=None, clearance=None,
+                 dynamics=None):
     """Write performance.md; ``side`` and ``memory``: section 6 (backends.py), ``clearance``:
-    section 7 (clearance.py), each left out when None."""
+    section 7 (clearance.py), ``dynamics``: section 8 (dynamics.py), each left out when
+    None."""
     lines = []
     add = lines.append
     add("# Performance: speed against error")
@@ -106,6 +109,8 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         "docs/img/work_precision.png")
     add("python benchmarks/speed_vs_error.py --quick   # smoke test, under a minute, "
         "written to a temporary directory")
+    add("python benchmarks/dynamics.py                 # section 8 alone, replaced in "
+        "place, and docs/img/dynamic_work_precision.png")
     add("```")
     add("")
     add("`--no-memory` leaves out the runs of a million steps in section 6 (about half a "
@@ -500,4 +505,6 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         lines += backends_section(plan, quick, side, memory)
     if clearance is not None:
         lines += clearance_section(clearance)
+    if dynamics is not None:
+        lines += dynamic_section(dynamics)
     (out_dir / "performance.md").write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -26,6 +26,10 @@ What it measures (each section of docs/performance.md is one of these):
    kinematic four-bar, each backend in its own process; the largest position error.
 7. The clearance analysis (issue 13) on its two examples: the slides' ODE against Newton
    step by step, time and agreement (clearance.py).
+8. The dynamic analysis (issue 15): a free pendulum, the free four-bar and Andrews'
+   squeezer at tolerances 1e-4 … 1e-10, time against the error achieved and the estimate
+   reported, scipy's DOP853 beside them (dynamics.py; ``python benchmarks/dynamics.py``
+   reruns this section alone and replaces it in docs/performance.md).
 
 References (the top-level ``references`` package, shared with the tests; nothing comes from
 pam2exu). Kinematics: the closed forms of references/closed_form.py (``four_bar``, chained
@@ -38,7 +42,8 @@ solved at every step), which checks itself by the power balance before it is use
 Layout: this file is the command line and the order of the run. Measuring:
 cases.py (the mechanisms and their references), plain_exudyn.py (the hand-written Exudyn
 four-bar), measure.py (grids, timing, errors of one configuration), sections.py (the
-sections 1–5 above), backends.py (section 6), clearance.py (section 7). Reporting: report.py (docs/performance.md),
+sections 1–5 above), backends.py (section 6), clearance.py (section 7), dynamics.py
+(section 8). Reporting: report.py (docs/performance.md),
 report_backends.py (its section 6), plot.py (docs/img/work_precision.png). The file puts the repository root on ``sys.path`` so that
 ``benchmarks`` and ``references`` import from a clone (``python -m benchmarks.speed_vs_error``
 from the root does the same).
@@ -56,6 +61,7 @@ sys.path.insert(0, str(ROOT))          # this clone's benchmarks, references (an
 
 from benchmarks.backends import memory, run_backend, side_by_side  # noqa: E402
 from benchmarks.clearance import measure as measure_clearance  # noqa: E402
+from benchmarks.dynamics import measure as measure_dynamics, plot_dynamic  # noqa: E402
 from benchmarks.cases import chain_model, four_bar_case  # noqa: E402
 from benchmarks.measure import DEFAULT_TOLERANCE, FULL, QUICK, log, machine, run_pam  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
@@ -127,11 +133,13 @@ def main(argv=None):
     peaks = None if args.no_memory else section("6b. peak memory, one process per run",
                                                  memory, plan)
     clearance = section("7. clearance: ODE against Newton", measure_clearance, plan)
+    dynamics = section("8. dynamic: work against precision", measure_dynamics, plan)
     elapsed = time.perf_counter() - start
     out_dir.mkdir(parents=True, exist_ok=True)
     plot(out_dir / "img" / "work_precision.png", grid, chain_rows, side)
+    plot_dynamic(out_dir / "img" / "dynamic_work_precision.png", dynamics)
     write_report(out_dir, info, plan, args.quick, grid, hard, chain_rows, plain_rows, newton,
-                 profiles, sections, elapsed, side, peaks, clearance)
+                 profiles, sections, elapsed, side, peaks, clearance, dynamics)
     log(f"wrote {out_dir / 'performance.md'} and {out_dir / 'img' / 'work_precision.png'} "
         f"({elapsed / 60:.1f} minutes)")
 
