@@ -302,8 +302,9 @@ def dynamic_section(measured) -> list[str]:
             + ("".join(f"{r.case} at {r.tolerance:.0e} stopped at {r.steps:,} steps with an "
                        f"estimate of {r.estimate:.1e} and an AccuracyWarning. "
                        for r in missed))
-            + "The natural-coordinates backend has no integrator yet (it refuses free "
-"solids), so this section measures the Exudyn backend only.", "", END]
+            + "This section measures the Exudyn backend (the default) only: the "
+            "natural-coordinates backend's integrator (backend/natural/dynamics.py) is not "
+            "in it yet.", "", END]
     return out
 
 
