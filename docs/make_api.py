@@ -34,8 +34,10 @@ OUTPUT = ROOT / "docs" / "api.md"
 #: (title, introduction, [(module, name), …]) in the order of the page
 SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
     ("Running an analysis",
-     "Load or build a model, run one of PAM's four analyses, get a `Results` table.",
-     [("pam2exu", "run"), ("pam2exu.analyses", "run")]),
+     ("Load or build a model, run one of PAM's four analyses or an extension (clearance, "
+      "equilibrium, dynamic), get a `Results` table; `energy` gives the energy account of a "
+      "kinetostatic or dynamic run."),
+     [("pam2exu", "run"), ("pam2exu.analyses", "run"), ("pam2exu", "energy")]),
     ("Models",
      ("A model is solids, elements and analysis settings. `load` and `loads` read the TOML "
       "format of [model-format.md](model-format.md); `Model` builds the same in Python."),

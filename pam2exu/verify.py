@@ -267,8 +267,8 @@ def verify(model, analysis=None, steps=None, t_end=None, backends=BACKENDS_COMPA
     solvers : dict, optional
         Backend name → its settings (``Settings`` of the backend); default: its defaults.
     tolerance : float, optional
-        The integration tolerance of a ``dynamic`` analysis (default: the model's); the
-        rule then allows ``INTEGRATION`` · tolerance · (1 + S).
+        The integration tolerance of a ``dynamic`` analysis (default: the model's), per unit
+        of value [-]; the rule then allows ``INTEGRATION`` · tolerance · (1 + S).
 
     Returns
     -------

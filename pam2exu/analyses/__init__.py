@@ -27,8 +27,9 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
     model : Model or path
         A model, or the path of a model file.
     analysis : str, optional
-        'assembly', 'quasi_static', 'kinematic' or 'kinetostatic' (default: the
-        model's [analysis] type).
+        'assembly', 'quasi_static', 'kinematic', 'kinetostatic', 'clearance',
+        'equilibrium' or 'dynamic' (``registry.ANALYSES``; default: the model's [analysis]
+        type).
     t_end : float, optional
         End of the interval [s].
     steps : int, optional
@@ -45,8 +46,8 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
         fi_rel, …): ``'rad'`` or ``'deg'`` (deg, deg/s, deg/s²); default: the model's
         ``[model] angles``.
     tolerance : float, optional
-        The dynamic analysis's integration tolerance (``Analysis.tolerance``); default: the
-        model's [analysis] tolerance.
+        The dynamic analysis's integration tolerance (``Analysis.tolerance``) per unit of
+        value [-]; default: the model's [analysis] tolerance.
 
     Returns
     -------
