@@ -12,6 +12,8 @@ model's plain data). The tests (tests/analyses/) and the benchmark
   equations (``newton_euler``), the model as TOML (``model_toml``).
 - ``revolute``: Newton–Euler for mechanisms of revolute joints and angular motors
   (``revolute_newton_euler``, checked by its power balance).
+- ``pendulum``: a compound pendulum, free or on a driven slider, as TOML, and its one-DOF
+  equation integrated by DOP853 (the dynamic, natural-dynamics and energy tests).
 - ``andrews``: Andrews' squeezing mechanism, the IVP test set's published state at 0.03 s
   and its equations integrated by DOP853 (tests/analyses/test_andrews.py,
   benchmarks/dynamics.py).

@@ -17,40 +17,10 @@ import pytest
 import pam2exu
 from pam2exu.cli import main
 from pam2exu.export import script
+from references.pendulum import pendulum_toml, slider_toml
 from test_export import POSITIONS, check_imports, max_difference, run_script
 
-PENDULUM = """
-[model]
-name = "pendulum"
-gravity = 9.81
-
-[[solid]]
-name = "ground"
-
-[[solid]]
-name = "lever"
-fi = 0.3
-mass = 2.0
-inertia = 0.02
-cog = [0.25, 0.0]
-points = { O = [0.0, 0.0], A = [0.5, 0.0] }
-
-[[element]]
-type = "fixed"
-name = "base"
-anc1 = "ground"
-
-[[element]]
-type = "revolute"
-name = "pivot"
-anc1 = "ground"
-anc2 = "lever.O"
-
-[analysis]
-type = "dynamic"
-t_end = 2.0
-steps = 50
-"""
+PENDULUM = pendulum_toml(0.3, analysis='type = "dynamic"\nt_end = 2.0\nsteps = 50')
 
 
 def relative_difference(header, data, res) -> float:
@@ -168,8 +138,7 @@ steps = 10
 
 
 def test_a_ramp_while_a_dof_is_free_is_refused_naming_the_element_and_law(tmp_path):
-    from analyses.test_dynamic import SLIDER
-    model = pam2exu.loads(SLIDER.replace('"bezier_c2"', '"ramp"'))
+    model = pam2exu.loads(slider_toml("ramp"))
     with pytest.raises(pam2exu.ModelError, match=r"'drive' \(linear_actuator\) follows the law "
                                                  r"ramp with a breakpoint at t = 0.2, 0.7 s"):
         script(model)

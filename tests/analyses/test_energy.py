@@ -12,35 +12,11 @@ import pytest
 import pam2exu
 from pam2exu.analyses.energy import account
 from pam2exu.cli import main
+from references.pendulum import D, G, IG, M, pendulum_toml
 
 ROOT = pam2exu.__file__.replace("pam2exu/__init__.py", "")
-G, M, D, IG, K4, TORQUE = 9.81, 2.0, 0.25, 0.02, 0.05, 1.5
-
-PENDULUM = f"""
-[model]
-name = "damped pendulum"
-gravity = {G}
-
-[[solid]]
-name = "ground"
-
-[[solid]]
-name = "lever"
-fi = -1.0
-mass = {M}
-inertia = {IG}
-cog = [{D}, 0.0]
-
-[[element]]
-type = "fixed"
-anc1 = "ground"
-
-[[element]]
-type = "revolute"
-name = "pivot"
-anc1 = "ground"
-anc2 = "lever"
-
+K4, TORQUE = 0.05, 1.5
+PENDULUM = pendulum_toml(-1.0, elements=f"""
 [[element]]
 type = "torsional_spring"
 name = "damper"
@@ -53,12 +29,7 @@ type = "torsor"
 name = "torque"
 anc1 = "lever"
 C = [0.0, 0.0, {TORQUE}]
-
-[analysis]
-type = "dynamic"
-t_end = 2.0
-steps = 200
-"""
+""", analysis='type = "dynamic"\nt_end = 2.0\nsteps = 200')
 
 
 def test_a_damped_pendulum_driven_by_a_torque():
@@ -69,7 +40,7 @@ def test_a_damped_pendulum_driven_by_a_torque():
     res = pam2exu.run(pam2exu.loads(PENDULUM), tolerance=1e-9)
     acc = account(pam2exu.loads(PENDULUM), res)
     fi, w = res["lever.fi"], res["lever.Dfi"]
-    IO = IG + M * D * D
+    IO = IG + M * D * D                   # references.pendulum's pendulum
     np.testing.assert_allclose(acc["energy.kinetic"], 0.5 * IO * w ** 2, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(acc["energy.potential"], M * G * D * np.sin(fi), atol=1e-12)
     np.testing.assert_allclose(acc["energy.torsors"], TORQUE * (fi - fi[0]), atol=1e-6)

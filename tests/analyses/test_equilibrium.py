@@ -23,57 +23,21 @@ import pam2exu
 from pam2exu.analyses import force_pass, native
 from pam2exu.analyses.equilibrium import StabilityWarning, reduced_stiffness
 from pam2exu.kinematics import State
+from references.pendulum import D, G, M, pendulum_toml
 
-G = 9.81
-M, D, K = 2.0, 0.25, 20.0            # the lever: mass, distance of G from the pivot, spring
-
-LEVER = f"""
-[model]
-name = "lever"
-gravity = {G}
-
-[[solid]]
-name = "ground"
-
-[[solid]]
-name = "lever"
-fi = FI
-mass = {M}
-inertia = 0.02
-cog = [{D}, 0.0]
-points = {{ O = [0.0, 0.0], A = [0.5, 0.0] }}
-
-[[element]]
-type = "fixed"
-name = "base"
-anc1 = "ground"
-
-[[element]]
-type = "revolute"
-name = "pivot"
-anc1 = "ground"
-anc2 = "lever.O"
-
-[[element]]
-type = "torsional_spring"
-name = "spring"
-anc1 = "ground"
-anc2 = "lever"
-C = [0.0, STIFFNESS, 0.0, 0.0]
-
-TORSOR
-
-[analysis]
-type = "equilibrium"
-"""
+K = 20.0                           # the torsional spring's stiffness [N·m/rad]
 
 
 def lever(fi=0.3, stiffness=K, torque=None):
+    """references.pendulum's pendulum held by a torsional spring (C2 = stiffness, C3 = 0),
+    with a torsor of moment ``torque`` when given, for the equilibrium analysis."""
     torsor = ("" if torque is None else
-              f'[[element]]\ntype = "torsor"\nname = "torque"\nanc1 = "lever"\n'
-              f"C = [0.0, 0.0, {torque}]")
-    return pam2exu.loads(LEVER.replace("FI", repr(fi)).replace("STIFFNESS", repr(stiffness))
-                         .replace("TORSOR", torsor))
+              f'\n[[element]]\ntype = "torsor"\nname = "torque"\nanc1 = "lever"\n'
+              f"C = [0.0, 0.0, {torque}]\n")
+    spring = (f'\n[[element]]\ntype = "torsional_spring"\nname = "spring"\nanc1 = "ground"\n'
+              f'anc2 = "lever"\nC = [0.0, {stiffness!r}, 0.0, 0.0]\n')
+    return pam2exu.loads(pendulum_toml(fi, elements=spring + torsor,
+                                       analysis='type = "equilibrium"'))
 
 
 def _run(model, **kw):

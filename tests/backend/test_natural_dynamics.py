@@ -10,7 +10,6 @@ free four-bar from the result columns; and the Exudyn backend's integration of t
 models (``pam2exu.verify``: two integrations within the verify rule, docs/verify.md).
 """
 import math
-import sys
 import warnings
 from pathlib import Path
 
@@ -22,11 +21,14 @@ import pam2exu
 from pam2exu.cli import main
 from pam2exu.laws import Law
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "analyses"))
-from test_dynamic import D, G, IG, IO, M, PENDULUM, SLIDER, pendulum  # noqa: E402
+from references.pendulum import D, G, IO, M, pendulum_toml, reference, slider_toml
 
 ROOT = Path(__file__).resolve().parents[2]
 FOUR_BAR = ROOT / "examples/equilibrium/spring_four_bar.toml"
+
+
+def pendulum(fi, dfi=0.0, dx=0.0):
+    return pam2exu.loads(pendulum_toml(fi, dfi, dx))
 
 
 def _run(model, **kw):
@@ -61,15 +63,14 @@ def test_torsional_spring_damper_at_the_pivot():
     """C4 of a torsional spring-damper (ground, lever) brakes the natural integration as
     I_O θ̈ = −m g d cos θ − k (θ − θ0) − c θ̇ says (the dampers see the rates)."""
     k, theta0, c = 3.0, -1.0, 0.4
-    text = PENDULUM.replace("@FI@", "0.3").replace("@DFI@", "0.0").replace("@DX@", "0.0")
-    text = text.replace("[analysis]", f"""[[element]]
+    text = pendulum_toml(0.3, elements=f"""
+[[element]]
 type = "torsional_spring"
 name = "hinge_spring"
 anc1 = "ground"
 anc2 = "lever"
 C = [0.0, {k}, {theta0}, {c}]
-
-[analysis]""")
+""")
     tolerance = 1e-8
     res = _run(pam2exu.loads(text), t_end=1.5, steps=30, tolerance=tolerance)
 
@@ -107,41 +108,10 @@ def test_pendulum_on_a_driven_slider_against_its_one_dof_equation():
     follows it exactly, the lever its one-DOF equation within the tolerance."""
     law = Law("bezier_c2", [0.2, 0.7, 0.5, 0.9])
     tolerance = 1e-8
-    res = _run(pam2exu.loads(SLIDER), tolerance=tolerance)
-
-    def rhs(t, y):
-        xdd = law(np.array([t]))[2][0]
-        return [y[1], (M * D * math.sin(y[0]) * xdd - M * G * D * math.cos(y[0])) / IO]
-
-    ref = solve_ivp(rhs, (0, 1.0), [-1.2, 0.0], method="DOP853", rtol=1e-13, atol=1e-14,
-                    t_eval=res.t)
+    res = _run(pam2exu.loads(slider_toml()), tolerance=tolerance)
+    ref = reference(res.t, (-1.2, 0.0), lambda t: law(np.array([t]))[2][0])
     np.testing.assert_allclose(res["slider.x"], law(res.t)[0], atol=1e-12)
     np.testing.assert_allclose(res["slider.Dx"], law(res.t)[1], atol=1e-12)
-    assert _within(res["lever.fi"], ref.y[0], tolerance) <= 1
-    assert _within(res["lever.Dfi"], ref.y[1], tolerance) <= 1
-
-
-def test_a_ramp_jolts_the_pendulum_by_the_plastic_impulse():
-    """The law breakpoints' impulses are the analysis's (m d sin θ Δẋ / I_O at 0.2 and 0.7 s);
-    each segment's end is the state before the jump (the law's rate just before it),
-    every row within the tolerance of DOP853 segment by segment (measured 7.6e-11 rad,
-    5.5e-10 rad/s)."""
-    tolerance, v = 1e-8, 0.8
-    res = _run(pam2exu.loads(SLIDER.replace('"bezier_c2"', '"ramp"')), tolerance=tolerance)
-
-    def swing(t, y):
-        return [y[1], -M * G * D * math.cos(y[0]) / IO]
-
-    y, t_eval = [-1.2, 0.0], res.t
-    ref = np.empty((2, len(t_eval)))
-    for a, b, jump in ((0.0, 0.2, v), (0.2, 0.7, -v), (0.7, 1.0, 0.0)):
-        rows = (t_eval >= a - 1e-12) & (t_eval <= b + 1e-12)
-        part = solve_ivp(swing, (a, b), y, method="DOP853", rtol=1e-13, atol=1e-14,
-                         dense_output=True)
-        ref[:, rows] = part.sol(np.clip(t_eval[rows], a, b))
-        y = part.sol(b)
-        y = [y[0], y[1] + M * D * math.sin(y[0]) * jump / IO]
-        ref[:, np.abs(t_eval - b) < 1e-12] = np.array(y)[:, None]
     assert _within(res["lever.fi"], ref[0], tolerance) <= 1
     assert _within(res["lever.Dfi"], ref[1], tolerance) <= 1
 
@@ -164,7 +134,7 @@ def test_natural_and_exudyn_agree_within_the_verify_rule(case):
     coordinates by DOP853) agree within 10 T (1 + S) (docs/verify.md); measured on the
     free four-bar at T = 1e-8: at most 0.6 % of the allowed difference."""
     if case == "slider":
-        model = pam2exu.loads(SLIDER)
+        model = pam2exu.loads(slider_toml())
         v = pam2exu.verify(model, analysis="dynamic", steps=25)
     else:
         model = pam2exu.load(FOUR_BAR)
