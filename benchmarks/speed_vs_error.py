@@ -26,10 +26,12 @@ What it measures (each section of docs/performance.md is one of these):
    kinematic four-bar, each backend in its own process; the largest position error.
 7. The clearance analysis (issue 13) on its two examples: the slides' ODE against Newton
    step by step, time and agreement (clearance.py).
-8. The dynamic analysis (issue 15): a free pendulum, the free four-bar and Andrews'
-   squeezer at tolerances 1e-4 … 1e-10, time against the error achieved and the estimate
-   reported, scipy's DOP853 beside them (dynamics.py; ``python benchmarks/dynamics.py``
-   reruns this section alone and replaces it in docs/performance.md).
+8. The dynamic analysis (issue 15) on both backends (Exudyn's generalized-α, the natural
+   backend's DOP853): a free pendulum, the free four-bar and Andrews' squeezer at
+   tolerances 1e-4 … 1e-10, time against the error achieved and the estimate reported,
+   AccuracyWarnings and failures, the faster backend per tolerance, scipy's DOP853 beside
+   them (dynamics.py; ``python benchmarks/dynamics.py`` reruns this section alone and
+   replaces it in docs/performance.md).
 
 References (the top-level ``references`` package, shared with the tests; nothing comes from
 pam2exu). Kinematics: the closed forms of references/closed_form.py (``four_bar``, chained
