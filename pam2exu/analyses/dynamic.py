@@ -48,7 +48,8 @@ PROJECTIONS = 3
 
 
 class AccuracyWarning(UserWarning):
-    """The dynamic analysis could not meet its tolerance within ``MOST_STEPS``."""
+    """The dynamic analysis could not meet its tolerance: the integrator's accuracy floor,
+    or more than ``MOST_STEPS`` steps (the message gives the estimate reached)."""
 
 
 def dynamic(job: Job):
@@ -95,8 +96,7 @@ def motion(job: Job, q0: np.ndarray, qd0: np.ndarray):
     # a breakpoint within round-off of a row is that row's time
     breaks = sorted({float(t[np.argmin(np.abs(t - b))])
                      if np.min(np.abs(t - b)) <= 1e-9 * dt else float(b)
-                     for el in mech.drivers for b in el.time_law().breakpoints()
-                     if t[0] < b < t[-1]})
+                     for el in mech.drivers for b in el.time_law().breakpoints()})
     breaks = [b for b in breaks if t[0] < b < t[-1]]
     q, qd = np.full((len(t), mech.nq), np.nan), np.full((len(t), mech.nq), np.nan)
     q[0], qd[0] = q0, qd0
