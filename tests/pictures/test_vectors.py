@@ -209,7 +209,6 @@ def test_instantaneous_centres_of_the_four_bar(examples):
     """draw(ic=True) at t = 0.1 s: the coupler's centre is where the crank's line O2A meets
     the rocker's line O4B (closed form from the run's positions), the crank's and rocker's
     at their pivots O2 = (0, 0) and O4 = (0.4, 0)."""
-    from matplotlib.lines import Line2D
     t = 0.1
     fig = draw(examples / "four_bar.toml", t=t, ic=True)
     marks = {}
