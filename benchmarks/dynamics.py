@@ -54,6 +54,7 @@ from references import andrews  # noqa: E402
 from pam2exu.analyses.dynamic import AccuracyWarning  # noqa: E402
 
 from benchmarks.measure import FULL, QUICK, ROOT, log, machine  # noqa: E402
+from references.pendulum import D, G, IO, M, pendulum_toml, swing  # noqa: E402
 
 BEGIN = ("<!-- section 8: written by benchmarks/dynamics.py (python benchmarks/dynamics.py "
          "rewrites it alone) -->")
@@ -64,41 +65,9 @@ LONG = 20.0
 TIE = 1.15
 #: the backends measured, and their names in the section
 BACKENDS = {"exudyn": "Exudyn", "natural": "natural"}
-G, M, D, IG = 9.81, 2.0, 0.25, 0.02
-IO = IG + M * D * D
 AMPLITUDE = 2.5
-
-PENDULUM = f"""
-[model]
-name = "pendulum"
-gravity = {G}
-
-[[solid]]
-name = "ground"
-
-[[solid]]
-name = "lever"
-fi = {AMPLITUDE - math.pi / 2!r}
-mass = {M}
-inertia = {IG}
-cog = [{D}, 0.0]
-points = {{ O = [0.0, 0.0] }}
-
-[[element]]
-type = "fixed"
-name = "base"
-anc1 = "ground"
-
-[[element]]
-type = "revolute"
-name = "pivot"
-anc1 = "ground"
-anc2 = "lever.O"
-
-[analysis]
-type = "dynamic"
-steps = 10
-"""
+#: references.pendulum's pendulum released at rest 2.5 rad from hanging, 10 rows
+PENDULUM = pendulum_toml(AMPLITUDE - math.pi / 2, analysis='type = "dynamic"\nsteps = 10')
 
 
 @dataclass
@@ -146,13 +115,9 @@ def _period():
     return 4.0 * math.sqrt(IO / (M * G * D)) * ellipk(math.sin(AMPLITUDE / 2) ** 2)
 
 
-def _pendulum_ode(t, y):
-    return [y[1], -M * G * D * math.cos(y[0]) / IO]
-
-
 def _pendulum_reference(times, rtol=1e-13):
     from scipy.integrate import solve_ivp
-    sol = solve_ivp(_pendulum_ode, (0.0, times[-1]), [AMPLITUDE - math.pi / 2, 0.0],
+    sol = solve_ivp(swing, (0.0, times[-1]), [AMPLITUDE - math.pi / 2, 0.0],
                     method="DOP853", rtol=rtol, atol=rtol, t_eval=times)
     return sol.y.T, sol.nfev
 
@@ -229,7 +194,7 @@ def _scipy(tolerances):
         best = np.inf
         for _ in range(3):
             begin = time.perf_counter()
-            sol = solve_ivp(_pendulum_ode, (0.0, period), [AMPLITUDE - math.pi / 2, 0.0],
+            sol = solve_ivp(swing, (0.0, period), [AMPLITUDE - math.pi / 2, 0.0],
                             method="DOP853", rtol=tol, atol=tol, t_eval=times)
             best = min(best, time.perf_counter() - begin)
         rows.append(ScipyRow("pendulum", tol, best, sol.nfev, _relative(sol.y.T, ref)))
