@@ -414,7 +414,8 @@ class Model:
                                           f"{limits.MODEL_NAME} are allowed"))
         seen: dict[str, str] = {}
         for solid in self.solids:
-            out += [Problem(solid.where, m) for m in solid_problems(solid)]
+            out += [Problem(solid.where, m)
+                    for m in solid_problems(solid, degrees=self.angles == "deg")]
             _unique(solid.name, solid.where, seen, out)
         scope = Scope(self.solids)
         scope.elements = self.elements

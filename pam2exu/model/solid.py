@@ -229,14 +229,24 @@ def _point_range(what: str, p) -> list[str]:
             for m in range_problems(f"{what} {c}", v, limits.LENGTH, "m")]
 
 
-def solid_problems(s: Solid) -> list[str]:
-    """Every problem with a solid's values (``Model.problems`` puts them under its place)."""
+def _in_degrees(limit: float, unit: str) -> tuple[float, str]:
+    """A range and unit given in radians, as a model written in degrees states them."""
+    if unit.startswith("rad"):
+        return (limit * 180.0 / math.pi if unit == "rad" else limit), "deg" + unit[3:]
+    return limit, unit
+
+
+def solid_problems(s: Solid, degrees: bool = False) -> list[str]:
+    """Every problem with a solid's values (``Model.problems`` puts them under its place);
+    ``degrees``: the model's angles are in degrees (``[model] angles``), and so are the
+    messages' units and the range of angles."""
     out = []
     for key, limit, unit in _SOLID_NUMBERS:
         value = getattr(s, key)
         if not is_number(value):
             out.append(f"{key} must be a number, got {value!r}")
-        out += range_problems(key, value, limit, unit)
+        out += range_problems(key, value, *(_in_degrees(limit, unit) if degrees
+                                           else (limit, unit)))
     for key in ("mass", "inertia"):
         if is_number(getattr(s, key)) and getattr(s, key) < 0:
             out.append(f"{key} is negative ({getattr(s, key)}): it must be ≥ 0")
@@ -266,8 +276,10 @@ def solid_problems(s: Solid) -> list[str]:
             out.append(f"line '{name}': point must be [x, y], got {line['point']!r}")
         elif "point" in line:
             out += _point_range(f"line '{name}' point", line["point"])
+        angle_range = _in_degrees(limits.ANGLE, "rad") if degrees else (limits.ANGLE, "rad")
         if "angle" in line and not is_number(line["angle"]):
-            out.append(f"line '{name}': angle must be a number [rad], got {line['angle']!r}")
-        out += range_problems(f"line '{name}' angle", line.get("angle"), limits.ANGLE, "rad")
+            out.append(f"line '{name}': angle must be a number [{angle_range[1]}], got "
+                       f"{line['angle']!r}")
+        out += range_problems(f"line '{name}' angle", line.get("angle"), *angle_range)
 
     return out

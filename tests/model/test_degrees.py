@@ -224,3 +224,24 @@ def test_pictures_of_a_degrees_model_are_those_of_the_radians_model(tmp_path):
     np.testing.assert_allclose(arrows_deg.values, arrows_rad.values, rtol=0, atol=1e-12)
     np.testing.assert_allclose(arrows_deg.points, arrows_rad.points,
                                rtol=0, atol=1e-12)
+
+
+def test_range_messages_of_a_degrees_model_are_in_degrees():
+    """A solid's fi, Dfi and line angles are checked in the model's unit: the limit of
+    1e7 rad is 5.73e8 deg, and the message says deg (a radian model keeps rad)."""
+    text = ('[model]\nangles = "{a}"\n[[solid]]\nname = "a"\nfi = 1e9\nDfi = 1e13\n'
+            'lines = {{ l = {{ point = [0, 0], angle = 1e10 }} }}\n')
+    with pytest.raises(pam2exu.ModelError) as error:
+        pam2exu.loads(text.format(a="deg"))
+    message = str(error.value)
+    assert "fi = 1e+09 deg is out of range: its magnitude must be at most 5.72958e+08 deg" \
+        in message
+    assert "Dfi = 1e+13 deg/s is out of range: its magnitude must be at most 1e+12 deg/s" \
+        in message
+    assert "line 'l' angle = 1e+10 deg is out of range" in message
+    assert "rad" not in message
+    # 5e8 deg is inside the degrees range (8.7e6 rad), 1e7 rad is the radian one
+    pam2exu.loads(text.format(a="deg").replace("1e9", "5e8").replace("1e13", "1")
+                  .replace("1e10", "0"))
+    with pytest.raises(pam2exu.ModelError, match="fi = 1e\\+09 rad is out of range"):
+        pam2exu.loads(text.format(a="rad"))
