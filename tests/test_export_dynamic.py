@@ -16,11 +16,29 @@ import pytest
 
 import pam2exu
 from pam2exu.cli import main
-from pam2exu.export import script
+from pam2exu.law_code import RATE_CODE
+from pam2exu.laws import LAWS
 from references.pendulum import pendulum_toml, slider_toml
 from test_export import POSITIONS, check_imports, max_difference, run_script
 
 PENDULUM = pendulum_toml(0.3, analysis='type = "dynamic"\nt_end = 2.0\nsteps = 50')
+#: a second solid hinged to the pendulum's end A
+ARM = """
+[[solid]]
+name = "arm"
+x = 0.4776682445628
+y = 0.1477601033307
+fi = -0.5
+mass = 1.0
+inertia = 0.01
+cog = [0.2, 0.0]
+
+[[element]]
+type = "revolute"
+name = "elbow"
+anc1 = "lever.A"
+anc2 = "arm"
+"""
 
 
 def relative_difference(header, data, res) -> float:
@@ -57,7 +75,8 @@ def test_free_pendulum_script_gives_the_dynamic_positions(tmp_path, capsys):
     check_imports(text)
     res = dynamic(model)
     steps = res.info["integration_steps"]
-    assert f"fine_steps = {steps}\n" in text and "SolveDynamic(" in text
+    assert f"    (0.0, 2.0, range(1, 51), {steps}, False),\n" in text    # one piece
+    assert "SolveDynamic(" in text and "def velocities_after" not in text
     assert "initialVelocities=[0.0, 0.0, 0.0]" in text
     header, data = run_script(path)
     assert len(data) == 51
@@ -101,22 +120,7 @@ def test_analysis_option_picks_the_dynamic_script(examples, tmp_path):
 def test_driven_actuators_follow_their_laws_in_the_script(tmp_path):
     """A pendulum on a slider driven by a linear actuator (a distance: pre-step function)
     and a lever turned by an angular actuator (an offset: user function of t)."""
-    model = pam2exu.loads(PENDULUM[:PENDULUM.index("[analysis]")] + """
-[[solid]]
-name = "arm"
-x = 0.4776682445628
-y = 0.1477601033307
-fi = -0.5
-mass = 1.0
-inertia = 0.01
-cog = [0.2, 0.0]
-
-[[element]]
-type = "revolute"
-name = "elbow"
-anc1 = "lever.A"
-anc2 = "arm"
-
+    model = pam2exu.loads(PENDULUM[:PENDULUM.index("[analysis]")] + ARM + """
 [[element]]
 type = "angular_actuator"
 name = "motor"
@@ -137,15 +141,71 @@ steps = 10
     assert relative_difference(header, data, dynamic(model)) <= 1e-8
 
 
-def test_a_ramp_while_a_dof_is_free_is_refused_naming_the_element_and_law(tmp_path):
-    model = pam2exu.loads(slider_toml("ramp"))
-    with pytest.raises(pam2exu.ModelError, match=r"'drive' \(linear_actuator\) follows the law "
-                                                 r"ramp with a breakpoint at t = 0.2, 0.7 s"):
-        script(model)
-    # before the first breakpoint it is exported
-    path = pam2exu.export(model, tmp_path / "slider.py", t_end=0.2, steps=10)
+@pytest.mark.parametrize("C, measured", [((0.2, 0.7, 0.5, 0.9), 1.5e-14),
+                                         ((0.215, 0.705, 0.5, 0.9), 8.8e-12)],
+                         ids=["breakpoints on rows", "breakpoints between rows"])
+def test_a_ramp_while_a_dof_is_free_jumps_in_the_script_as_in_the_analysis(C, measured,
+                                                                           tmp_path):
+    """The pendulum on a slider driven by a ramp: its velocities jump at C1 and C2 (the
+    plastic impulse of the contract, M and C_q from Exudyn); the script integrates the
+    analysis's pieces between them with the analysis's step counts."""
+    model = pam2exu.loads(slider_toml("ramp", C))
+    path = pam2exu.export(model, tmp_path / "slider.py")
+    text = path.read_text()
+    check_imports(text)
+    for call in ("ComputeMassMatrix(mbs)", "ComputeJacobianAE(mbs", "def velocities_after",
+                 "def ramp_rate(t, C1, C2, C3, C4):", "lambda t: ramp_rate(t, "):
+        assert call in text
+    assert text.count(", True),\n") == 2                        # two breakpoints
     header, data = run_script(path)
-    assert relative_difference(header, data, dynamic(model, t_end=0.2, steps=10)) <= 1e-8
+    res = dynamic(model)
+    assert len(data) == len(res) == 51
+    difference = relative_difference(header, data, res)
+    assert difference <= 1e-8, difference                       # measured: see the ids
+    assert difference <= 100 * measured
+    fi = data[:, header.index("lever.fi")]
+    assert np.ptp(np.diff(fi)) > 0.01                           # it is jerked about
+    # the interval ending at the first breakpoint: no jump inside, one piece
+    path = pam2exu.export(model, tmp_path / "before.py", t_end=C[0], steps=10)
+    assert "def velocities_after" not in path.read_text()
+    header, data = run_script(path)
+    assert relative_difference(header, data, dynamic(model, t_end=C[0], steps=10)) <= 1e-8
+
+
+def test_an_angular_ramp_jumps_in_the_script_as_in_the_analysis(tmp_path):
+    """An angular actuator (an offset by a user function of t, no pre-step function) with a
+    ramp whose breakpoints fall between rows, driving a lever with a free arm."""
+    model = pam2exu.loads(PENDULUM[:PENDULUM.index("[analysis]")] + ARM + """
+[[element]]
+type = "angular_actuator"
+name = "motor"
+anc1 = "ground"
+anc2 = "lever"
+law = "ramp"
+C = [0.13, 0.33, 0.3, -0.2]
+
+[analysis]
+type = "dynamic"
+t_end = 0.5
+steps = 10
+""")
+    path = pam2exu.export(model, tmp_path / "motor.py")
+    text = path.read_text()
+    assert "(o_motor, lambda t: ramp_rate(t, 0.13, 0.33, 0.3, -0.2))," in text
+    assert "PreStepUserFunction" not in text
+    header, data = run_script(path)
+    assert relative_difference(header, data, dynamic(model)) <= 1e-8   # measured 2.9e-13
+
+
+@pytest.mark.parametrize("name", list(RATE_CODE))
+def test_rate_code_is_the_laws_derivative_with_right_hand_limits(name):
+    namespace = {"np": np}
+    exec(RATE_CODE[name], namespace)
+    rate = namespace[f"{name}_rate"]
+    C = (0.2, 0.7, 0.5, 0.9)
+    for t in (0.0, 0.1, 0.2, 0.3, 0.45, 0.7, 0.9):
+        expected = float(LAWS[name][0](np.float64(t), C)[1])
+        assert rate(t, *C) == pytest.approx(expected, rel=1e-15, abs=1e-15)
 
 
 def test_a_fully_driven_dynamic_model_gets_the_positions_script(examples, tmp_path):

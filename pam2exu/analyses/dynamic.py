@@ -88,9 +88,11 @@ def dynamic(job: Job):
 
 # ---- the motion, by Exudyn, to the tolerance ---------------------------------------------
 
-def motion(job: Job, q0: np.ndarray, qd0: np.ndarray):
+def motion(job: Job, q0: np.ndarray, qd0: np.ndarray, pieces: list | None = None):
     """(q, q̇) at every time of the job, segment by segment between the laws' breakpoints
-    (where the velocities jump: ``impulse``), each one to the tolerance (``romberg``)."""
+    (where the velocities jump: ``impulse``), each one to the tolerance (``romberg``).
+    ``pieces``: a list that receives every run's (times, rows it fills, steps of its finest
+    Exudyn run, whether it ends at a breakpoint), in order (``export_dynamic`` repeats them)."""
     mech, t = job.mech, job.times
     dt = float(t[1] - t[0])
     # a breakpoint within round-off of a row is that row's time
@@ -107,6 +109,8 @@ def motion(job: Job, q0: np.ndarray, qd0: np.ndarray):
         for times, rows in _pieces(t, inside, start, end):
             at_break = end < float(t[-1]) and times[-1] == end
             found, estimate, n = romberg(job, times, *state, at_break=at_break)
+            if pieces is not None:
+                pieces.append((times, list(rows), n, at_break))
             q[rows], qd[rows] = found[0][1:len(rows) + 1], found[1][1:len(rows) + 1]
             worst, steps = max(worst, estimate), max(steps, n)
             state = (found[0][-1], found[1][-1])
