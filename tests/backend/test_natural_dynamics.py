@@ -128,6 +128,31 @@ def test_radau_when_dop853_takes_too_many_steps(monkeypatch):
     assert _within(res["lever.Dfi"], ref.y[1], 1e-6) <= 1
 
 
+@pytest.mark.parametrize("tolerance", [5e-324, 1e-300])
+def test_a_tolerance_below_the_integrators_floor_stops_at_the_floor(monkeypatch, tolerance):
+    """A valid tolerance no integrator meets (a subnormal 5e-324: 0.1 · tol underflowed to
+    rtol = atol = 0, and the run never ended; 1e-300: atol 1e-301, and DOP853 stopped on a
+    step below the spacing of floats) is integrated as far as DOP853 goes: the runs start
+    at rtol = atol = SMALLEST (fuzz seed 5e-324 on examples/equilibrium/spring_four_bar.toml
+    let go: over 5 minutes before), and the AccuracyWarning gives the estimate reached."""
+    import pam2exu.backend.natural.dynamics as nd
+    from pam2exu.analyses.dynamic import AccuracyWarning
+    seen = []
+    run = nd.Dynamics.run
+
+    def spy(self, times, y0, r):
+        seen.append(r)
+        assert r > 0 and len(seen) <= 4, seen        # r = 0: a run that never ends
+        return run(self, times, y0, r)
+    monkeypatch.setattr(nd.Dynamics, "run", spy)
+    with pytest.warns(AccuracyWarning):
+        res = pam2exu.run(pendulum(0.3), backend="natural", t_end=0.2, steps=4,
+                          tolerance=tolerance)
+    assert seen[0] == nd.SMALLEST
+    assert 0 < res.info["integration_error"] < 1e-10
+    assert np.isfinite(res.to_numpy()).all()
+
+
 @pytest.mark.parametrize("case", ["four_bar", "slider", "damped_four_bar"])
 def test_natural_and_exudyn_agree_within_the_verify_rule(case):
     """Two independent integrations (Exudyn's generalized-α refined by Romberg, natural

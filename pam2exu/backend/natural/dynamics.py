@@ -215,14 +215,17 @@ def motion(backend, form, mech, times, q0, qd0, tolerance: float, verbose: int =
     """(q, q̇ (n, nq) at ``times``, error estimate, steps of the finest run): runs at
     rtol = atol = r = ``FIRST`` · tolerance, r / ``REFINE``, … until two successive runs
     differ by at most tolerance · (1 + |value|) on every x, y, fi and rate (the finer one
-    returned), or r reaches ``SMALLEST`` (the estimate then says what was reached)."""
+    returned), or r reaches ``SMALLEST`` (the estimate then says what was reached; r starts
+    there for a tolerance below 10 ``SMALLEST``)."""
     times = np.asarray(times, dtype=float)
     q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
     dyn = Dynamics(backend, form, mech)
     y0 = dyn.start(float(times[0]), q0, qd0)
     if len(times) < 2:
         return q0[None], qd0[None], 0.0, 0
-    r = FIRST * tolerance
+    # below SMALLEST the runs would not go finer (a subnormal tolerance made r = 0: rtol
+    # and atol 0, a run that never ends; 1e-300 an atol DOP853 cannot step to)
+    r = max(FIRST * tolerance, SMALLEST)
     previous, estimate = None, math.inf
     while True:
         ys, fis, steps = dyn.run(times, y0, r)
