@@ -3,7 +3,10 @@
 A mutant is one of the model files of ``SOURCES`` with 1 to 3 mutations (``KINDS``) applied:
 deleted keys and sections, wrong types, extreme numbers, odd names, dangling and self anchors,
 deep nesting, broken TOML, a cp1252 file, absurd analysis settings and law constants, swapped
-element types, over-constrained and degenerate elements, and so on. Everything is drawn from
+element types, over-constrained and degenerate elements, and so on; and the keys of the
+extensions (issues 13 and 15): the dynamic analysis's ``tolerance``, the solids' initial
+rates ``Dx``, ``Dy``, ``Dfi``, ``clearance`` flags on elements, ``[[variation]]`` entries and
+``[model] angles``. Everything is drawn from
 ``random.Random(seed)``: the same seed gives the same bytes, whatever the state of the package
 (the generator does not import pam2exu), so a seed reported by a campaign stays reproducible.
 
@@ -36,7 +39,30 @@ SOURCES = (
     "tests/data/every_element.toml",
     "tests/data/parallelogram5.toml",
     "tests/data/compare/crank.toml",
+    "examples/clearance/locomotive.toml",
+    "examples/clearance/slider_guided_twice.toml",
+    "examples/equilibrium/spring_four_bar.toml",
+    "examples/dynamics/andrews.toml",
+    "tests/fuzz/seeds/spring_four_bar_deg.toml",
 )
+
+#: [analysis] settings a source is read with, so that its own analysis stays fast (the
+#: clearance examples' 400 steps take about 3 s; Andrews' 0.03 s at 1e-8, 5 s)
+SOURCE_SETTINGS = {
+    "examples/clearance/locomotive.toml": {"t_end": 2.0, "steps": 16},
+    "examples/clearance/slider_guided_twice.toml": {"t_end": 0.5, "steps": 16},
+    "examples/dynamics/andrews.toml": {"t_end": 0.003, "tolerance": 1e-5},
+}
+
+#: the analyses whose work grows with the interval and the steps beyond the others'
+SLOW_TYPES = ("dynamic", "dinamica", "clearance", "joc")
+#: the fast campaign's caps (``generate(..., extreme=False)``): a dynamic run over at most
+#: DYNAMIC_T_END s in at most DYNAMIC_STEPS steps, a clearance run in at most
+#: CLEARANCE_STEPS steps, a tolerance in TOLERANCE_RANGE and initial rates of at most
+#: RATE_LIMIT (a dynamic run's steps grow as the rates, the interval and 1/tolerance^(1/3))
+DYNAMIC_T_END, DYNAMIC_STEPS, CLEARANCE_STEPS = 0.01, 10, 20
+TOLERANCE_RANGE = (1e-8, 1e-3)
+RATE_LIMIT = 100.0
 
 #: element types and their keys (besides type and name), as in docs/model-format.md
 TYPES = {
@@ -178,9 +204,11 @@ _SOURCE_DOCS: dict[str, dict] = {}
 
 
 def source_doc(source: str) -> dict:
-    """The parsed model file (a fresh copy)."""
+    """The parsed model file (a fresh copy), with its ``SOURCE_SETTINGS``."""
     if source not in _SOURCE_DOCS:
-        _SOURCE_DOCS[source] = tomllib.loads((ROOT / source).read_text(encoding="utf-8"))
+        doc = tomllib.loads((ROOT / source).read_text(encoding="utf-8"))
+        doc.get("analysis", {}).update(SOURCE_SETTINGS.get(source, {}))
+        _SOURCE_DOCS[source] = doc
     return copy.deepcopy(_SOURCE_DOCS[source])
 
 
@@ -198,12 +226,15 @@ class Mutant:
     header: str = ""                      # text put before the TOML (a comment)
     byte_ops: list = field(default_factory=list)
     data: bytes = b""
+    extreme: bool = False                 # valid values a run may take long on allowed
+    capped: list[str] = field(default_factory=list)   # what the fast campaign capped
 
     @property
     def description(self) -> str:
         if not self.notes:
             return f"{self.source} (unchanged)"
-        return f"{self.source}: " + "; ".join(self.notes)
+        caps = [f"fast: {', '.join(self.capped)}"] if self.capped else []
+        return f"{self.source}: " + "; ".join(self.notes + caps)
 
 
 def short(v, n: int = 48) -> str:
@@ -837,7 +868,8 @@ def m_enum_value(rng, m):
     target = rng.choice(["analysis type", "law", "axes", "element type"])
     new = rng.choice(["nosuch", "", " kinematic", "KINEMATIC", "Kinematic", "quasi-static",
                       "cinematica", "dynamic", "assembly\n", "revolute ", "Revolute", "local",
-                      "GLOBAL", "global", "solid", "ramp", "kinetostatic", "ensamblatge"])
+                      "GLOBAL", "global", "solid", "ramp", "kinetostatic", "ensamblatge",
+                      "clearance", "equilibrium", "dinamica", "joc", "equilibri", "Dynamic"])
     if target == "analysis type":
         _analysis(m.doc)["type"] = new
         return f"[analysis] type = {new!r}"
@@ -901,6 +933,10 @@ def m_geometry(rng, m):
 
 def m_many_copies(rng, m):
     k = rng.choice([2, 3, 10, 40])
+    if k == 40 and not m.extreme:
+        # 40 free solids make the equilibrium's descent take 30–50 s to give up (200
+        # proximal steps, each one an Exudyn system of 40 solids): extreme campaigns only
+        k = 10
     if rng.random() < 0.7 and elements(m.doc) and isinstance(m.doc.get("element"), list):
         e = rng.choice(elements(m.doc))
         for i in range(k - 1):
@@ -963,6 +999,179 @@ def m_file_name(rng, m):
     return f"file named {short(m.name)}"
 
 
+# ---- the extensions' keys (shared/spec/clearance.md, shared/spec/dynamics.md, angles) -----
+
+#: [analysis] tolerance: invalid values (a clean error), and valid ones within the fast
+#: campaign's TOLERANCE_RANGE (its ends, and the loosest allowed, 1e-2)
+TOLERANCES = (0, 0.0, -0.0, -1e-6, -1, NAN, INF, -INF, "nan", "NaN", "1e-6", "", True,
+              [1e-6], {"value": 1e-6}, 10**400, 0.011, 1.0, 1e300, 1e-2, 1e-3, 1e-4, 1e-6,
+              1e-8, Raw("1979-05-27"))
+#: valid tolerances a dynamic run may take long on (``generate(..., extreme=True)`` only)
+EXTREME_TOLERANCES = (1e-10, 1e-12, 1e-15, 1e-100, 1e-300, 5e-324)
+RATES = (0.1, -2.0, 10.0, 0.0, -0.0, NAN, INF, -INF, 1e300, 1e13, 10**400, "1.0", True, [1.0],
+         {"x": 1.0})
+EXTREME_RATES = (1e3, 1e6, 1e12, -1e12)
+CLEARANCE_FLAGS = (True, True, False, "true", 1, 0, "yes", NAN, [True], {"on": True})
+VARIATION_KEYS = ("anchor", "dx", "dy", "dangle", "w", "wx", "wy", "wangle", "tau")
+VARIATION_VALUES = (1e-4, -3e-4, 0.0, 2.0, NAN, INF, -INF, 1e300, -1e300, 5e-324, 1e-300,
+                    10**400, "1e-4", True, [1e-4], -1.0, 1e6)
+ANGLE_UNITS = ("deg", "deg", "rad", "DEG", "degrees", "grad", "", " deg", 1, True, ["deg"],
+               NAN, "°")
+CLEARANCE_TYPES = ("revolute", "articulacio", "pin_slot", "piu_guia", "prismatic")
+
+
+def m_tolerance(rng, m):
+    pool = TOLERANCES + (EXTREME_TOLERANCES if m.extreme else ())
+    new = copy.deepcopy(rng.choice(pool))
+    _analysis(m.doc)["tolerance"] = new
+    if rng.random() < 0.3:
+        _analysis(m.doc)["type"] = rng.choice(["dynamic", "dinamica"])
+        return f"tolerance = {short(new)}, type = 'dynamic'"
+    return f"tolerance = {short(new)}"
+
+
+def m_initial_rates(rng, m):
+    pool = solids(m.doc)
+    if not pool:
+        raise _Skip
+    notes = []
+    for s in rng.sample(pool, rng.randint(1, len(pool))):
+        key = rng.choice(["Dx", "Dy", "Dfi", "Dfi", "dfi", "DDfi", "Dz"])
+        new = copy.deepcopy(rng.choice(RATES + (EXTREME_RATES if m.extreme else ())))
+        s[key] = new
+        notes.append(f"{_label(s)} {key} = {short(new)}")
+    if rng.random() < 0.3:
+        _analysis(m.doc)["type"] = "dynamic"
+        notes.append("type = 'dynamic'")
+    return ", ".join(notes)
+
+
+def m_clearance(rng, m):
+    els = elements(m.doc)
+    if not els:
+        raise _Skip
+    variant = rng.choice(["one joint", "one joint", "every joint", "any element", "flag value",
+                          "none", "analysis"])
+    joints = [e for e in els if e.get("type") in CLEARANCE_TYPES]
+    if variant == "one joint" and joints:
+        e = rng.choice(joints)
+        e["clearance"] = True
+        return f"{_label(e)} clearance = true"
+    if variant == "every joint" and joints:
+        for e in joints:
+            e["clearance"] = True
+        return f"clearance = true on all {len(joints)} joints"
+    if variant == "none":
+        flagged = [e for e in els if "clearance" in e]
+        for e in flagged:
+            del e["clearance"]
+        return f"clearance flags removed from {len(flagged)} elements"
+    if variant == "analysis":
+        _analysis(m.doc)["type"] = rng.choice(["clearance", "joc"])
+        return f"[analysis] type = {_analysis(m.doc)['type']!r}"
+    e = rng.choice(els)
+    new = copy.deepcopy(rng.choice(CLEARANCE_FLAGS))
+    e["clearance"] = new
+    return f"{_label(e)} clearance = {short(new)}"
+
+
+def _variations(doc) -> list:
+    if not isinstance(doc.get("variation"), list):
+        doc["variation"] = _list(doc, "variation")
+    return doc["variation"]
+
+
+def m_variation(rng, m):
+    variant = rng.choice(["add", "add", "value", "delete key", "unknown key", "duplicate",
+                          "bare solid", "dangle on a point", "not a table", "delete all"])
+    pts, lines = _points(m.doc), _points(m.doc, "lines")
+    if variant == "not a table":
+        new = copy.deepcopy(rng.choice([1, "ground.O", [1, 2], {"anchor": "ground.O"}, [[]]]))
+        m.doc["variation"] = new
+        return f"variation = {short(new)}"
+    if variant == "delete all":
+        m.doc.pop("variation", None)
+        return "every [[variation]] deleted"
+    vs = _variations(m.doc)
+    if variant in ("add", "bare solid", "dangle on a point") or not vs:
+        kind = "line" if lines and (rng.random() < 0.4 or not pts) else "point"
+        if not pts and not lines:
+            raise _Skip
+        s, p = rng.choice(lines if kind == "line" else pts)
+        entry = {"anchor": f"{s}.{p}", "dx": rng.choice([1e-4, -3e-4, 0.0, 1e-2]),
+                 "dy": rng.choice([2e-4, 0.0, -1e-3])}
+        if kind == "line" and rng.random() < 0.6:
+            entry["dangle"] = rng.choice([2e-3, -1e-2, 0.0])
+        for key in rng.sample(["w", "wx", "wy", "wangle", "tau"], rng.randint(0, 3)):
+            entry[key] = rng.choice([0.8, 1.9, 0.3, 0.0, 5.0])
+        if variant == "bare solid":
+            entry["anchor"] = s
+        elif variant == "dangle on a point":
+            entry["dangle"] = 1e-3
+        vs.append(entry)
+        return f"[[variation]] {short(entry, 120)}"
+    v = rng.choice(vs)
+    if not isinstance(v, dict):
+        raise _Skip
+    if variant == "value":
+        key = rng.choice(VARIATION_KEYS)
+        new = copy.deepcopy(rng.choice(VARIATION_VALUES) if key != "anchor" else rng.choice(
+            ["nosuch.P", "", ".", "ground", "ground.nosuch", 1.0, ["ground.O"]]))
+        v[key] = new
+        return f"[[variation]] {short(v.get('anchor'), 24)} {key} = {short(new)}"
+    if variant == "delete key" and v:
+        key = rng.choice(list(v))
+        del v[key]
+        return f"[[variation]] {short(v.get('anchor'), 24)}: {key} deleted"
+    if variant == "unknown key":
+        key = rng.choice(["dfi", "omega", "Tau", "dz", ""])
+        v[key] = 1.0
+        return f"[[variation]] {short(v.get('anchor'), 24)}: unknown key {key!r}"
+    vs.append(copy.deepcopy(v))
+    return f"[[variation]] {short(v.get('anchor'), 24)} given twice"
+
+
+def m_angles(rng, m):
+    new = copy.deepcopy(rng.choice(ANGLE_UNITS))
+    if not isinstance(m.doc.get("model"), dict):
+        m.doc["model"] = {}
+    m.doc["model"]["angles"] = new
+    return f"[model] angles = {short(new)}"
+
+
+def _fast(m) -> list[str]:
+    """The fast campaign's caps on the mutant's valid numbers (``SLOW_TYPES``'s interval and
+    steps, the tolerance, the initial rates); the notes of what changed."""
+    notes = []
+    an = m.doc.get("analysis")
+    if isinstance(an, dict):
+        kind = an.get("type")
+        kind = kind.strip().lower() if isinstance(kind, str) else kind
+        caps = []
+        if kind in ("dynamic", "dinamica"):
+            caps = [("t_end", DYNAMIC_T_END), ("steps", DYNAMIC_STEPS)]
+        elif kind in ("clearance", "joc"):
+            caps = [("steps", CLEARANCE_STEPS)]
+        for key, cap in caps:
+            v = an.get(key)                   # missing: the defaults, 1 s in 100 steps
+            valid = _is_number(v) and v <= (1e9 if key == "t_end" else 10**7)
+            if v is None or (valid and v > cap):
+                an[key] = cap
+                notes.append(f"{key} {short(v, 24)} capped to {cap:g}")
+        tol = an.get("tolerance")
+        low, high = TOLERANCE_RANGE
+        if _is_number(tol) and 0 < tol < low:
+            an["tolerance"] = low
+            notes.append(f"tolerance {tol!r} capped to {low:g}")
+    for s in solids(m.doc):
+        for key in ("Dx", "Dy", "Dfi"):
+            v = s.get(key)
+            if _is_number(v) and RATE_LIMIT < abs(v) <= 1e12:
+                s[key] = math.copysign(RATE_LIMIT, v)
+                notes.append(f"{_label(s)} {key} {v!r} capped to {s[key]:g}")
+    return notes
+
+
 #: every mutation kind: name -> function(rng, mutant) -> note
 KINDS = {
     "delete_key": m_delete_key,
@@ -995,14 +1204,24 @@ KINDS = {
     "perturb": m_perturb,
     "initial_guess": m_initial_guess,
     "file_name": m_file_name,
+    "tolerance": m_tolerance,
+    "initial_rates": m_initial_rates,
+    "clearance": m_clearance,
+    "variation": m_variation,
+    "angles": m_angles,
 }
 #: how often each kind is drawn, relative to 1 (byte-level kinds hide the others' effects)
 WEIGHTS = {"broken_toml": 0.5, "encoding": 0.3, "file_name": 0.5, "deep_nesting": 0.6}
 
 
-def generate(seed: int, n_mutations: int | None = None, source: str | None = None) -> Mutant:
+def generate(seed: int, n_mutations: int | None = None, source: str | None = None,
+             extreme: bool = False) -> Mutant:
     """The mutant of ``seed``: its source, 1–3 mutations (``n_mutations`` to choose; 0 gives
-    the source model as written by ``dumps``), name, bytes and description."""
+    the source model as written by ``dumps``), name, bytes and description.
+
+    ``extreme``: valid values that make a run long may stay (tolerances down to 5e-324,
+    initial rates up to 1e12, a dynamic run over 1e7 s …); without it, ``_fast`` caps them
+    (the fast campaign, whose cases each stay within the runner's time limit)."""
     rng = random.Random(seed)
     src = rng.choice(SOURCES)
     if source is not None:
@@ -1010,7 +1229,7 @@ def generate(seed: int, n_mutations: int | None = None, source: str | None = Non
     n = rng.choice((1, 1, 1, 2, 2, 3))
     if n_mutations is not None:
         n = n_mutations
-    m = Mutant(seed, src, source_doc(src), Path(src).name)
+    m = Mutant(seed, src, source_doc(src), Path(src).name, extreme=extreme)
     kinds = list(KINDS)
     weights = [WEIGHTS.get(k, 1.0) for k in kinds]
     for _ in range(n):
@@ -1021,6 +1240,8 @@ def generate(seed: int, n_mutations: int | None = None, source: str | None = Non
             note = "not applicable here"
         m.kinds.append(kind)
         m.notes.append(f"{kind}: {note}")
+    if not extreme and n:
+        m.capped = _fast(m)
     text = m.header + dumps(m.doc)
     data = text.encode(m.encoding, errors="replace")
     for op in m.byte_ops:

@@ -4,9 +4,12 @@ A case is the mutant of one seed (``mutants.mutant``), written as bytes into a f
 temporary directory that becomes the working directory, then run
 
 * in-process: ``pam2exu.run(path)`` (the file's own analysis) and ``pam2exu.run(path,
-  analysis=<another one, drawn from the seed>)``, warnings suppressed;
+  analysis=<another one, drawn from the seed>)``, warnings suppressed (another dynamic
+  analysis over ``OTHER_SETTINGS``' short interval, another clearance analysis in few steps);
 * for a fraction of the seeds, through the command line, in-process: ``pam2exu.cli.main``
-  with ``run``, ``check``, ``run -o out.csv`` and, rarely, ``draw -o x.png``.
+  with ``run``, ``check``, ``run -o out.csv`` and, for some, one of ``EXTRA_RUNS``
+  (``-o out.xlsx``, ``-o out.parquet``, ``--at``, ``--energy``, ``--angles deg``); rarely
+  ``draw -o x.png``, with ``--vectors``, ``--ic``, ``--guess`` or ``--t``.
 
 The contract, for every call: a success whose Results hold only finite values and whose CSV
 (``Results.to_csv``) reads back bit for bit with ``pam2exu.read_csv``; or a ``Pam2ExuError``
@@ -33,9 +36,16 @@ Pam2ExuError), or a fault, whose class is one of
   worker killed when it did not answer within the limit and a margin);
 * ``crash``: the worker process died (a segmentation fault, ``os._exit``, …).
 
+An Excel or Parquet file written must read back (openpyxl, pyarrow) with finite values.
+
 Command line (from the repository's root)::
 
     python -m tests.fuzz.runner --count 10000 --workers 2 --seed 0 [--report out.md]
+
+``--extreme`` makes the mutants with ``mutants.generate(..., extreme=True)``: valid values
+a run may take long on (tolerances down to 5e-324, initial rates up to 1e12, a dynamic run
+over up to 1e7 s) stay, so hangs there say what the analyses do with them; the fast
+campaign (the default, and CI's) caps them.
 """
 from __future__ import annotations
 
@@ -63,11 +73,26 @@ import numpy as np
 
 from .mutants import generate
 
-ANALYSES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
+ANALYSES = ("assembly", "quasi_static", "kinematic", "kinetostatic", "clearance",
+            "equilibrium", "dynamic")
+#: the other analysis's settings where they would make a case slow (a dynamic run's work
+#: grows with its interval, a clearance run's with its steps)
+OTHER_SETTINGS = {"dynamic": {"t_end": 0.01, "steps": 5}, "clearance": {"steps": 10}}
 #: fraction of the cases also run through the command line (run, check, run -o out.csv)
 CLI_FRACTION = 0.25
+#: fraction of the command line cases that also run one of EXTRA_RUNS
+EXTRA_FRACTION = 0.3
+#: the command line's other outputs (run MODEL …)
+EXTRA_RUNS = (["-o", "out.xlsx"], ["-o", "out.parquet"], ["--at", "0"], ["--at", "0.37", "0"],
+              ["--at", "-1"], ["--at", "1e300"], ["--energy", "energy.png"],
+              ["--angles", "deg"], ["--angles", "deg", "-o", "out.csv"])
+#: the options whose argument is a file the command line is asked to write
+WRITES = ("-o", "--energy")
 #: fraction of the cases also drawn (draw -o x.png)
 DRAW_FRACTION = 0.03
+#: what a drawing may show besides the configuration at t = 0
+DRAW_OPTIONS = ([], ["--vectors", "v"], ["--vectors", "a"], ["--vectors", "F"], ["--ic"],
+                ["--guess"], ["--t", "0.3"], ["--t", "0.3", "--vectors", "F", "--ic"])
 #: time limit of one case [s], and the margin after which a silent worker is killed
 TIMEOUT = 20.0
 MARGIN = 10.0
@@ -175,6 +200,12 @@ def _pam2exu_error(exc, via) -> str:
     return ""
 
 
+def _settings_args(analysis: str) -> list[str]:
+    """The command line options of ``OTHER_SETTINGS[analysis]``."""
+    return [a for k, v in OTHER_SETTINGS.get(analysis, {}).items()
+            for a in (f"--{k.replace('_', '-')}", str(v))]
+
+
 def plan(seed: int) -> tuple[str, list[list[str]]]:
     """The other analysis of a case, and its command lines (with ``MODEL`` for the file)."""
     r = random.Random(f"case-{seed}")
@@ -183,10 +214,13 @@ def plan(seed: int) -> tuple[str, list[list[str]]]:
     if r.random() < CLI_FRACTION:
         out = ["run", "MODEL", "-o", "out.csv"]
         if r.random() < 0.5:
-            out += ["-a", r.choice(ANALYSES)]
+            analysis = r.choice(ANALYSES)
+            out += ["-a", analysis, *_settings_args(analysis)]
         commands += [["run", "MODEL"], ["check", "MODEL"], out]
+        if r.random() < EXTRA_FRACTION:
+            commands.append(["run", "MODEL", *r.choice(EXTRA_RUNS)])
     if r.random() < DRAW_FRACTION:
-        commands.append(["draw", "MODEL", "-o", "x.png"])
+        commands.append(["draw", "MODEL", "-o", "x.png", *r.choice(DRAW_OPTIONS)])
     return other, commands
 
 
@@ -231,15 +265,44 @@ def _check_results(res, via, scratch) -> None:
         raise _Fault("csv", via, f"values differ: {what}", sub="values differ")
 
 
+def _check_table_file(path, via) -> None:
+    """An Excel or Parquet file of ``run -o`` reads back (openpyxl, pyarrow) with finite
+    numbers in its table (an Excel workbook's first sheet: names, units, then the rows)."""
+    try:
+        if path.endswith(".parquet"):
+            import pyarrow.parquet as pq
+            table = pq.read_table(path)
+            data = np.column_stack([np.asarray(c, dtype=float) for c in table.columns]) \
+                if table.num_columns else np.zeros((0, 0))
+        else:
+            import openpyxl
+            book = openpyxl.load_workbook(path, read_only=True)
+            try:
+                rows = list(book.worksheets[0].iter_rows(values_only=True))
+            finally:
+                book.close()
+            data = np.array([list(row) for row in rows[2:]], dtype=float)
+    except CaseTimeout:
+        raise
+    except BaseException as exc:     # noqa: BLE001
+        raise _Fault("cli output", via, f"{path} does not read back: {type(exc).__name__}: "
+                     f"{_cut(exc)}", _detail(exc), sub=f"{type(exc).__name__} reading {path}")
+    if data.size == 0 or not np.isfinite(data).all():
+        raise _Fault("non-finite", via, f"{path} holds no values or NaN/inf values",
+                     sub=Path(path).suffix)
+
+
 def _api_call(name, analysis, scratch) -> tuple[bool, str]:
     """One in-process run: (True, '') when it ran, (False, foreign cause or '') for a clean
     error; _Fault otherwise."""
     import pam2exu
-    via = f"pam2exu.run(path, analysis={analysis!r})"
+    settings = OTHER_SETTINGS.get(analysis, {})
+    via = f"pam2exu.run(path, analysis={analysis!r}" + "".join(
+        f", {k}={v!r}" for k, v in settings.items()) + ")"
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            res = pam2exu.run(name, analysis=analysis)
+            res = pam2exu.run(name, analysis=analysis, **settings)
     except CaseTimeout:
         raise
     except pam2exu.Pam2ExuError as exc:
@@ -277,11 +340,15 @@ def _cli(argv, scratch) -> bool:
     if escaped is not None:
         raise _exception_fault(escaped, via)
     if code == 0:
+        if "--energy" in argv and not os.path.isfile(argv[argv.index("--energy") + 1]):
+            raise _Fault("cli output", via, "exit 0 but the --energy figure was not written")
         if "-o" in argv:
             out = argv[argv.index("-o") + 1]
             if not os.path.isfile(out):
                 raise _Fault("cli output", via, f"exit 0 but {out} was not written")
-            if argv[0] == "run":
+            if argv[0] == "run" and not out.endswith(".csv"):
+                _check_table_file(out, via)
+            elif argv[0] == "run":
                 try:
                     back = pam2exu.read_csv(out)
                 except CaseTimeout:
@@ -314,22 +381,24 @@ def _on_alarm(signum, frame):
 
 
 def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = None,
-             cli: bool | None = None) -> Outcome:
+             cli: bool | None = None, extreme: bool = False) -> Outcome:
     """Run the case of ``seed`` in this process and classify it (see the module docstring).
 
     ``timeout``: seconds before SIGALRM interrupts the case (main thread only; None: no
     limit). ``n_mutations``: passed to ``mutants.generate`` (0: the unchanged model).
     ``cli``: True/False to force the command line runs on or off (None: as planned).
+    ``extreme``: passed to ``mutants.generate`` (valid values a run may take long on kept).
     """
     try:
-        m = generate(seed, n_mutations)
+        m = generate(seed, n_mutations, extreme=extreme)
     except Exception as exc:         # noqa: BLE001 - a fault of the generator itself
         return Outcome(seed, "fault", f"generator {type(exc).__name__} at {location(exc)}",
                        via="mutants.generate", message=f"{type(exc).__name__}: {_cut(exc)}",
                        detail=_detail(exc))
     other, commands = plan(seed)
-    if cli is True and not commands:
-        commands = [["run", "MODEL"], ["check", "MODEL"], ["run", "MODEL", "-o", "out.csv"]]
+    if cli is True and not any(c[0] == "check" for c in commands):
+        commands = [["run", "MODEL"], ["check", "MODEL"], ["run", "MODEL", "-o", "out.csv"],
+                    *commands]
     elif cli is False:
         commands = []
     outcome = Outcome(seed, description=m.description, kinds=list(m.kinds))
@@ -361,8 +430,12 @@ def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = 
                     outcome.status = "success" if ran else "clean error"
             for command in commands:
                 argv = [m.name if a == "MODEL" else a for a in command]
-                if "-o" in argv:
-                    allowed.add(argv[argv.index("-o") + 1])
+                for flag in WRITES:
+                    if flag in argv:
+                        allowed.add(argv[argv.index(flag) + 1])
+                if "-o" in argv and argv[argv.index("-o") + 1].endswith(".csv"):
+                    # a clearance run's extremes, beside its CSV (shared/spec/clearance.md)
+                    allowed.add(argv[argv.index("-o") + 1][:-4] + ".extremes.csv")
                 step = "pam2exu " + " ".join(argv)
                 outcome.successes += _cli(argv, scratch)
                 outcome.calls += 1
@@ -399,7 +472,7 @@ def _vm_size() -> int:
         return 0
 
 
-def _worker(conn, timeout: float, memory: int | None) -> None:
+def _worker(conn, timeout: float, memory: int | None, extreme: bool = False) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if memory:
         _soft, hard = resource.getrlimit(resource.RLIMIT_AS)
@@ -415,7 +488,7 @@ def _worker(conn, timeout: float, memory: int | None) -> None:
             break
         if seed is None:
             break
-        outcome = run_case(seed, timeout)
+        outcome = run_case(seed, timeout, extreme=extreme)
         conn.send(dataclasses.asdict(outcome))
         if outcome.fault == "hang":        # interrupted anywhere: start afresh
             break
@@ -423,9 +496,10 @@ def _worker(conn, timeout: float, memory: int | None) -> None:
 
 
 class _Worker:
-    def __init__(self, ctx, timeout, memory):
+    def __init__(self, ctx, timeout, memory, extreme=False):
         self.conn, child = ctx.Pipe()
-        self.proc = ctx.Process(target=_worker, args=(child, timeout, memory), daemon=True)
+        self.proc = ctx.Process(target=_worker, args=(child, timeout, memory, extreme),
+                                daemon=True)
         self.proc.start()
         child.close()
         self.seed = None
@@ -535,7 +609,8 @@ class Campaign:
 
 
 def campaign(count: int, workers: int = 2, seed: int = 0, timeout: float = TIMEOUT,
-             margin: float = MARGIN, memory: int | None = MEMORY, progress=None) -> Campaign:
+             margin: float = MARGIN, memory: int | None = MEMORY, progress=None,
+             extreme: bool = False) -> Campaign:
     """Run the cases of seeds ``seed`` … ``seed + count - 1`` on ``workers`` processes.
 
     Each worker (forked, with pam2exu imported) runs cases in-process with a SIGALRM limit of
@@ -543,17 +618,18 @@ def campaign(count: int, workers: int = 2, seed: int = 0, timeout: float = TIMEO
     the case recorded as a hang, one that dies as a crash; either is replaced and the campaign
     goes on. ``memory``: bytes of address space a worker may add (RLIMIT_AS), so that absurd
     allocations end in MemoryError. ``progress(done, campaign)`` is called after each case.
+    ``extreme``: the mutants of ``generate(..., extreme=True)`` (see the module's doc).
     """
     ctx = mp.get_context("fork")
     result = Campaign(count, seed, workers)
     start = time.monotonic()
     seeds = list(range(seed, seed + count))
     seeds.reverse()
-    pool = [_Worker(ctx, timeout, memory) for _ in range(max(1, min(workers, count)))]
+    pool = [_Worker(ctx, timeout, memory, extreme) for _ in range(max(1, min(workers, count)))]
 
     def lost(w, fault, message, sub):
         try:
-            m = generate(w.seed)
+            m = generate(w.seed, extreme=extreme)
             description, kinds = m.description, list(m.kinds)
         except Exception as exc:     # noqa: BLE001 - reported by run_case's outcome
             description, kinds = f"(no mutant: {type(exc).__name__})", []
@@ -594,7 +670,7 @@ def campaign(count: int, workers: int = 2, seed: int = 0, timeout: float = TIMEO
                     progress(done, result)
                 if replace:
                     w.kill()
-                    pool[i] = _Worker(ctx, timeout, memory)
+                    pool[i] = _Worker(ctx, timeout, memory, extreme)
                 else:
                     w.seed = None
     finally:
@@ -624,9 +700,12 @@ def main(argv=None) -> int:
     p.add_argument("--jsonl", metavar="OUT.jsonl", help="write every outcome, one JSON a line")
     p.add_argument("--case", type=int, metavar="SEED",
                    help="run one case in this process and print its outcome")
+    p.add_argument("--extreme", action="store_true",
+                   help="keep valid values a run may take long on (tolerances down to "
+                        "5e-324, rates up to 1e12, …) instead of capping them")
     args = p.parse_args(argv)
     if args.case is not None:
-        outcome = run_case(args.case, args.timeout)
+        outcome = run_case(args.case, args.timeout, extreme=args.extreme)
         for k, v in dataclasses.asdict(outcome).items():
             print(f"{k}: {v}")
         return 0 if outcome.status != "fault" else 1
@@ -637,7 +716,8 @@ def main(argv=None) -> int:
             end = "\r" if tty and done != args.count else "\n"
             print(f"{done}/{args.count} mutants, {result.n_faults} faults", end=end,
                   file=sys.stderr, flush=True)
-    result = campaign(args.count, args.workers, args.seed, args.timeout, progress=progress)
+    result = campaign(args.count, args.workers, args.seed, args.timeout, progress=progress,
+                      extreme=args.extreme)
     print(result.summary())
     if args.jsonl:
         import json

@@ -14,8 +14,11 @@ from . import runner
 from .mutants import KINDS, SOURCES, dumps, generate, mutant, source_doc
 
 #: the CI campaign: seeds CI_SEED … CI_SEED + CI_COUNT - 1 on 2 workers: about 25 s on two
-#: cores when no case hangs (about 30 ms per mutant per worker); each hang adds up to 20 s
-CI_SEED, CI_COUNT = 0, 1500
+#: cores when no case hangs, within the 30 s of 1,500 mutants before the extensions' seeds
+#: (clearance, equilibrium, dynamic and degrees models, and those analyses as the other one,
+#: make a mutant about 2.3 times as long: 1,500 took 69 s, 500 take 25 s); each hang adds
+#: up to 20 s
+CI_SEED, CI_COUNT = 0, 500
 LONG_COUNT = 10_000
 
 
@@ -78,7 +81,7 @@ def test_unchanged_model_is_classified_success(source):
     expected = "clean error" if source.endswith("every_element.toml") else "success"
     # every_element.toml does not assemble (it is for Jacobians at arbitrary poses)
     assert (outcome.status, outcome.fault) == (expected, ""), outcome
-    assert outcome.calls == 5
+    assert outcome.calls >= 5          # 2 in-process, run, check, run -o out.csv, …
 
 
 def _patched_case(monkeypatch, fake, timeout=None):
