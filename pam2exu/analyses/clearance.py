@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import MobilityError, ModelError, SolverError
 from ..kinematics import PER_SOLID, State
 from ..model.solid import LineRef
+from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect
 from .least_norm import RANK, Closure, applicability, follow, lagrange_jacobian, time_rate
 from .native import target_values
@@ -40,7 +41,10 @@ def clearance(job: Job):
     mech = job.mech
     mob = check_mobility(job, mech.initial_q(), need_driven=False)
     job.warnings.extend(str(p) for p in mech.model.warnings())
-    q0 = assemble(job, redundant=mob.redundant > 0)
+    # an undriven degree of freedom: the assembly nearest the guess (the guess springs of
+    # ``assembly``), so that condition (ii) below names the free solids
+    q0 = assemble(job, redundant=mob.redundant > 0,
+                  anchor_stiffness=GUESS_STIFFNESS if mob.dof else 0.0)
     closures = Closures(mech, q0)
     p, nq, m = closures.p, closures.nq, closures.m
     t0 = float(job.times[0])

@@ -199,6 +199,18 @@ def test_an_undriven_mechanism_fails_condition_ii_naming_its_solids(request):
     assert "'ground'" not in text
 
 
+def test_a_clearance_run_of_an_undriven_model_names_its_free_solids():
+    """Through pam2exu.run (found by the fuzz suite): the assembly nearest the guess, then
+    condition (ii) naming the free solids (before, the static solver's failure to assemble
+    an undriven model stopped it, naming none)."""
+    path = pam2exu.__file__.replace("pam2exu/__init__.py",
+                                    "examples/equilibrium/spring_four_bar.toml")
+    with pytest.raises(pam2exu.MobilityError,
+                       match=r"^t=0: condition \(ii\) fails: .*the solids 'crank', "
+                             r"'coupler', 'rocker' are left free"):
+        pam2exu.run(path, analysis="clearance", steps=4)
+
+
 def test_a_lost_strict_minimum_stops_the_run_at_its_time():
     """Item 3 of the contract: a reduced Hessian with a non-positive eigenvalue (here W =
     −5 I on a closure with a one-dimensional kernel where the δq part dominates) is a
