@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import ModelError, SolverError
 from ..kinematics import State, pose
-from . import force_pass, native
+from . import force_pass, free, native
 from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect, warn
 from .kinetostatic import kinetostatic
@@ -282,22 +282,16 @@ def project(mech, t, q, qd):
 def require_inertia(mech, t: float, q: np.ndarray) -> None:
     """ModelError naming the solids of a free motion that moves no mass and no inertia
     (Zᵀ M Z singular, Z a basis of the motions the constraints allow)."""
-    st = State([t], q[None])
-    J = native.equations(mech, st).jacobian[0]
-    _, sv, Vt = np.linalg.svd(J)
-    rank = int(np.sum(sv > 1e-9 * sv[0])) if sv.size else 0
-    Z = Vt[rank:].T
+    Z = free.free_motions(mech, t, q)              # angles scaled by the length scale
     if Z.shape[1] == 0:
         return
     scale = np.tile([1.0, 1.0, mech.scale()], len(mech.solids))
-    M = mass_matrix(mech, st)[0] / np.outer(scale, scale)
-    values, vectors = np.linalg.eigh(Z.T @ (M * np.outer(scale, scale)) @ Z)
+    M = mass_matrix(mech, State([t], q[None]))[0] / np.outer(scale, scale)
+    values, vectors = np.linalg.eigh(Z.T @ M @ Z)
     size = max(float(np.max(np.abs(M))), np.finfo(float).tiny)
     if values[0] > 1e-12 * size:
         return
-    mode = Z @ vectors[:, 0]
-    moved = [s.name for i, s in enumerate(mech.solids)
-             if np.max(np.abs(mode[pose(i)] * scale[pose(i)])) > 1e-6 * np.max(np.abs(mode * scale))]
+    moved = free.moving_solids(mech, Z @ vectors[:, :1])
     raise ModelError(
         f"a free motion of the solids {', '.join(repr(n) for n in moved)} moves no mass and "
         "no inertia, so its acceleration is not defined: give those solids a mass or an "

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..kinematics import State, column
-from . import force_pass, native
+from ..kinematics import State
+from . import force_pass, free
 from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect, warn
 from .positions import assemble, check_residual
@@ -48,7 +48,7 @@ class Stability:
     so that every entry is in N/m)."""
 
     eigenvalues: np.ndarray     # ascending, of the symmetric part of K_r
-    modes: np.ndarray           # (nq, k): the modes, in x, y, fi of every solid
+    modes: np.ndarray           # (nq, k): the modes, in x, y and L·fi of every solid
     size: float                 # the largest |entry| of the full stiffness, for NEUTRAL
 
     @property
@@ -94,7 +94,8 @@ def equilibrium(job: Job):
         warn(job, f"the equilibrium found is {kind}: the smallest eigenvalue of the reduced "
                   f"tangent stiffness is {stability.smallest:.3g} N/m (angles scaled by the "
                   f"length scale {mech.scale():g} m); its mode moves the solids "
-                  f"{_moved(mech, stability.modes[:, 0])}. Start from a guess off it, on "
+                  f"{_quoted(free.moving_solids(mech, stability.modes[:, :1]))}. "
+                  "Start from a guess off it, on "
                   "the side of the stable configuration you expect", StabilityWarning)
     check_residual(mech, job.times, q[None], job)
     job.stage = "computing the reactions (static equilibrium)"
@@ -169,13 +170,10 @@ def reduced_stiffness(mech, t: float, q: np.ndarray, lam: np.ndarray) -> Stabili
     K = -_load_stiffness(mech, t, q) - _constraint_curvature(mech, t, q, lam)
     K = K / np.outer(scale, scale)                       # in the scaled coordinates
     K = 0.5 * (K + K.T)
-    J = native.equations(mech, State([t], q[None])).jacobian[0] / scale
-    _, s, Vt = np.linalg.svd(J)
-    rank = int(np.sum(s > 1e-9 * s[0])) if s.size else 0
-    Z = Vt[rank:].T
+    Z = free.free_motions(mech, t, q)
     values, vectors = np.linalg.eigh(Z.T @ K @ Z)
     size = max(float(np.max(np.abs(K), initial=0.0)), np.finfo(float).tiny)
-    return Stability(values, (Z @ vectors) / scale[:, None], size)
+    return Stability(values, Z @ vectors, size)
 
 
 def _load_stiffness(mech, t: float, q: np.ndarray) -> np.ndarray:
@@ -198,12 +196,8 @@ def _constraint_curvature(mech, t: float, q: np.ndarray, lam: np.ndarray) -> np.
     return W[0]
 
 
-def _moved(mech, mode: np.ndarray) -> str:
-    """The solids a mode moves, quoted, largest first."""
-    size = np.array([np.max(np.abs(mode[[column(i, 0), column(i, 1)]])) +
-                     mech.scale() * abs(mode[column(i, 2)]) for i in range(len(mech.solids))])
-    order = [i for i in np.argsort(-size) if size[i] > 1e-6 * np.max(size)]
-    return ", ".join(f"'{mech.solids[i].name}'" for i in order)
+def _quoted(names: list[str]) -> str:
+    return ", ".join(f"'{n}'" for n in names)
 
 
 def _no_equilibrium(job, mob, error) -> ModelError:
