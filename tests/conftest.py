@@ -64,6 +64,31 @@ def pytest_addoption(parser):
     parser.addoption("--fuzz-long", action="store_true", default=False,
                      help="tests/fuzz: run the long fuzz campaign (10,000 mutants) instead of "
                           "the CI one")
+    parser.addoption("--long", action="store_true", default=False,
+                     help="also run the long tests (marked 'long': long runs and sweeps, "
+                          "minutes each on two cores), skipped by default")
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "long(backends=None): a long run or sweep, run only with --long; with "
+                   "backends=(...), only its cases on those backends (every_backend) are long")
+
+
+def pytest_collection_modifyitems(config, items):
+    """Skip the tests marked ``long`` (or their cases on the backends the marker names)
+    unless ``--long`` is given."""
+    if config.getoption("--long"):
+        return
+    skip = pytest.mark.skip(reason="a long test: run with --long")
+    for item in items:
+        mark = item.get_closest_marker("long")
+        if mark is None:
+            continue
+        backends = mark.kwargs.get("backends")
+        params = getattr(getattr(item, "callspec", None), "params", {})
+        if backends is None or params.get("every_backend") in backends:
+            item.add_marker(skip)
 
 
 @pytest.fixture(params=list(pam2exu.registry.BACKENDS))

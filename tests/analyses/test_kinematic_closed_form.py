@@ -311,7 +311,12 @@ def test_fixed_axis_gears_with_ground_as_arm():
     assert_matches(res, ref, L=0.1, w=float(np.max(np.abs(df))) * abs(T12))
 
 
-@pytest.mark.parametrize("size, turns", [(1.0, 60), (0.01, 1), (0.01, 60)],
+#: 60 turns take 11 s on the natural backend (2 cores): --long (one turn stays in CI)
+SIXTY_TURNS = pytest.mark.long(backends=("natural",))
+
+
+@pytest.mark.parametrize("size, turns", [pytest.param(1.0, 60, marks=SIXTY_TURNS), (0.01, 1),
+                                         pytest.param(0.01, 60, marks=SIXTY_TURNS)],
                          ids=["60_turns", "centimetre_gears", "centimetre_gears_60_turns"])
 def test_gear_pair_many_turns(size, turns):
     """Angles are never wrapped, so after many turns the angle equations add up terms of

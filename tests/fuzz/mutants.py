@@ -56,11 +56,15 @@ SOURCE_SETTINGS = {
 
 #: the analyses whose work grows with the interval and the steps beyond the others'
 SLOW_TYPES = ("dynamic", "dinamica", "clearance", "joc")
-#: the fast campaign's caps (``generate(..., extreme=False)``): a dynamic run over at most
-#: DYNAMIC_T_END s in at most DYNAMIC_STEPS steps, a clearance run in at most
-#: CLEARANCE_STEPS steps, a tolerance in TOLERANCE_RANGE and initial rates of at most
-#: RATE_LIMIT (a dynamic run's steps grow as the rates, the interval and 1/tolerance^(1/3))
-DYNAMIC_T_END, DYNAMIC_STEPS, CLEARANCE_STEPS = 0.01, 10, 20
+#: the fast campaign's caps (``generate(..., extreme=False)``), which bound each case's work
+#: (not its time): a dynamic run over at most DYNAMIC_T_END s in at most DYNAMIC_STEPS steps,
+#: a clearance run over at most CLEARANCE_T_END s in at most CLEARANCE_STEPS steps, a
+#: tolerance in TOLERANCE_RANGE and initial rates of at most RATE_LIMIT (a dynamic run's steps
+#: grow as the rates, the interval and 1/tolerance^(1/3); a clearance run's integration steps
+#: grow as the motion over its interval: all_elements.toml over its 1 s takes ~1,750
+#: evaluations of the least-norm right-hand side, ~30 s, over 0.05 s ~2 s)
+DYNAMIC_T_END, DYNAMIC_STEPS = 0.01, 10
+CLEARANCE_T_END, CLEARANCE_STEPS = 0.05, 20
 TOLERANCE_RANGE = (1e-8, 1e-3)
 RATE_LIMIT = 100.0
 
@@ -1139,6 +1143,17 @@ def m_angles(rng, m):
     return f"[model] angles = {short(new)}"
 
 
+#: [analysis] backend values: mostly the natural backend (the second formulation, which must
+#: solve what Exudyn solves), and names a user may get wrong
+BACKEND_VALUES = ("natural", "natural", "natural", "exudyn", "Natural", "nat", "", 3, ["natural"])
+
+
+def m_backend(rng, m):
+    new = copy.deepcopy(rng.choice(BACKEND_VALUES))
+    _analysis(m.doc)["backend"] = new
+    return f"[analysis] backend = {short(new)}"
+
+
 def _fast(m) -> list[str]:
     """The fast campaign's caps on the mutant's valid numbers (``SLOW_TYPES``'s interval and
     steps, the tolerance, the initial rates); the notes of what changed."""
@@ -1151,7 +1166,7 @@ def _fast(m) -> list[str]:
         if kind in ("dynamic", "dinamica"):
             caps = [("t_end", DYNAMIC_T_END), ("steps", DYNAMIC_STEPS)]
         elif kind in ("clearance", "joc"):
-            caps = [("steps", CLEARANCE_STEPS)]
+            caps = [("t_end", CLEARANCE_T_END), ("steps", CLEARANCE_STEPS)]
         for key, cap in caps:
             v = an.get(key)                   # missing: the defaults, 1 s in 100 steps
             valid = _is_number(v) and v <= (1e9 if key == "t_end" else 10**7)
@@ -1209,6 +1224,7 @@ KINDS = {
     "clearance": m_clearance,
     "variation": m_variation,
     "angles": m_angles,
+    "backend": m_backend,
 }
 #: how often each kind is drawn, relative to 1 (byte-level kinds hide the others' effects)
 WEIGHTS = {"broken_toml": 0.5, "encoding": 0.3, "file_name": 0.5, "deep_nesting": 0.6}

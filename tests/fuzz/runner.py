@@ -4,12 +4,15 @@ A case is the mutant of one seed (``mutants.mutant``), written as bytes into a f
 temporary directory that becomes the working directory, then run
 
 * in-process: ``pam2exu.run(path)`` (the file's own analysis) and ``pam2exu.run(path,
-  analysis=<another one, drawn from the seed>)``, warnings suppressed (another dynamic
-  analysis over ``OTHER_SETTINGS``' short interval, another clearance analysis in few steps);
+  analysis=<another one, drawn from the seed>)``, for ``NATURAL_FRACTION`` of the seeds on
+  the natural backend, warnings suppressed (another dynamic or clearance analysis over
+  ``OTHER_SETTINGS``' short interval in few steps);
 * for a fraction of the seeds, through the command line, in-process: ``pam2exu.cli.main``
   with ``run``, ``check``, ``run -o out.csv`` and, for some, one of ``EXTRA_RUNS``
-  (``-o out.xlsx``, ``-o out.parquet``, ``--at``, ``--energy``, ``--angles deg``); rarely
-  ``draw -o x.png``, with ``--vectors``, ``--ic``, ``--guess`` or ``--t``.
+  (``-o out.xlsx``, ``-o out.parquet``, ``--at``, ``--energy``, ``--angles deg``,
+  ``--backend natural``) and one of ``NEWER_COMMANDS`` (``verify``, ``export``, ``plot``,
+  ``run --plot``, on short runs); rarely ``draw -o x.png``, with ``--vectors``, ``--ic``,
+  ``--guess`` or ``--t``.
 
 The contract, for every call: a success whose Results hold only finite values and whose CSV
 (``Results.to_csv``) reads back bit for bit with ``pam2exu.read_csv``; or a ``Pam2ExuError``
@@ -32,7 +35,10 @@ Pam2ExuError), or a fault, whose class is one of
 * ``non-finite``: a Results table with NaN or infinite values;
 * ``csv``: the CSV does not read back identical (or cannot be written or read);
 * ``stray file``: a file left in the working directory;
-* ``hang``: the case did not finish within the time limit (interrupted by SIGALRM, or the
+* ``verify differs``: ``pam2exu verify`` ran both backends and they differ beyond the
+  tolerance it derives (the two formulations disagree on the mutant);
+* ``hang``: the case did not finish within the hang guard (``TIMEOUT``, far above any case's
+  work; interrupted by SIGALRM, or the
   worker killed when it did not answer within the limit and a margin);
 * ``crash``: the worker process died (a segmentation fault, ``os._exit``, …).
 
@@ -71,13 +77,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .mutants import generate
+from .mutants import CLEARANCE_T_END, DYNAMIC_STEPS, DYNAMIC_T_END, generate
 
 ANALYSES = ("assembly", "quasi_static", "kinematic", "kinetostatic", "clearance",
             "equilibrium", "dynamic")
-#: the other analysis's settings where they would make a case slow (a dynamic run's work
-#: grows with its interval, a clearance run's with its steps)
-OTHER_SETTINGS = {"dynamic": {"t_end": 0.01, "steps": 5}, "clearance": {"steps": 10}}
+#: the other analysis's settings where they would make a case long (a dynamic run's work
+#: grows with its interval and steps, a clearance run's with its interval and steps): the
+#: fast campaign's caps (mutants.py), so that no case's work depends on its source's interval
+OTHER_SETTINGS = {"dynamic": {"t_end": DYNAMIC_T_END, "steps": DYNAMIC_STEPS // 2},
+                  "clearance": {"t_end": CLEARANCE_T_END, "steps": 10}}
 #: fraction of the cases also run through the command line (run, check, run -o out.csv)
 CLI_FRACTION = 0.25
 #: fraction of the command line cases that also run one of EXTRA_RUNS
@@ -85,17 +93,35 @@ EXTRA_FRACTION = 0.3
 #: the command line's other outputs (run MODEL …)
 EXTRA_RUNS = (["-o", "out.xlsx"], ["-o", "out.parquet"], ["--at", "0"], ["--at", "0.37", "0"],
               ["--at", "-1"], ["--at", "1e300"], ["--energy", "energy.png"],
-              ["--angles", "deg"], ["--angles", "deg", "-o", "out.csv"])
+              ["--angles", "deg"], ["--angles", "deg", "-o", "out.csv"],
+              ["--backend", "natural"], ["--backend", "natural", "-o", "out.csv"])
 #: the options whose argument is a file the command line is asked to write
-WRITES = ("-o", "--energy")
+WRITES = ("-o", "--energy", "--plot-file")
+#: fraction of the cases whose other analysis runs on the natural backend
+NATURAL_FRACTION = 0.3
+#: fraction of the command line cases that also run one of NEWER_COMMANDS
+NEWER_FRACTION = 0.35
+#: the newer commands, on short runs (their work bounded like the other analysis's); plot
+#: reads the CSV of the case's ``run MODEL -o out.csv``
+SHORT = ["--t-end", str(DYNAMIC_T_END), "--steps", str(DYNAMIC_STEPS // 2)]
+NEWER_COMMANDS = (["verify", "MODEL", *SHORT], ["verify", "MODEL", "-a", "kinematic"],
+                  ["export", "MODEL", "-o", "script.py", *SHORT],
+                  ["export", "MODEL", "-o", "script.py", "--forces"],
+                  ["plot", "out.csv", "*.fi", "-o", "p.png"],
+                  ["plot", "out.csv", "Fx", "--x", "t", "-o", "p.svg"],
+                  ["run", "MODEL", "--plot", "*.fi", "--plot-file", "p.png", *SHORT])
 #: fraction of the cases also drawn (draw -o x.png)
 DRAW_FRACTION = 0.03
 #: what a drawing may show besides the configuration at t = 0
 DRAW_OPTIONS = ([], ["--vectors", "v"], ["--vectors", "a"], ["--vectors", "F"], ["--ic"],
                 ["--guess"], ["--t", "0.3"], ["--t", "0.3", "--vectors", "F", "--ic"])
-#: time limit of one case [s], and the margin after which a silent worker is killed
-TIMEOUT = 20.0
-MARGIN = 10.0
+#: the hang guard: a case still running after TIMEOUT s is interrupted and reported as a
+#: hang, a worker silent for TIMEOUT + MARGIN s is killed. It aborts a true hang only and
+#: decides nothing else: the fast campaign bounds each case's work by its caps (mutants.py),
+#: and its slowest case takes ~10 s on an idle 2-core machine (~25 s with the machine
+#: loaded), so the guard sits ~60x above the slowest legitimate case
+TIMEOUT = 600.0
+MARGIN = 60.0
 #: address space a worker may use beyond what it has when it starts [bytes]
 MEMORY = 3 * 2**30
 
@@ -206,10 +232,12 @@ def _settings_args(analysis: str) -> list[str]:
             for a in (f"--{k.replace('_', '-')}", str(v))]
 
 
-def plan(seed: int) -> tuple[str, list[list[str]]]:
-    """The other analysis of a case, and its command lines (with ``MODEL`` for the file)."""
+def plan(seed: int) -> tuple[str, str | None, list[list[str]]]:
+    """The other analysis of a case, the backend it runs on (None: the file's), and the
+    case's command lines (with ``MODEL`` for the file)."""
     r = random.Random(f"case-{seed}")
     other = r.choice(ANALYSES)
+    backend = "natural" if r.random() < NATURAL_FRACTION else None
     commands = []
     if r.random() < CLI_FRACTION:
         out = ["run", "MODEL", "-o", "out.csv"]
@@ -219,9 +247,11 @@ def plan(seed: int) -> tuple[str, list[list[str]]]:
         commands += [["run", "MODEL"], ["check", "MODEL"], out]
         if r.random() < EXTRA_FRACTION:
             commands.append(["run", "MODEL", *r.choice(EXTRA_RUNS)])
+        if r.random() < NEWER_FRACTION:
+            commands.append(list(r.choice(NEWER_COMMANDS)))
     if r.random() < DRAW_FRACTION:
         commands.append(["draw", "MODEL", "-o", "x.png", *r.choice(DRAW_OPTIONS)])
-    return other, commands
+    return other, backend, commands
 
 
 def _check_results(res, via, scratch) -> None:
@@ -292,11 +322,13 @@ def _check_table_file(path, via) -> None:
                      sub=Path(path).suffix)
 
 
-def _api_call(name, analysis, scratch) -> tuple[bool, str]:
+def _api_call(name, analysis, scratch, backend=None) -> tuple[bool, str]:
     """One in-process run: (True, '') when it ran, (False, foreign cause or '') for a clean
     error; _Fault otherwise."""
     import pam2exu
-    settings = OTHER_SETTINGS.get(analysis, {})
+    settings = dict(OTHER_SETTINGS.get(analysis, {}))
+    if backend is not None:
+        settings["backend"] = backend
     via = f"pam2exu.run(path, analysis={analysis!r}" + "".join(
         f", {k}={v!r}" for k, v in settings.items()) + ")"
     try:
@@ -314,6 +346,11 @@ def _api_call(name, analysis, scratch) -> tuple[bool, str]:
 
 
 def _cli_call(argv) -> tuple[int | None, str, BaseException | None]:
+    code, err, escaped, _out = _cli_call_out(argv)
+    return code, err, escaped
+
+
+def _cli_call_out(argv) -> tuple[int | None, str, BaseException | None, str]:
     from pam2exu.cli import main
     out, err = io.StringIO(), io.StringIO()
     code, escaped = None, None
@@ -329,24 +366,39 @@ def _cli_call(argv) -> tuple[int | None, str, BaseException | None]:
         err.write(f"\n[SystemExit({exc.code!r})]")
     except BaseException as exc:     # noqa: BLE001
         escaped = exc
-    return code, err.getvalue(), escaped
+    return code, err.getvalue(), escaped, out.getvalue()
 
 
 def _cli(argv, scratch) -> bool:
     """One command line run: True for exit 0, False for a clean error; _Fault otherwise."""
     import pam2exu
     via = "pam2exu " + " ".join(argv)
-    code, err, escaped = _cli_call(argv)
+    code, err, escaped, out_text = _cli_call_out(argv)
     if escaped is not None:
         raise _exception_fault(escaped, via)
+    if argv[0] == "verify" and code == 1 and not err.startswith("pam2exu: "):
+        # both runs ran and the two formulations differ: the finding verify exists for
+        differ = [line for line in out_text.splitlines() if "differ" in line.lower()]
+        raise _Fault("verify differs", via, _cut(" / ".join(differ[:3]) or out_text, 400),
+                     sub=" ".join(argv[2:]) or "model's analysis")
     if code == 0:
-        if "--energy" in argv and not os.path.isfile(argv[argv.index("--energy") + 1]):
-            raise _Fault("cli output", via, "exit 0 but the --energy figure was not written")
+        for flag in ("--energy", "--plot-file"):
+            if flag in argv and not os.path.isfile(argv[argv.index(flag) + 1]):
+                raise _Fault("cli output", via, f"exit 0 but the {flag} figure was not written")
         if "-o" in argv:
             out = argv[argv.index("-o") + 1]
             if not os.path.isfile(out):
                 raise _Fault("cli output", via, f"exit 0 but {out} was not written")
-            if argv[0] == "run" and not out.endswith(".csv"):
+            if argv[0] == "export":
+                try:
+                    with open(out, encoding="utf-8") as fh:
+                        compile(fh.read(), out, "exec")
+                except CaseTimeout:
+                    raise
+                except BaseException as exc:     # noqa: BLE001
+                    raise _Fault("cli output", via, f"the exported script does not compile: "
+                                 f"{type(exc).__name__}: {_cut(exc)}", sub="export")
+            elif argv[0] == "run" and not out.endswith(".csv"):
                 _check_table_file(out, via)
             elif argv[0] == "run":
                 try:
@@ -395,7 +447,7 @@ def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = 
         return Outcome(seed, "fault", f"generator {type(exc).__name__} at {location(exc)}",
                        via="mutants.generate", message=f"{type(exc).__name__}: {_cut(exc)}",
                        detail=_detail(exc))
-    other, commands = plan(seed)
+    other, backend, commands = plan(seed)
     if cli is True and not any(c[0] == "check" for c in commands):
         commands = [["run", "MODEL"], ["check", "MODEL"], ["run", "MODEL", "-o", "out.csv"],
                     *commands]
@@ -420,9 +472,9 @@ def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = 
             signal.setitimer(signal.ITIMER_REAL, timeout)
             armed = True
         try:
-            for k, analysis in enumerate((None, other)):
-                step = f"pam2exu.run(path, analysis={analysis!r})"
-                ran, cause = _api_call(m.name, analysis, scratch)
+            for k, (analysis, on) in enumerate(((None, None), (other, backend))):
+                step = f"pam2exu.run(path, analysis={analysis!r}, backend={on!r})"
+                ran, cause = _api_call(m.name, analysis, scratch, on)
                 outcome.cause = outcome.cause or cause
                 outcome.calls += 1
                 outcome.successes += ran
@@ -450,7 +502,8 @@ def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = 
         outcome.message, outcome.detail, outcome.sub = f.message, f.detail, f.sub
     except CaseTimeout as exc:
         outcome.status, outcome.fault, outcome.via = "fault", "hang", step
-        outcome.message = f"interrupted after {timeout} s at {location(exc)}"
+        outcome.message = (f"no result after {timeout:g} s, the hang guard, far above any "
+                           f"case's work: a hang, interrupted at {location(exc)}")
         outcome.detail, outcome.sub = _detail(exc), "interrupted"
     except BaseException as exc:     # noqa: BLE001 - a fault of the runner itself
         outcome.status, outcome.fault, outcome.via = "fault", f"runner {type(exc).__name__}", step
