@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from .elements import ALIASES, ELEMENTS, FORCE, Element
+from .elements.base import Param
 from .errors import closest
 from .laws import LAW_ALIASES, LAWS
 from .model.solid import SOLID_OUTPUTS
@@ -68,6 +69,27 @@ def _default(cls: type[Element], key: str) -> str:
     return f"`{value!r}`".replace("'", '"')
 
 
+def values(param: Param) -> list[str]:
+    """The strings a key of ``param``'s kind takes, as a model file writes them: a choice's
+    choices, a law's names and Catalan aliases ([] for the other kinds)."""
+    if param.kind == "choice":
+        return list(param.choices)
+    if param.kind == "law":
+        return [*LAWS, *LAW_ALIASES]
+    return []
+
+
+def _what_to_write(param: Param) -> str:
+    """A key's meaning, then the values it takes, each as TOML writes it (`"solid"`)."""
+    if param.kind == "law":
+        aliases = {law: alias for alias, law in LAW_ALIASES.items()}
+        return param.meaning + ": " + ", ".join(
+            f'`"{n}"`' + (f' (or `"{aliases[n]}"`)' if n in aliases else "") for n in LAWS)
+    if param.kind == "choice":
+        return param.meaning + ": " + " or ".join(f'`"{c}"`' for c in param.choices)
+    return param.meaning
+
+
 def _analyses(level: str, owner: str = "element") -> str:
     """The analyses giving a variable of ``level`` (``registry.analyses_giving``)."""
     return ", ".join(analyses_giving(level, owner))
@@ -97,13 +119,14 @@ def element_markdown(cls: type[Element], level: int = 3, anchor: bool = True) ->
     lines = [f'<a id="{cls.type}"></a>', ""] if anchor else []
     lines += [f"{'#' * level} `{cls.type}`{alias}", "", cls.summary[0].upper() + cls.summary[1:]
               + ".", ""]
-    keys = [("type", f'`"{cls.type}"` (or `"{cls.alias}"`)', "required"),
+    or_alias = f' (or `"{cls.alias}"`)' if cls.alias != cls.type else ""
+    keys = [("type", f'`"{cls.type}"`{or_alias}', "required"),
             ("name", "unique name", f"`{cls.type}<n>`")]
     for k in range(len(cls.anchors)):
         keys.append((f"anc{k + 1}", f"{anchor_meaning(cls, k)}: {_ANCHOR_FORMS[cls.anchors[k]]}",
                      "required"))
     for key, param in cls.params.items():
-        keys.append((key, param.meaning, _default(cls, key)))
+        keys.append((key, _what_to_write(param), _default(cls, key)))
     lines += _table(("key", "what to write", "default"),
                     ((f"`{k}`", m, d) for k, m, d in keys))
     lines.append("")
