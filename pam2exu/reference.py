@@ -69,24 +69,15 @@ def _default(cls: type[Element], key: str) -> str:
     return f"`{value!r}`".replace("'", '"')
 
 
-def values(param: Param) -> list[str]:
-    """The strings a key of ``param``'s kind takes, as a model file writes them: a choice's
-    choices, a law's names and Catalan aliases ([] for the other kinds)."""
-    if param.kind == "choice":
-        return list(param.choices)
-    if param.kind == "law":
-        return [*LAWS, *LAW_ALIASES]
-    return []
-
-
 def _what_to_write(param: Param) -> str:
-    """A key's meaning, then the values it takes, each as TOML writes it (`"solid"`)."""
+    """A key's meaning, then the values it takes (``Param.values``), each as TOML writes it:
+    a law's names with their Catalan aliases, a choice's choices."""
     if param.kind == "law":
         aliases = {law: alias for alias, law in LAW_ALIASES.items()}
         return param.meaning + ": " + ", ".join(
             f'`"{n}"`' + (f' (or `"{aliases[n]}"`)' if n in aliases else "") for n in LAWS)
-    if param.kind == "choice":
-        return param.meaning + ": " + " or ".join(f'`"{c}"`' for c in param.choices)
+    if param.values():
+        return param.meaning + ": " + " or ".join(f'`"{c}"`' for c in param.values())
     return param.meaning
 
 
