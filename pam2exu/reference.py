@@ -103,13 +103,19 @@ def _table(header: tuple[str, ...], rows) -> list[str]:
     return lines
 
 
+def _sentence(text: str) -> str:
+    """``text`` as a sentence: a leading word capitalised (not a formula's symbol, 'fi2'),
+    a full stop at the end."""
+    word = text.split(" ", 1)[0]
+    return (text[:1].upper() + text[1:] if word.isalpha() else text) + "."
+
+
 def element_markdown(cls: type[Element], level: int = 3, anchor: bool = True) -> str:
     """One element's section: what it does, its keys, its equations and its outputs
     (``anchor``: with an HTML anchor named after the type, for links within a page)."""
     alias = f" [`{cls.alias}`]" if cls.alias != cls.type else ""
     lines = [f'<a id="{cls.type}"></a>', ""] if anchor else []
-    lines += [f"{'#' * level} `{cls.type}`{alias}", "", cls.summary[0].upper() + cls.summary[1:]
-              + ".", ""]
+    lines += [f"{'#' * level} `{cls.type}`{alias}", "", _sentence(cls.summary), ""]
     or_alias = f' (or `"{cls.alias}"`)' if cls.alias != cls.type else ""
     keys = [("type", f'`"{cls.type}"`{or_alias}', "required"),
             ("name", "unique name", f"`{cls.type}<n>`")]
