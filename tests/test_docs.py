@@ -10,6 +10,7 @@
   values of the keys that take names (analysis types, backends, angle units, laws, choices).
   A key added to the loader without docs, or documented but refused, fails here.
 """
+import ast
 import re
 from pathlib import Path
 
@@ -38,6 +39,31 @@ def test_no_mention_of_shared(path):
     text = path.read_text(encoding="utf-8")
     lines = [n for n, line in enumerate(text.splitlines(), 1) if "shared/" in line]
     assert not lines, f"{path.relative_to(ROOT)} mentions shared/ at lines {lines}"
+
+
+def _strings(source: str) -> list[tuple[int, str]]:
+    """(line, text) of every string constant of a module that is not a docstring: its
+    messages, help texts and summaries (docstrings reach users through docs/api.md)."""
+    tree = ast.parse(source)
+    docstrings = {id(node.body[0].value) for node in ast.walk(tree)
+                  if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef,
+                                       ast.AsyncFunctionDef))
+                  and node.body and isinstance(node.body[0], ast.Expr)
+                  and isinstance(node.body[0].value, ast.Constant)}
+    return [(node.lineno, node.value) for node in ast.walk(tree)
+            if isinstance(node, ast.Constant) and isinstance(node.value, str)
+            and id(node) not in docstrings]
+
+
+def test_no_message_of_the_package_mentions_shared():
+    """What the package prints (errors, warnings, help texts) sends no one to shared/."""
+    found = [f"{path.relative_to(ROOT)}:{line}"
+             for path in sorted((ROOT / "pam2exu").rglob("*.py"))
+             for line, text in _strings(path.read_text(encoding="utf-8")) if "shared/" in text]
+    assert not found, found
+    # a message split over two literals is one string; a docstring is not a message
+    assert _strings('"""shared/ doc."""\nx = f"a {1} (shared/" "spec)"\n') == [
+        (2, "a "), (2, " (shared/spec)")]
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(ROOT)))
