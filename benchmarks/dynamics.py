@@ -12,7 +12,7 @@ achieved against a reference computed without pam2exu, the estimate pam2exu repo
 (``res.info["integration_error"]``), its step count (``res.info["integration_steps"]``: Exudyn's
 fixed steps of its finest run, the natural backend's adaptive steps of its finest run), and
 whether an ``AccuracyWarning`` was issued. A run that raises is a row too, with its message.
-Errors are measured as the tolerance is defined (shared/spec/dynamics.md): the largest
+Errors are measured as the tolerance is defined (docs/model-format.md): the largest
 |value − reference| / (1 + |reference|) over coordinates and rates.
 
 - **pendulum**: a free compound pendulum (m 2 kg, d 0.25 m, I_G 0.02 kg·m², g 9.81), let go

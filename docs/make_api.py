@@ -210,8 +210,8 @@ def element_docstring(cls) -> str:
             kind = _KINDS.get(spec.kind, spec.kind)
             if spec.kind == "constants":
                 kind += f" (at most {spec.size})"
-            if spec.kind == "choice":
-                kind += ", one of " + ", ".join(repr(c) for c in spec.choices)
+            if spec.values():
+                kind += ", one of " + ", ".join(repr(c) for c in spec.values())
             default = "" if spec.required or p.default is None else \
                 f" Default ``{_default(p.default)}``."
             law = next((v for v in cls.outputs if v.name == "f(t)"), None)

@@ -297,7 +297,7 @@ class VariationWarning(UserWarning):
 
     Issued once per model when it is validated (``load``, ``loads``, ``Model.validate``,
     ``Model.mechanism``), naming the entry and its anchor; ``Model.warnings()`` lists the
-    same texts. Variations are read by the clearance analysis only (shared/spec/clearance.md).
+    same texts. Variations are read by the clearance analysis only (docs/clearance.md).
 
     Parameters
     ----------

@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from .elements import ALIASES, ELEMENTS, FORCE, Element
+from .elements.base import Param
 from .errors import closest
 from .laws import LAW_ALIASES, LAWS
 from .model.solid import SOLID_OUTPUTS
@@ -68,6 +69,18 @@ def _default(cls: type[Element], key: str) -> str:
     return f"`{value!r}`".replace("'", '"')
 
 
+def _what_to_write(param: Param) -> str:
+    """A key's meaning, then the values it takes (``Param.values``), each as TOML writes it:
+    a law's names with their Catalan aliases, a choice's choices."""
+    if param.kind == "law":
+        aliases = {law: alias for alias, law in LAW_ALIASES.items()}
+        return param.meaning + ": " + ", ".join(
+            f'`"{n}"`' + (f' (or `"{aliases[n]}"`)' if n in aliases else "") for n in LAWS)
+    if param.values():
+        return param.meaning + ": " + " or ".join(f'`"{c}"`' for c in param.values())
+    return param.meaning
+
+
 def _analyses(level: str, owner: str = "element") -> str:
     """The analyses giving a variable of ``level`` (``registry.analyses_giving``)."""
     return ", ".join(analyses_giving(level, owner))
@@ -90,20 +103,27 @@ def _table(header: tuple[str, ...], rows) -> list[str]:
     return lines
 
 
+def _sentence(text: str) -> str:
+    """``text`` as a sentence: a leading word capitalised (not a formula's symbol, 'fi2'),
+    a full stop at the end."""
+    word = text.split(" ", 1)[0]
+    return (text[:1].upper() + text[1:] if word.isalpha() else text) + "."
+
+
 def element_markdown(cls: type[Element], level: int = 3, anchor: bool = True) -> str:
     """One element's section: what it does, its keys, its equations and its outputs
     (``anchor``: with an HTML anchor named after the type, for links within a page)."""
     alias = f" [`{cls.alias}`]" if cls.alias != cls.type else ""
     lines = [f'<a id="{cls.type}"></a>', ""] if anchor else []
-    lines += [f"{'#' * level} `{cls.type}`{alias}", "", cls.summary[0].upper() + cls.summary[1:]
-              + ".", ""]
-    keys = [("type", f'`"{cls.type}"` (or `"{cls.alias}"`)', "required"),
+    lines += [f"{'#' * level} `{cls.type}`{alias}", "", _sentence(cls.summary), ""]
+    or_alias = f' (or `"{cls.alias}"`)' if cls.alias != cls.type else ""
+    keys = [("type", f'`"{cls.type}"`{or_alias}', "required"),
             ("name", "unique name", f"`{cls.type}<n>`")]
     for k in range(len(cls.anchors)):
         keys.append((f"anc{k + 1}", f"{anchor_meaning(cls, k)}: {_ANCHOR_FORMS[cls.anchors[k]]}",
                      "required"))
     for key, param in cls.params.items():
-        keys.append((key, param.meaning, _default(cls, key)))
+        keys.append((key, _what_to_write(param), _default(cls, key)))
     lines += _table(("key", "what to write", "default"),
                     ((f"`{k}`", m, d) for k, m, d in keys))
     lines.append("")

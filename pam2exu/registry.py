@@ -106,16 +106,15 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("clearance", "joc", frozenset({POSITION, CLEARANCE}), driven=False,
                  at_start=False,
                  summary="the clearance of least norm of an over-constrained mechanism as "
-                 "its dimensions vary (shared/spec/clearance.md)",
+                 "its dimensions vary",
                  function="pam2exu.analyses.clearance:clearance", element_outputs=False),
     AnalysisType("equilibrium", "equilibri", frozenset({POSITION, FORCE}), driven=False,
                  at_start=True,
-                 summary="the free degrees of freedom in stable static equilibrium at t = 0 "
-                 "(shared/spec/dynamics.md)",
+                 summary="the free degrees of freedom in stable static equilibrium at t = 0",
                  function="pam2exu.analyses.equilibrium:equilibrium"),
     AnalysisType("dynamic", "dinamica", _ALL, driven=False, at_start=False,
                  summary="forward dynamics: the free degrees of freedom move under the "
-                 "loads, to [analysis] tolerance (shared/spec/dynamics.md)",
+                 "loads, to [analysis] tolerance",
                  function="pam2exu.analyses.dynamic:dynamic"),
 )}
 

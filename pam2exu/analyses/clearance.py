@@ -102,8 +102,8 @@ def _warn_far_from_first_order(job, closures, j, rows, redundant):
             f"{closures.names[col]} departs from its first-order estimate by "
             f"{gap[rows.index(k), col]:.3g} (more than half its largest magnitude) from "
             f"t = {job.times[k]:.6g} s: the variations are too large for the linear picture, "
-            "or a singular position of the nominal mechanism is near (shared/spec/"
-            "clearance.md, 'Scope')")
+            "or a singular position of the nominal mechanism is near (docs/clearance.md, "
+            "'When the method applies')")
 
 
 class Closures:

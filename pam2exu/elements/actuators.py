@@ -6,10 +6,10 @@ from typing import Any
 
 import numpy as np
 
-from ..laws import LAWS, Law
+from ..laws import Law
 from .base import FORCE, POSITION, VELOCITY, Actuator, Param, Var
 
-_LAW = Param("law", "time law: " + ", ".join(LAWS))
+_LAW = Param("law", "time law")
 _C = Param("constants", "constants C1…C4 of the law")
 
 

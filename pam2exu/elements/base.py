@@ -57,6 +57,15 @@ class Param:
     #: (pam2exu/model/angles.py converts them once, to radians)
     angles: tuple[bool, ...] = ()
 
+    def values(self) -> tuple[str, ...]:
+        """The strings the key takes, as a model file writes them: a choice's choices, a
+        law's names and PAM's Catalan aliases; () for the other kinds."""
+        if self.kind == "choice":
+            return tuple(self.choices)
+        if self.kind == "law":
+            return (*LAWS, *LAW_ALIASES)
+        return ()
+
     def problem(self, key: str, value: Any) -> str | None:
         if value is None:
             return f"'{key}' is required ({self.meaning})" if self.required else None

@@ -1,4 +1,4 @@
-"""Reading a model file (TOML, the format of shared/spec/model-format.md)."""
+"""Reading a model file (TOML, the format of docs/model-format.md)."""
 from __future__ import annotations
 
 import tomllib

@@ -48,8 +48,8 @@ class Analysis:
         lists the backends).
     tolerance : float
         Accuracy required of the ``dynamic`` analysis's time integration: its error at
-        most tolerance · (1 + |value|) on every coordinate and rate, SI units
-        (shared/spec/dynamics.md); 0 < tolerance ≤ 1e-2 [-]. Other analyses ignore it.
+        most tolerance · (1 + |value|) on every coordinate and rate, SI units;
+        0 < tolerance ≤ 1e-2 [-]. Other analyses ignore it.
 
     Examples
     --------

@@ -36,8 +36,8 @@ class Solid:
         Centre of mass G in the local frame [m].
     Dx, Dy, Dfi : float
         Initial-velocity guess of the ``dynamic`` analysis: the rates of x, y [m/s] and
-        fi [rad/s] at t = 0 (shared/spec/dynamics.md); the velocities nearest to them that
-        satisfy the velocity equations are used. Default 0.
+        fi [rad/s] at t = 0; the velocities nearest to them that satisfy the velocity
+        equations are used. Default 0.
     points : dict
         ``{name: [x, y]}`` in the local frame [m]; anchors ``"<solid>.<point>"``.
     lines : dict
@@ -69,7 +69,7 @@ class Solid:
     Dy: float = 0.0
     Dfi: float = 0.0
 
-    #: keys beyond the contract's [[solid]] table (shared/spec/dynamics.md)
+    #: keys beyond the contract's [[solid]] table (forward dynamics; docs/model-format.md)
     EXTENSIONS: ClassVar[tuple[str, ...]] = ("Dx", "Dy", "Dfi")
     #: 1-based position in the file's [[solid]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False)
@@ -204,6 +204,10 @@ class Scope:
         return getattr(self, kind)(text)
 
 
+#: the keys of a line of a solid's ``lines`` table: its defining point and its angle
+LINE_KEYS = ("point", "angle")
+
+
 def _pair(v) -> bool:
     return isinstance(v, (list, tuple)) and len(v) == 2 and all(is_number(x) for x in v)
 
@@ -270,8 +274,8 @@ def solid_problems(s: Solid, degrees: bool = False) -> list[str]:
             out.append(f"line '{name}' must be {{ point = [x, y], angle = a }}, got {line!r}")
             continue
         for key in line:
-            if key not in ("point", "angle"):
-                out.append(f"line '{name}' has an unknown key '{key}'{closest(key, ('point', 'angle'))}")
+            if key not in LINE_KEYS:
+                out.append(f"line '{name}' has an unknown key '{key}'{closest(key, LINE_KEYS)}")
         if "point" in line and not _pair(line["point"]):
             out.append(f"line '{name}': point must be [x, y], got {line['point']!r}")
         elif "point" in line:
