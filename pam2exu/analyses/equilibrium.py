@@ -1,10 +1,11 @@
 """Static equilibrium with free degrees of freedom (shared/spec/dynamics.md, ``equilibrium``).
 
 The actuators hold their laws' values at t = 0; the free degrees of freedom settle where
-gravity, the torsors and the springs (without their damper terms) balance. Exudyn's static
-solver finds the configuration, with the masses and force elements in the model, from the
-assembled guess; the native pass gives the reactions and checks them; the equilibrium must
-be stable: on the constraint manifold the reduced tangent stiffness
+gravity, the torsors and the springs (without their damper terms) balance. The backend's
+static equilibrium (``Backend.static_equilibrium``: Exudyn's static solver with the masses
+and force elements, or Newton on the natural coordinates' equilibrium) finds the
+configuration from the assembled guess; the native pass gives the reactions and checks
+them; the equilibrium must be stable: on the constraint manifold the reduced tangent stiffness
 
     K_r = Zᵀ (−∂Q/∂q − Σ_i λ_i ∂²C_i/∂q²) Z,   Z an orthonormal basis of ker C_q,
 
@@ -18,6 +19,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kinematics import State
+from ..registry import BACKENDS, resolve
 from . import force_pass, free
 from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect, warn
@@ -66,9 +68,9 @@ def equilibrium(job: Job):
 
     A fully driven model gives the first row of ``quasi_static``. Otherwise, from the
     assembly nearest to the guess (``assemble``, with the guess springs of ``assembly``),
-    the potential energy is descended by proximal steps (``descend``), each one solved by
-    the backend's static solver with the forces; then the same solver without the
-    proximal springs gives the equilibrium exactly. Not stable (``reduced_stiffness``):
+    the potential energy is descended by proximal steps (``descend``), each one the
+    backend's ``static_equilibrium`` with springs tying the solids to the last step; then
+    the same without the springs gives the equilibrium exactly. Not stable (``reduced_stiffness``):
     a ``StabilityWarning``. No equilibrium: a ModelError naming the free solids.
     """
     mech = job.mech
@@ -76,11 +78,12 @@ def equilibrium(job: Job):
     if mob.dof == 0:
         return quasi_static(job)
     if not job.backend.moves_free_solids:
+        able = [name for name, b in BACKENDS.items() if resolve(b.implementation).moves_free_solids]
         raise ModelError(
             f"the {job.backend.name} backend cannot solve a static equilibrium with free "
             f"degrees of freedom (the solids {', '.join(repr(n) for n in mob.free_solids)} "
-            "are free): run the equilibrium analysis on the exudyn backend "
-            "(backend = \"exudyn\", --backend exudyn)")
+            f"are free): run the equilibrium analysis on the {' or '.join(able)} backend "
+            f"(backend = \"{able[0]}\", --backend {able[0]})")
     redundant = mob.redundant > 0
     start = assemble(job, redundant, GUESS_STIFFNESS)
     job.stage = f"descending the potential energy with {job.backend.solver_name}"
@@ -108,32 +111,32 @@ def descend(job: Job, start: np.ndarray, redundant: bool):
     energy (q None, with the solver's last message, when there is none).
 
     Proximal steps q_(n+1) = argmin V(q) + ½ k |q − q_n|² on the constraints (angles scaled
-    by the length scale), each one the backend's static solver with the forces and
-    springs of stiffness k tying q to q_n (``anchor_stiffness``): for k above the largest
+    by the length scale), each one the backend's ``static_equilibrium`` with springs of
+    stiffness k tying q to q_n (``anchor_stiffness``): for k above the largest
     negative curvature each step is a strictly convex problem whose solution lowers V, so
     the descent does not stop on an unstable equilibrium it does not start exactly on.
     k halves after each step solved and doubles after a failure. Once a step moves less
-    than ``NEWTON_FROM`` of the length scale, the static solver without the springs is
-    tried: its equilibrium is taken when it lies as near (Newton did not jump to another
+    than ``NEWTON_FROM`` of the length scale, the static equilibrium without the springs
+    is tried: its equilibrium is taken when it lies as near (Newton did not jump to another
     branch), is stable and its V is not above the step's, else the descent goes on. A
     step that does not move at all starts on an equilibrium: that one is taken, stable or
     not (``equilibrium`` warns).
     """
-    mech, t, times = job.mech, float(job.times[0]), job.times[:1]
+    mech, t = job.mech, float(job.times[0])
     scale = np.tile([mech.scale(), mech.scale(), 1.0], len(mech.solids))
     k = _initial_stiffness(mech, t, start)
     q, error = start, None
     for _ in range(DESCENT_STEPS):
-        found = job.backend.solve_positions(mech, times, q, job.solver, redundant=redundant,
-                                            forces=True, anchor_stiffness=k)
+        found = job.backend.static_equilibrium(mech, t, q, job.solver, redundant=redundant,
+                                               anchor_stiffness=k)
         if not found.solved:
             k, error = 2.0 * k, found.error
             continue
         step = float(np.max(np.abs(found.q[0] - q) / scale))
         q, k = found.q[0], 0.5 * k
         if step <= NEWTON_FROM:
-            exact = job.backend.solve_positions(mech, times, q, job.solver,
-                                                redundant=redundant, forces=True)
+            exact = job.backend.static_equilibrium(mech, t, q, job.solver,
+                                                   redundant=redundant)
             if exact.solved:
                 qe, lam = exact.q[0], exact.multipliers[0]
                 near = float(np.max(np.abs(qe - q) / scale)) <= NEWTON_FROM

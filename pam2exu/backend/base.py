@@ -68,9 +68,9 @@ class Backend(Protocol):
     gives_rates : bool
         ``solve_positions(..., rates=True)`` returns velocities and accelerations too.
     moves_free_solids : bool
-        ``solve_positions(..., forces=True)`` moves the free degrees of freedom to a static
-        equilibrium (the ``equilibrium`` analysis needs it; otherwise it only gives the
-        multipliers at positions the constraints fix).
+        It has ``static_equilibrium``, which moves the free degrees of freedom to a static
+        equilibrium (the ``equilibrium`` analysis needs it, and refuses free degrees of
+        freedom on a backend without).
     integrates : bool
         It integrates the equations of motion (``dynamic``), by one of two methods:
         ``integrate(mech, times, q0, qd0, substeps, verbose)`` with a fixed step
@@ -116,5 +116,54 @@ class Backend(Protocol):
             the guess; the equilibrium's descent steps).
         rates : bool
             Also return ``Positions.qd`` and ``qdd`` (ignored unless ``gives_rates``).
+        """
+        ...
+
+    def static_equilibrium(self, mech, t: float, start: np.ndarray, settings, *,
+                           redundant: bool = False,
+                           anchor_stiffness: float = 0.0) -> Positions:
+        """A static equilibrium at time t, the free degrees of freedom moved to it from
+        ``start`` (only with ``moves_free_solids``): what the ``equilibrium`` analysis's
+        descent calls (``analyses.equilibrium.descend``).
+
+        The answer q satisfies the constraints C(q, t) = 0 (the actuators at their laws'
+        values at t), and the loads (gravity, the torsors, the springs without their
+        dampers) and, if ``anchor_stiffness`` k > 0, springs tying every moving solid's
+        x, y, fi to their values in ``start`` (stiffness k on x and y [N/m], k L² on fi
+        [N·m/rad], L = ``mech.scale()``) do no virtual work on any motion the constraints
+        allow: q is a stationary point of
+
+            V(q) + ½ k Σ_solids [(x − x_s)² + (y − y_s)² + L² (fi − fi_s)²]
+
+        on C(q, t) = 0, V the potential energy of the loads. Newton's iteration (or any
+        method that converges to the stationary point nearest ``start``; it need not be a
+        minimum) to the backend's tolerance. A ``start`` that already is such a point
+        (Newton's first step within the tolerance) is returned as it is, bit for bit: the
+        descent takes a step that does not move as the sign that it started on an
+        equilibrium.
+
+        Parameters
+        ----------
+        mech : Mechanism
+        t : float
+            The time [s].
+        start : numpy.ndarray
+            (nq,) x, y, fi of every solid where the iteration starts and the springs tie;
+            it satisfies the constraints at t.
+        settings
+            An instance of ``Settings``.
+        redundant : bool
+            The constraint Jacobian is rank deficient (consistent redundant constraints).
+        anchor_stiffness : float
+            k [N/m] (0: no springs, the equilibrium of the loads alone).
+
+        Returns
+        -------
+        Positions
+            One row: ``q`` (1, nq) the equilibrium with fi in the turn nearest ``start``
+            (NaN and ``solved`` 0 with the solver's ``error`` when it did not converge,
+            ``last`` where it stopped); ``multipliers`` (1, n_equations) λ in pam2exu's row
+            order with f + Cqᵀ λ = 0, f the loads and springs on x, y, fi (least norm where
+            constraints are redundant); ``iterations``.
         """
         ...

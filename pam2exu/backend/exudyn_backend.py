@@ -2,6 +2,8 @@
 Exudyn's static solver, one load step per time."""
 from __future__ import annotations
 
+import numpy as np
+
 from .base import Positions
 from .system import ExudynSystem, SolveSettings
 
@@ -31,6 +33,14 @@ class Exudyn:
         error = None if system.error is None else str(system.error)
         return Positions(q, solved, error, system.coordinates(), lam,
                          system.newton_iterations)
+
+    def static_equilibrium(self, mech, t, start, settings, *, redundant=False,
+                           anchor_stiffness=0.0) -> Positions:
+        """See ``Backend.static_equilibrium``: Exudyn's static solver with the masses,
+        gravity and force elements (``forces``) and the anchor springs, at t alone."""
+        return self.solve_positions(mech, np.array([float(t)]), start, settings,
+                                    redundant=redundant, forces=True,
+                                    anchor_stiffness=anchor_stiffness)
 
     def integrate(self, mech, times, q0, qd0, substeps, verbose=0):
         """``backend.integrate.integrate``: Exudyn's trapezoidal rule (``SolveDynamic``)

@@ -10,6 +10,9 @@ References, each computed here without pam2exu's code:
   minimize_scalar;
 - a pendulum exactly at its top warns (unstable), a torque larger than m g d is an error
   naming the lever, and a fully driven model gives the first row of quasi_static.
+
+Each test runs on each backend (``every_backend`` in conftest.py): Exudyn's static solver
+and Newton on the natural coordinates' equilibrium, with the same tolerances.
 """
 import math
 import warnings
@@ -24,6 +27,9 @@ from pam2exu.analyses import force_pass, native
 from pam2exu.analyses.equilibrium import StabilityWarning, reduced_stiffness
 from pam2exu.kinematics import State
 from references.pendulum import D, G, M, pendulum_toml
+
+#: each test runs on each backend (``every_backend`` in conftest.py)
+pytestmark = pytest.mark.usefixtures("every_backend")
 
 K = 20.0                           # the torsional spring's stiffness [N·m/rad]
 
@@ -181,7 +187,11 @@ def test_a_fully_driven_model_gives_the_first_row_of_quasi_static():
     np.testing.assert_array_equal(res.to_numpy()[0], first.to_numpy()[0])
 
 
-def test_the_natural_backend_refuses_free_solids_naming_them():
+def test_a_backend_without_a_static_equilibrium_refuses_free_solids_naming_them(monkeypatch):
+    """A backend that does not declare ``moves_free_solids`` is refused by name, and the
+    message names one that can (both shipped backends can: the flag is switched off)."""
+    from pam2exu.backend.natural import Natural
+    monkeypatch.setattr(Natural, "moves_free_solids", False)
     with pytest.raises(pam2exu.ModelError, match="natural backend cannot solve a static "
-                                                 "equilibrium.*'lever'"):
+                                                 "equilibrium.*'lever'.*on the exudyn backend"):
         pam2exu.run(lever(), backend="natural")

@@ -22,6 +22,7 @@ from .dynamics import motion
 from .loads import multipliers
 from .anchored import anchored
 from .solver import MAX_SUBSTEPS, NaturalSettings, Solver
+from .statics import Statics, pose_distance
 
 __all__ = ["Natural", "NaturalSettings", "Formulation", "Frame", "Coordinate"]
 
@@ -35,8 +36,9 @@ class Natural:
     Settings = NaturalSettings
     #: it can return velocities and accelerations with the positions
     gives_rates = True
-    #: no static equilibrium of free solids; their motion: ``motion`` (``dynamics``)
-    moves_free_solids = False
+    #: the static equilibrium of free solids: ``static_equilibrium`` (``statics``); their
+    #: motion: ``motion`` (``dynamics``)
+    moves_free_solids = True
     integrates = True
 
     def __init__(self):
@@ -100,19 +102,37 @@ class Natural:
     def _anchored(self, form, mech, t0, z_start, settings, w):
         """The assembly with free degrees of freedom: nearest the model's x, y, fi (the same
         distance as the Exudyn backend's springs: x, y in m, fi times the length scale)."""
-        K = form.pose_forms()
-        q0 = mech.initial_q()
-        L2 = mech.scale() ** 2
-        rows, target, weight = [], [], []
-        for i, f in enumerate(form.frames):
-            if i in form.grounds:
-                continue
-            x0, y0, fi0 = (q0[column(i, k)] for k in range(PER_SOLID))
-            rows += [K[4 * i], K[4 * i + 1], np.eye(form.nz + 1)[f.angle]]
-            target += [x0, y0, fi0]
-            weight += [1.0, 1.0, L2]
-        return anchored(form.terms, t0, z_start, np.array(rows), np.array(target),
-                        np.array(weight), settings, w)
+        rows, target, weight = pose_distance(form, mech, mech.initial_q())
+        return anchored(form.terms, t0, z_start, rows, target, weight, settings, w)
+
+    def static_equilibrium(self, mech, t, start, settings, *, redundant=False,
+                           anchor_stiffness=0.0) -> Positions:
+        """See ``Backend.static_equilibrium``: Newton's iteration on Q(z) − Φ_zᵀ λ = 0,
+        Φ(z, t) = 0 with the anchor springs (``statics``), in the formulation with every
+        angle; λ back in pam2exu's rows from the loads on x, y, fi (``loads.multipliers``)."""
+        start = np.asarray(start, dtype=float)
+        form = self.formulation(mech, all_angles=True)
+        w = self.weights(form, mech)
+        statics = Statics(form, mech, t, start, anchor_stiffness)
+        z0 = form.from_q(start)[0]
+        z, _, iterations, ok = statics.solve(z0, w, settings.tolerance,
+                                                    settings.max_iterations)
+        nan = np.full((1, mech.nq), np.nan)
+        if not ok:
+            last = self.to_q(form, mech, z[None], start)[0]
+            return Positions(nan, 0, f"Newton's iteration on the static equilibrium did not "
+                             f"converge at t = {t:.6g} s in {iterations} iterations",
+                             last if np.isfinite(last).all() else start,
+                             iterations=iterations)
+        q = start[None].copy() if np.array_equal(z, z0) else self.to_q(form, mech, z[None],
+                                                                          start)
+        extra = None
+        if anchor_stiffness:              # the springs' forces on x, y, fi: −k W (q − q_s)
+            moving = np.array([i not in form.grounds for i in range(len(mech.solids))])
+            scale = np.tile([1.0, 1.0, mech.scale() ** 2], len(mech.solids))
+            extra = -anchor_stiffness * scale * np.repeat(moving, PER_SOLID) * (q - start)
+        lam = multipliers(form, np.array([float(t)]), z[None], q, extra)
+        return Positions(q, 1, None, q[0], lam, iterations)
 
     def _failed(self, form, solver, t, z, settings) -> str:
         with np.errstate(all="ignore"):

@@ -110,15 +110,17 @@ class Loads:
         return out
 
 
-def multipliers(form, t: np.ndarray, z: np.ndarray, q: np.ndarray) -> np.ndarray:
+def multipliers(form, t: np.ndarray, z: np.ndarray, q: np.ndarray,
+                extra: np.ndarray | None = None) -> np.ndarray:
     """λ (n, m) in pam2exu's row order with Cqᵀ λ = −Q: the static equilibrium of gravity and
-    the force elements (no dampers), the forces taken from natural coordinates."""
+    the force elements (no dampers), the forces taken from natural coordinates, plus
+    ``extra`` (n, nq) on x, y, fi when given (the equilibrium's anchor springs)."""
     mech = form.mech
     loads = Loads(form, z, q)
     loads.gravity(mech.gravity)
     for el in mech.elements:
         el.natural_loads(loads)
-    Q = loads.on_pose()
+    Q = loads.on_pose() if extra is None else loads.on_pose() + extra
     st = State(t, q)
     J = np.zeros((len(t), mech.n_equations, mech.nq))
     for el, rows in zip(mech.constraints, mech.rows):
