@@ -34,6 +34,9 @@ STEP = 1e-6
 #: a descent step that moves less than this fraction of the length scale (and rad) is
 #: followed by the static solver without the proximal springs
 NEWTON_FROM = 1e-2
+#: a descent step that moves at most this fraction of the length scale (and rad) did not
+#: move: it started on an equilibrium (round-off of the backend's solve)
+STILL = 1e-12
 #: round-off allowed in comparing potential energies, relative
 ENERGY_ROUNDOFF = 1e-12
 #: the most proximal steps of the descent
@@ -119,7 +122,7 @@ def descend(job: Job, start: np.ndarray, redundant: bool):
     than ``NEWTON_FROM`` of the length scale, the static equilibrium without the springs
     is tried: its equilibrium is taken when it lies as near (Newton did not jump to another
     branch), is stable and its V is not above the step's, else the descent goes on. A
-    step that does not move at all starts on an equilibrium: that one is taken, stable or
+    step that does not move (``STILL``) starts on an equilibrium: that one is taken, stable or
     not (``equilibrium`` warns).
     """
     mech, t = job.mech, float(job.times[0])
@@ -142,7 +145,7 @@ def descend(job: Job, start: np.ndarray, redundant: bool):
                 near = float(np.max(np.abs(qe - q) / scale)) <= NEWTON_FROM
                 lower = potential(mech, t, qe) <= potential(mech, t, q) + ENERGY_ROUNDOFF * max(
                     1.0, abs(potential(mech, t, q)))
-                if near and (step == 0.0 or (lower and reduced_stiffness(mech, t, qe,
+                if near and (step <= STILL or (lower and reduced_stiffness(mech, t, qe,
                                                                          lam).stable)):
                     return qe, lam, None
             error = exact.error

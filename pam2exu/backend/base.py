@@ -138,9 +138,9 @@ class Backend(Protocol):
         on C(q, t) = 0, V the potential energy of the loads. Newton's iteration (or any
         method that converges to the stationary point nearest ``start``; it need not be a
         minimum) to the backend's tolerance. A ``start`` that already is such a point
-        (Newton's first step within the tolerance) is returned as it is, bit for bit: the
+        (Newton's first step within the tolerance) is returned unmoved, to round-off: the
         descent takes a step that does not move as the sign that it started on an
-        equilibrium.
+        equilibrium (``analyses.equilibrium.STILL``).
 
         Parameters
         ----------

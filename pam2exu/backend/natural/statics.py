@@ -39,6 +39,9 @@ LONGEST_STEP = 0.5
 #: a step at most this (in the weights of ``Natural.weights``) that no longer halves is
 #: round-off: the iteration has converged as far as the forces' round-off lets it
 ROUNDOFF_STEP = 1e-10
+#: an answer must balance to this, relative: |Φ| against the size of its terms, the loads
+#: the constraints do not balance (Q − Φ_zᵀ λ, λ of least squares) against the loads
+BALANCED = 1e-9
 
 
 class Statics:
@@ -124,15 +127,31 @@ class Statics:
             if not np.isfinite(step):
                 return z, lam, iteration, False
             if step <= tolerance:
-                return z, lam, iteration, True
+                return z, lam, iteration, self.balanced(z, J)
             if step <= ROUNDOFF_STEP and step > 0.5 * last:
-                return z + dz, lam, iteration, True
+                return z + dz, lam, iteration, self.balanced(z + dz)
             if step > last:                   # moving away again: diverging
                 return z, lam, iteration, False
             z = z + dz * min(1.0, LONGEST_STEP / step)
             if step <= LONGEST_STEP:
                 last = step
         return z, lam, iterations, False
+
+
+    def balanced(self, z: np.ndarray, J: np.ndarray | None = None) -> bool:
+        """Whether z is an answer (``BALANCED``): Newton's step also stops where the
+        equations are singular (a unit vector off its length, measured)."""
+        terms = self.terms
+        if J is None:
+            J = terms.dense(terms.jacobian(z[None]))[0]
+        phi = np.abs(terms.residual(self.t, z[None])[0])
+        size = terms.magnitude(self.t, z[None])[0]
+        force = self.balance(z)
+        lam = np.linalg.lstsq(J.T, force, rcond=1e-12)[0]
+        left = np.max(np.abs(force - J.T @ lam), initial=0.0)
+        return bool(np.all(phi <= BALANCED * size)
+                    and left <= BALANCED * max(np.max(np.abs(force), initial=0.0),
+                                               np.max(np.abs(J.T @ lam), initial=0.0)))
 
 
 def pose_distance(form, mech, target_q: np.ndarray):
