@@ -176,11 +176,3 @@ def test_cli_verify_dynamic_exits_0(capsys):
     assert code == 0, out
     assert "two time integrations, each within T = 1e-08" in out
     assert "AGREE: natural and exudyn agree" in out
-
-
-def test_equilibrium_still_refuses_free_solids_on_natural():
-    """Only the motion is integrated: the natural backend has no static equilibrium of free
-    solids (tests/analyses/test_equilibrium.py has the message)."""
-    model = pam2exu.load(FOUR_BAR)
-    with pytest.raises(pam2exu.ModelError, match="natural backend cannot solve a static"):
-        pam2exu.run(model, backend="natural")
