@@ -468,7 +468,8 @@ Multibody Systems*, 1994) and solves them with pam2exu's own Newton method. This
 explains that formulation on one worked example, the four-bar of
 [`examples/four_bar.toml`](../examples/four_bar.toml): its coordinates, its equations, their
 Jacobian, the exact acceleration terms and the constant mass matrix; then how every element
-type is converted, how x, y, fi come back, and how to read `pam2exu verify`.
+type is converted, how x, y, fi come back, the forward dynamics and the static equilibrium
+it solves (every analysis runs on this backend), and how to read `pam2exu verify`.
 
 Every table, equation and number below is generated from the code
 (`pam2exu/backend/natural/`, `Element.natural` of each element type) by
@@ -871,6 +872,28 @@ x, y, fi and rate; the finer one is kept. The analysis does the rest (law breakp
 impulses, accelerations, reactions), as for Exudyn, so `pam2exu verify MODEL -a dynamic`
 compares two independent integrations (rule in [verify.md](verify.md))."""
 
+STATICS = """\
+## Static equilibrium in natural coordinates
+
+The `equilibrium` analysis on this backend (`pam2exu/backend/natural/statics.py`) balances
+the same Q, at rest (no dampers), against the constraints:
+
+```text
+Q(z) − Φ_zᵀ λ = 0,   Φ(z, t) = 0            (a stationary point of V on Φ = 0: Q = −∂V/∂z)
+[H    Φ_zᵀ] [Δz]   [Q − k Aᵀ W g]
+[Φ_z  0   ] [λ ] = [−Φ          ],   H = −∂Q/∂z + k Aᵀ W A + Σ λ_i ∂²Φ_i/∂z²
+```
+
+Newton's iteration on these conditions, ∂Q/∂z by central differences and the constraints'
+curvature exact, is what the analysis's descent calls (`Backend.static_equilibrium`, the
+same call Exudyn's static solver answers): proximal steps with springs tying x, y, fi of
+every solid to the last step (k on x and y, k L² on fi; x, y, fi are A z + c when every
+solid has an angle coordinate, g = A z + c − q_s, W = diag(1, 1, L²)), then the equilibrium
+without them. The angles the torsional springs read are atan2 of each solid's vector, so Q
+is the exact gradient of −V everywhere in z. The analysis then checks stability with the
+reduced tangent stiffness in x, y, fi, as for Exudyn, so `pam2exu verify MODEL` on an
+equilibrium model compares two independent equilibria (rule in [verify.md](verify.md))."""
+
 VERIFY = """\
 ## Reading `pam2exu verify`
 
@@ -941,6 +964,7 @@ def render(w: Worked | None = None) -> str:
     out += _pose_section(w)
     out += _mass_formula_section()
     out += [DYNAMICS, ""]
+    out += [STATICS, ""]
     out += [VERIFY, ""]
     out += [SIDE.format(m=w.mech.n_equations, nq=w.mech.nq, nz=w.form.nz), ""]
     text = "\n".join(out)

@@ -174,6 +174,8 @@ def test_every_analysis_and_backend_of_the_registry_resolves():
     for b in registry.BACKENDS.values():
         backend = b.create()
         assert backend.name == b.name and hasattr(backend.Settings(), "tolerance")
+        if backend.moves_free_solids:        # the equilibrium analysis calls it
+            assert callable(getattr(backend, "static_equilibrium", None)), b.name
 
 
 # ---- docs/architecture.md stays true -----------------------------------------------------
