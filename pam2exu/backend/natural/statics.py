@@ -32,10 +32,12 @@ from .loads import Loads
 #: the central differences' step of ∂Q/∂z: points × the length scale, vectors and angles
 #: as they are
 STEP = 1e-6
-#: Newton's step is cut to at most this (in the weights of ``Natural.weights``: the length
-#: scale for points, a radian for angles): a step beyond the region where the equations
-#: are nearly quadratic only throws the iteration far from the answer
-LONGEST_STEP = 0.5
+#: Newton's step is cut so that no unit vector or angle coordinate moves by more than this
+#: [rad] (every moving solid has an angle coordinate here, so any solid's turn shows in
+#: them): the equations are nonlinear in the turns, and a longer one throws the iteration
+#: far from the answer; a translation is not cut (a free solid falling under its anchor
+#: springs is one step)
+LONGEST_TURN = 0.5
 #: a step at most this (in the weights of ``Natural.weights``) that no longer halves is
 #: round-off: the iteration has converged as far as the forces' round-off lets it
 ROUNDOFF_STEP = 1e-10
@@ -66,6 +68,10 @@ class Statics:
         self.start, self.k = np.asarray(start, dtype=float), float(stiffness)
         self.K = form.pose_forms()               # (x, y, cos, sin) per solid = K [z; 1]
         self.A, self.target, self.weight = pose_distance(form, mech, self.start)
+        # gravity acts at fixed points of the solids (a, b constant): its Q is constant
+        weight = Loads(form, np.zeros((1, form.nz)), np.zeros((1, mech.nq)))
+        weight.gravity(mech.gravity)
+        self.weight_forces = weight.on_coordinates()[0]
 
     def angles(self, z: np.ndarray) -> np.ndarray:
         """fi (n, solids) of configurations z (n, nz): atan2 of each solid's vector, in the
@@ -84,10 +90,9 @@ class Statics:
         q[:, column(solids, 0)], q[:, column(solids, 1)] = pose[:, 0::4], pose[:, 1::4]
         q[:, ANGLES] = self.angles(z)
         loads = Loads(self.form, z, q)
-        loads.gravity(self.mech.gravity)
         for el in self.mech.elements:
             el.natural_loads(loads)
-        return loads.on_coordinates()
+        return self.weight_forces + loads.on_coordinates()
 
     def balance(self, z: np.ndarray, h: np.ndarray | None = None):
         """Q − k Aᵀ W g (nz,): the loads and the springs on z; with steps h (nz,), also
@@ -107,11 +112,13 @@ class Statics:
 
     def solve(self, z: np.ndarray, w: np.ndarray, tolerance: float, iterations: int):
         """(z, λ, iterations, converged): Newton's iteration (module doc) from z, each step
-        (weighted by ``w``) cut to ``LONGEST_STEP``, until the step is at most
-        ``tolerance``, or at round-off, in at most ``iterations``. A step within the
+        cut to ``LONGEST_TURN``, until the step (weighted by ``w``) is at most
+        ``tolerance``, or at round-off, in at most ``iterations``; a step that is not cut
+        and is longer than the last one not cut stops it (diverging). A step within the
         tolerance is not taken: a start that already is an equilibrium is kept as it is."""
         terms, nz, m = self.terms, self.terms.nz, self.terms.m
         h = STEP / w
+        turning = np.array([c.kind != "point" for c in self.form.coordinates])
         J = terms.dense(terms.jacobian(z[None]))[0]
         lam = np.linalg.lstsq(J.T, self.balance(z), rcond=1e-12)[0]
         last = np.inf
@@ -132,8 +139,9 @@ class Statics:
                 return z + dz, lam, iteration, self.balanced(z + dz)
             if step > last:                   # moving away again: diverging
                 return z, lam, iteration, False
-            z = z + dz * min(1.0, LONGEST_STEP / step)
-            if step <= LONGEST_STEP:
+            turn = float(np.max(np.abs(dz[turning]), initial=0.0))
+            z = z + dz * min(1.0, LONGEST_TURN / turn) if turn else z + dz
+            if turn <= LONGEST_TURN:
                 last = step
         return z, lam, iterations, False
 
