@@ -8,6 +8,8 @@ References, each computed here without pam2exu's code:
   the minimum of its potential energy V(θ) = Σ m g y_G + ½ k (ro − L0)², with the
   positions from the circle intersection of the four-bar, found by scipy's
   minimize_scalar;
+- a redundant parallelogram (tests/data/parallelogram5.toml without its motor) with a
+  torsional spring under gravity: k θ + 0.3 m g cos θ = 0, solved by brentq;
 - a pendulum exactly at its top warns (unstable), a torque larger than m g d is an error
   naming the lever, and a fully driven model gives the first row of quasi_static.
 
@@ -121,6 +123,32 @@ def test_four_bar_with_a_spring_at_the_minimum_of_its_potential_energy():
     assert res["rocker.fi"][0] == pytest.approx(fr, abs=1e-9)
     assert V(th) == pytest.approx(best.fun, abs=1e-12)
     assert V(th) < V(_four_bar().solids[1].fi)          # lower than where it started
+    assert res.info["stiffness_eigenvalue"] > 0
+
+
+def test_a_redundant_parallelogram_against_its_moment_balance():
+    """tests/data/parallelogram5.toml (three cranks 0.3 long, a coupler over them: one
+    redundant revolute) without its motor, assembled, under gravity with a torsional spring
+    k = 5 on crank 1 and 1 kg on every moving solid (each centre of mass at its frame
+    origin): the coupler translates, V(θ) = m g 0.3 sin θ + ½ k θ², so k θ + 0.3 m g cos θ = 0
+    (brentq); the redundant reactions are of least norm, the crank angles equal."""
+    model = pam2exu.load(Path(__file__).resolve().parents[1] / "data/parallelogram5.toml")
+    model.elements.remove(model["motor"])
+    model.add("torsional_spring", name="tspring", anc1="ground", anc2="crank1",
+              C=[0.0, 5.0, 0.0, 0.0])
+    model.gravity = G
+    for solid in model.solids[1:]:
+        solid.mass, solid.inertia = 1.0, 0.01
+        solid.fi = 1.6
+    model["crank2"].x = 1.0
+    model["coupler"].x, model["coupler"].y = 0.3 * math.cos(1.6), 0.3 * math.sin(1.6)
+    model["coupler"].fi = 0.0
+    res = _run(model, analysis="equilibrium")
+    theta = brentq(lambda f: 5.0 * f + 0.3 * G * math.cos(f), -1.5, 1.5, xtol=1e-15)
+    for crank in ("crank1", "crank2", "crank3"):
+        assert res[f"{crank}.fi"][0] == pytest.approx(theta, abs=1e-12)
+    assert res["coupler.fi"][0] == pytest.approx(0.0, abs=1e-12)
+    assert res["tspring.Parell"][0] == pytest.approx(5.0 * theta, abs=1e-10)
     assert res.info["stiffness_eigenvalue"] > 0
 
 
