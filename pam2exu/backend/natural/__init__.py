@@ -116,7 +116,7 @@ class Natural:
         statics = Statics(form, mech, t, start, anchor_stiffness)
         z0 = form.from_q(start)[0]
         z, _, iterations, ok = statics.solve(z0, w, settings.tolerance,
-                                                    settings.max_iterations)
+                                             settings.max_iterations)
         nan = np.full((1, mech.nq), np.nan)
         if not ok:
             last = self.to_q(form, mech, z[None], start)[0]
@@ -124,8 +124,10 @@ class Natural:
                              f"converge at t = {t:.6g} s in {iterations} iterations",
                              last if np.isfinite(last).all() else start,
                              iterations=iterations)
-        q = start[None].copy() if np.array_equal(z, z0) else self.to_q(form, mech, z[None],
-                                                                          start)
+        if np.array_equal(z, z0):         # no step taken: the start, unmoved
+            q = start[None].copy()
+        else:
+            q = self.to_q(form, mech, z[None], start)
         extra = None
         if anchor_stiffness:              # the springs' forces on x, y, fi: −k W (q − q_s)
             moving = np.array([i not in form.grounds for i in range(len(mech.solids))])
