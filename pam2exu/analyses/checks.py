@@ -38,14 +38,16 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
     tol = max(RESIDUAL_TOLERANCE, 100 * tolerance) * mech.scale()
     if worst > tol:
         first = int(np.argmax(per_step > tol))
-        if job is not None and first > 0:
+        if job is not None:
             # redundant constraints whose targets part: the solver (told to ignore the
-            # singular Jacobian) can stop on a configuration that violates them
-            disagreement, _ = native.contradiction(mech, float(t[first]), q[first - 1])
+            # singular Jacobian) can stop on a configuration that violates them; from the
+            # start when they tie held solids only, which no backend moves
+            before = q[max(first - 1, 0)]
+            disagreement, _ = native.contradiction(mech, float(t[first]), before)
             if disagreement > tol:
                 raise position_failure(job, Positions(
                     q, first, "no error (it stopped on a configuration that violates the "
-                              "constraints)", q[first - 1]))
+                              "constraints)", before))
         k = int(np.argmax(per_step))
         name, value = native.worst_elements(mech, res[k], 1)[0]
         label = job.backend.label if job is not None else "the backend"

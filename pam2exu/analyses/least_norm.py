@@ -103,15 +103,18 @@ class Applicability:
 def _ratio_and_null(shape: tuple, svd, side: str):
     """(σ_min/σ_max, a basis of the null space on ``side``: 'left' (columns λ with Aᵀλ ≈ 0)
     or 'right' (columns δ with A δ ≈ 0)) of a matrix A of ``shape`` from its full SVD,
-    singular values ≤ RANK σ_max counting as 0."""
+    singular values ≤ RANK σ_max counting as 0; a ratio of +inf where that null space is
+    {0} and A has no singular value (no equations, or nothing they constrain)."""
     U, s, Vt = svd
     size = min(shape)
-    lost = np.r_[s <= RANK * s[0], np.ones(max(shape) - size, dtype=bool)]
-    if side == "left":
-        smallest = 0.0 if shape[0] > size else s[-1]
-        return smallest / s[0], U[:, lost[:shape[0]]]
-    smallest = 0.0 if shape[1] > size else s[-1]
-    return smallest / s[0], Vt[lost[:shape[1]]].T
+    top = s[0] if s.size else 0.0
+    lost = np.r_[s <= RANK * top, np.ones(max(shape) - size, dtype=bool)]
+    n = shape[0] if side == "left" else shape[1]
+    null = U[:, lost[:n]] if side == "left" else Vt[lost[:n]].T
+    smallest = 0.0 if n > size else (s[-1] if s.size else top)
+    if top > 0:
+        return smallest / top, null
+    return (np.inf if null.shape[1] == 0 else 0.0), null
 
 
 def _reduced_hessian(c: Closure, svd) -> float:

@@ -151,15 +151,21 @@ class Spring(_SpringDamper):
         """ro = |Q − P| (F > 0 attracts P and Q); SolverError where the points coincide."""
         P, Q = (st.point(r.solid, r.local) for r in self.refs)
         gap = Q - P
-        length = np.hypot(gap.value[:, 0], gap.value[:, 1])
-        if st.n and np.min(length) <= 1e-12 * max(1.0, float(np.max(np.abs(P.value)))):
-            k = int(np.argmin(length))
-            raise SolverError(
-                f"at t = {st.t[k]:.6g} s the points of spring '{self.name}' coincide (ro = "
-                f"{length[k]:.3g} m): a spring of length 0 has no direction for its force. "
-                f"Attach it between points that stay apart, or end the interval before "
-                f"this time.", time=float(st.t[k]), elements=(f"'{self.name}' (spring)",))
+        self.require_apart(st.t, np.hypot(gap.value[:, 0], gap.value[:, 1]), P.value)
         return gap.norm()
+
+    def require_apart(self, t, length, P) -> None:
+        """SolverError at the first time where ro ≤ 1e-12 max(1, |P|): a spring of length 0
+        has no direction for its force."""
+        if not len(length) or np.min(length) > 1e-12 * max(1.0, float(np.max(np.abs(P)))):
+            return
+        k = int(np.argmin(length))
+        when = f"at t = {t[k]:.6g} s " if np.isfinite(t[k]) else ""
+        raise SolverError(
+            f"{when}the points of spring '{self.name}' coincide (ro = "
+            f"{length[k]:.3g} m): a spring of length 0 has no direction for its force. "
+            f"Attach it between points that stay apart, or end the interval before "
+            f"this time.", time=float(t[k]), elements=(f"'{self.name}' (spring)",))
 
 
     def build(self, ex):
@@ -186,6 +192,7 @@ class Spring(_SpringDamper):
         P, Q = (nl.point(r.solid, r.local) for r in self.refs)
         gap = Q - P
         ro = np.hypot(gap[:, 0], gap[:, 1])
+        self.require_apart(nl.t, ro, P)
         rate = nl.point_rate(self.ref2.solid, self.ref2.local) - \
             nl.point_rate(self.ref1.solid, self.ref1.local)
         dro = np.sum(gap * rate, axis=1) / ro

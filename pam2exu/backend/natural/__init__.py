@@ -82,14 +82,18 @@ class Natural:
             last = self.to_q(form, mech, z1[None], start)[0]
             return Positions(q, 0, self._failed(form, solver, times[0], z1, settings),
                              last if np.isfinite(last).all() else start)
-        z, solved = solver.run(times, z0)
+        if form.nz == 0:                 # every solid held: nothing moves, nothing to solve
+            z, solved = np.zeros((n, 0)), n
+        else:
+            z, solved = solver.run(times, z0)
         error = None
         if solved < n:
             error = self._failed(form, solver, times[solved], z[solved - 1], settings)
         q[:solved] = self.to_q(form, mech, z[:solved], start)
         found = Positions(q, solved, error, q[solved - 1], iterations=solver.iterations)
         if rates and solved:
-            zd, zdd = solver.run_rates(times[:solved], z[:solved])
+            zd, zdd = (solver.run_rates(times[:solved], z[:solved]) if form.nz
+                       else (z[:solved], z[:solved]))
             qd, qdd = self.to_rates(form, mech, z[:solved], zd, zdd)
             del zd, zdd
             if solved < n:                     # NaN after the last solved step, as q

@@ -89,7 +89,7 @@ class Dynamics:
         """Q (nz,) of gravity, torsors and spring-dampers at the state."""
         q = np.zeros((1, self.mech.nq))
         q[0, ANGLES] = self.angles(z)
-        loads = Loads(self.form, z[None], q, zd[None])
+        loads = Loads(self.form, z[None], q, zd[None], t=t)
         for el in self.mech.elements:
             el.natural_loads(loads)
         return self.weight + loads.on_coordinates()[0]

@@ -30,10 +30,16 @@ class Loads:
         (n, nq) the same configurations as x, y, fi.
     zd : numpy.ndarray, optional
         (n, nz) their rates ż (the dampers' forces); None: at rest.
+    t : numpy.ndarray, optional
+        (n,) the times of the configurations, for the messages of elements whose force is
+        not defined there; None: not known (NaN).
     """
 
-    def __init__(self, form, z: np.ndarray, q: np.ndarray, zd: np.ndarray | None = None):
+    def __init__(self, form, z: np.ndarray, q: np.ndarray, zd: np.ndarray | None = None,
+                 t: np.ndarray | None = None):
         self.form, self.q, self.n = form, q, q.shape[0]
+        self.t = np.full(self.n, np.nan) if t is None else np.broadcast_to(
+            np.asarray(t, dtype=float), (self.n,))
         self.z = np.asarray(z, dtype=float)
         self.zd = zd
         ns = len(form.frames)

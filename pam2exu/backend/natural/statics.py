@@ -89,7 +89,7 @@ class Statics:
         solids = np.arange(len(self.mech.solids))
         q[:, column(solids, 0)], q[:, column(solids, 1)] = pose[:, 0::4], pose[:, 1::4]
         q[:, ANGLES] = self.angles(z)
-        loads = Loads(self.form, z, q)
+        loads = Loads(self.form, z, q, t=self.t[0])
         for el in self.mech.elements:
             el.natural_loads(loads)
         return self.weight_forces + loads.on_coordinates()
