@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 import numbers
 
+from .errors import echo
+
 #: |coordinate| of any point, origin, centre of mass or line [m]; also spring free
 #: lengths and the distances of linear actuators' laws
 LENGTH = 1e6
@@ -63,7 +65,7 @@ def name_problem(name) -> str | None:
     "name 'a.b' contains '.', which separates a solid from its point or line: rename it"
     """
     if not isinstance(name, str) or not name.strip():
-        return f"name must be a non-empty string, got {_short(name)}"
+        return f"name must be a non-empty string, got {echo(name)}"
     if len(name) > NAME:
         return f"name is {len(name)} characters long: at most {NAME} are allowed"
     if not name.isprintable():
@@ -81,9 +83,3 @@ def shown(name, width: int = 40) -> str:
     """A name as messages show it: cut to ``width`` characters (a name of any type)."""
     text = str(name)
     return text if len(text) <= width else text[:width - 3] + "..."
-
-
-def _short(value) -> str:
-    """repr of a value, cut to 60 characters."""
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."

@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import closest
+from ..errors import closest, echo
 from ..limits import VALUE, is_number, shown
 from ..kinematics import Quantity, State, pose
 from ..laws import LAW_ALIASES, LAWS, VALUES_OF_F, Law, law_names
@@ -25,6 +25,11 @@ POSITION, VELOCITY, ACCELERATION, FORCE = "position", "velocity", "acceleration"
 #: the level of a joint's clearance parameters (``Element.clearance_parameters``): given by
 #: the clearance analysis only (shared/spec/clearance.md)
 CLEARANCE = "clearance"
+
+
+#: how an anchor of each kind is written
+ANCHOR_FORMS = {"solid": '"solid"', "point": '"solid.point", or "solid" for its origin',
+                "line": '"solid.line", or "solid" for its x axis'}
 
 
 @dataclass(frozen=True)
@@ -70,11 +75,22 @@ class Param:
         if value is None:
             return f"'{key}' is required ({self.meaning})" if self.required else None
         if self.kind == "constants":
-            values = list(value) if isinstance(value, (list, tuple, np.ndarray)) else [value]
+            if not isinstance(value, (list, tuple, np.ndarray)):
+                shape = ", ".join(f"C{k + 1}" for k in range(self.size))
+                if not is_number(value):
+                    return (f"'{key}' must be a list of numbers, {key} = [{shape}] "
+                            f"({self.meaning}), got {echo(value)}")
+                return (f"'{key}' must be a list, {key} = [{shape}] ({self.meaning}), got the "
+                        f"single number {value!r}: write {key} = [{value!r}] if it is C1, and "
+                        f"give the other constants")
+            values = list(value)
             if len(values) > self.size:
                 return (f"'{key}' has {len(values)} constants, at most {self.size} are allowed "
                         f"({self.meaning})")
-            bad = [repr(v) for v in values if not is_number(v)]
+            if any(isinstance(v, (list, tuple, dict, np.ndarray)) for v in values):
+                return (f"'{key}' must be a flat list of numbers, {key} = [C1, C2, …] "
+                        f"({self.meaning}), got a nested list {echo(value)}")
+            bad = [echo(v) for v in values if not is_number(v)]
             if bad:
                 return f"'{key}' must hold numbers, got {', '.join(bad)}"
             large = [f"C{k + 1} = {v:g}" for k, v in enumerate(values) if abs(v) > self.limit]
@@ -85,23 +101,23 @@ class Param:
             if isinstance(value, (list, tuple)) and len(value) == 1:
                 value = value[0]
             if not is_number(value):
-                return f"'{key}' must be a number ({self.meaning}), got {value!r}"
+                return f"'{key}' must be a number ({self.meaning}), got {echo(value)}"
             if abs(value) > self.limit:
                 return (f"'{key}' = {value:g} is out of range: it must lie within "
                         f"±{self.limit:g} ({self.meaning}; are the units right?)")
 
         elif self.kind == "law":
             if not isinstance(value, str) or (value not in LAWS and value not in LAW_ALIASES):
-                return (f"unknown law '{value}'{closest(value, law_names())}; "
+                return (f"unknown law {echo(value)}{closest(value, law_names())}; "
                         f"known laws: {', '.join(law_names())}")
         elif self.kind == "choice":
             if value not in self.choices:
                 return (f"'{key}' must be one of {', '.join(map(repr, self.choices))}, "
-                        f"got {value!r}{closest(value, self.choices)}")
+                        f"got {echo(value)}{closest(value, self.choices)}")
         elif self.kind == "solid" and not isinstance(value, str):
-            return f"'{key}' must be a solid name, got {value!r}"
+            return f"'{key}' must be a solid name, got {echo(value)}"
         elif self.kind == "boolean" and not isinstance(value, bool):
-            return f"'{key}' must be true or false ({self.meaning}), got {value!r}"
+            return f"'{key}' must be true or false ({self.meaning}), got {echo(value)}"
         return None
 
 
@@ -201,10 +217,14 @@ class Element:
                 if value is None:
                     out.append(f"'{kind}' is missing: it must name a {self.anchors[k]}")
                     continue
+                if not isinstance(value, str):
+                    out.append(f"'{kind}' must be a string naming a {self.anchors[k]} "
+                               f"({ANCHOR_FORMS[self.anchors[k]]}), got {echo(value)}")
+                    continue
                 try:
                     scope.resolve(self.anchors[k], value)
                 except LookupError as exc:
-                    out.append(f"{kind} = '{value}': {exc}")
+                    out.append(f"{kind} = {echo(value)}: {exc}")
             elif value is not None:
                 out.append(f"a {self.type} takes no '{kind}' (remove it)")
         for key, param in self.params.items():
@@ -215,7 +235,7 @@ class Element:
                 try:
                     scope.solid(getattr(self, key))
                 except LookupError as exc:
-                    out.append(f"{key} = '{getattr(self, key)}': {exc}")
+                    out.append(f"{key} = {echo(getattr(self, key))}: {exc}")
         if not out and len(self.anchors) == 2 and self.equations:
             a, b = (scope.resolve(kind, getattr(self, f"anc{k + 1}"))
                     for k, kind in enumerate(self.anchors))

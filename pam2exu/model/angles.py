@@ -14,7 +14,7 @@ import copy
 import math
 
 from ..elements import Element
-from ..errors import Problem
+from ..errors import Problem, echo
 from ..limits import is_number
 from .solid import Solid
 from .variation import Variation
@@ -104,7 +104,7 @@ def angles_problem(angles) -> str | None:
     """The message for a bad ``[model] angles`` (None when it is "rad" or "deg")."""
     if angles in UNITS:
         return None
-    return (f"angles must be \"rad\" (the default) or \"deg\", got {angles!r}: the unit of every "
+    return (f"angles must be \"rad\" (the default) or \"deg\", got {echo(angles)}: the unit of every "
             "angle the model gives (fi, line angles, an angular actuator's law, …)")
 
 

@@ -5,7 +5,8 @@ import tomllib
 from pathlib import Path
 
 from ..elements import ALIASES, ELEMENTS, misplaced_clearance
-from ..errors import ModelError, Problem, closest
+from ..errors import ModelError, Problem, closest, echo
+from ..limits import shown
 from .model import Analysis, Model
 from .solid import Solid
 from .variation import KEYS as _VARIATION_KEYS
@@ -149,14 +150,14 @@ def loads(text: str, source: str = "<string>") -> Model:
     problems: list[Problem] = []
     for key in data:
         if key not in _TABLES:
-            problems.append(Problem(f"[{key}]", f"unknown table{closest(key, _TABLES)}; "
+            problems.append(Problem(f"[{echo(key)[1:-1]}]", f"unknown table{closest(key, _TABLES)}; "
                                                 f"a model has {', '.join(_TABLES)}"))
     head = _table(data, "model", problems)
     _unknown_keys(head, _MODEL_KEYS, "[model]", problems)
     model = Model(name=head.get("name", Path(source).stem), gravity=head.get("gravity", 9.81),
                   source=source, angles=head.get("angles", "rad"))
     for k, entry in enumerate(_array(data, "solid", problems), start=1):
-        where = f"[[solid]] #{k}" + (f" '{entry['name']}'" if "name" in entry else "")
+        where = f"[[solid]] #{k}" + (f" '{shown(entry['name'])}'" if "name" in entry else "")
         _unknown_keys(entry, _SOLID_KEYS, where, problems)
         if "name" not in entry:
             problems.append(Problem(where, "'name' is missing"))
@@ -164,14 +165,14 @@ def loads(text: str, source: str = "<string>") -> Model:
         keys.setdefault("name", f"solid{k}")
         model.add_solid(Solid(**keys, position=k))
     for k, entry in enumerate(_array(data, "element", problems), start=1):
-        where = f"[[element]] #{k}" + (f" '{entry['name']}'" if "name" in entry else "")
+        where = f"[[element]] #{k}" + (f" '{shown(entry['name'])}'" if "name" in entry else "")
         kind = entry.get("type")
         if kind is None:
             problems.append(Problem(where, f"'type' is missing; one of {', '.join(ELEMENTS)}"))
             continue
         cls = ELEMENTS.get(ALIASES.get(kind, kind)) if isinstance(kind, str) else None
         if cls is None:
-            problems.append(Problem(where, f"unknown element type '{kind}'"
+            problems.append(Problem(where, f"unknown element type {echo(kind)}"
                                            f"{closest(kind, [*ELEMENTS, *ALIASES])}; known types: "
                                            f"{', '.join(ELEMENTS)}"))
             continue
@@ -216,6 +217,6 @@ def _array(data, key, problems) -> list[dict]:
 def _unknown_keys(entry: dict, allowed, where, problems) -> list[str]:
     bad = [key for key in entry if key not in allowed]
     for key in bad:
-        problems.append(Problem(where, f"unknown key '{key}'{closest(key, allowed)}; "
+        problems.append(Problem(where, f"unknown key {echo(key)}{closest(key, allowed)}; "
                                        f"allowed keys: {', '.join(allowed)}"))
     return bad

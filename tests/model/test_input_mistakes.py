@@ -1,0 +1,102 @@
+"""What a new user got wrong and pam2exu let pass or explained badly (issue 22): each test
+fails on the code before the fix."""
+from __future__ import annotations
+
+import pytest
+
+from pam2exu import ModelError, load, loads
+
+SOLIDS = """
+[[solid]]
+name = "ground"
+points = { O = [0.0, 0.0] }
+
+[[solid]]
+name = "crank"
+points = { O = [0.0, 0.0], A = [0.1, 0.0] }
+"""
+
+DRIVE = """
+[[element]]
+type = "revolute"
+name = "O"
+anc1 = "ground.O"
+anc2 = "crank.O"
+
+[[element]]
+type = "fixed"
+anc1 = "ground"
+
+[[element]]
+type = "angular_actuator"
+name = "motor"
+anc1 = "ground"
+anc2 = "crank"
+"""
+
+
+def error_of(text: str, tmp_path=None) -> ModelError:
+    """The ModelError of a model that must fail (read from a file when tmp_path is given)."""
+    with pytest.raises(ModelError) as info:
+        if tmp_path is None:
+            loads(text)
+        else:
+            path = tmp_path / "m.toml"
+            path.write_text(text, encoding="utf-8")
+            load(path)
+    return info.value
+
+
+# ---- C given as a number, or nested -----------------------------------------------------------
+
+def test_constants_given_as_one_number_are_refused(tmp_path):
+    """C = 360.0 was read silently as C1 = 360 (the motor stood still at 360 rad)."""
+    error = error_of(SOLIDS + DRIVE + "C = 360.0\n", tmp_path)
+    text = str(error)
+    assert len(error.problems) == 1
+    assert text.startswith(str(tmp_path / "m.toml") + ": [[element]] #3 'motor' "
+                                                      "(angular_actuator): ")
+    assert "'C' must be a list, C = [C1, C2, C3, C4]" in text
+    assert "write C = [360.0] if it is C1" in text
+
+
+def test_nested_constants_say_the_list_must_be_flat():
+    """C = [[1.0, 2.0]] answered "'C' must hold numbers, got [1.0, 2.0]"."""
+    text = str(error_of(SOLIDS + DRIVE + "C = [[1.0, 2.0]]\n"))
+    assert text.endswith("'C' must be a flat list of numbers, C = [C1, C2, …] (constants C1…C4 "
+                         "of the law), got a nested list [[1.0, 2.0]]")
+
+
+# ---- values quoted once, and not without end ----------------------------------------------------
+
+def test_an_anchor_that_is_not_a_string_is_quoted_once():
+    """anc1 = ["crank"] gave "anc1 = '['crank']': no solid '['crank']'"."""
+    text = str(error_of(SOLIDS + '[[element]]\ntype = "revolute"\nanc1 = ["crank"]\n'
+                                 'anc2 = "crank.O"\n'))
+    assert "'[" not in text and "]'" not in text
+    assert text.endswith("'anc1' must be a string naming a point (\"solid.point\", or \"solid\" "
+                         "for its origin), got ['crank']")
+
+
+def test_a_variation_anchor_that_is_not_a_string_is_quoted_once():
+    text = str(error_of(SOLIDS + '[[variation]]\nanchor = ["crank"]\ndx = 1e-3\n'))
+    assert "(anchor ['crank'])" in text and "'[" not in text
+
+
+def test_a_huge_value_is_echoed_cut():
+    """A 900,000-character type was echoed whole (and difflib took seconds on it)."""
+    text = str(error_of(SOLIDS + f'[[element]]\ntype = "{"x" * 900_000}"\n'))
+    assert len(text) < 600
+    assert f"unknown element type '{'x' * 80}… (900000 characters)'" in text
+
+
+def test_a_long_list_of_problems_is_cut_with_the_count():
+    """2,000 problems were listed in 385 kB: the message lists 20 and says how many more."""
+    text = "".join(f'[[solid]]\nname = "s{k}"\nmass = -1.0\n' for k in range(2000))
+    error = error_of(text)
+    assert len(error.problems) == 2000
+    lines = str(error).splitlines()
+    assert lines[0] == "<string>: 2000 problems in the model:"
+    assert len(lines) == 22
+    assert lines[1] == "  - [[solid]] #1 's0': mass is negative (-1.0): it must be ≥ 0"
+    assert lines[-1].startswith("  … and 1980 more")
