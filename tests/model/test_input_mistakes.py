@@ -100,3 +100,26 @@ def test_a_long_list_of_problems_is_cut_with_the_count():
     assert len(lines) == 22
     assert lines[1] == "  - [[solid]] #1 's0': mass is negative (-1.0): it must be ≥ 0"
     assert lines[-1].startswith("  … and 1980 more")
+
+
+# ---- encodings ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("encoding,name", [("utf-16", "UTF-16"), ("utf-16-be", "UTF-16"),
+                                           ("utf-16-le", "UTF-16"), ("utf-32", "UTF-32")])
+def test_a_utf16_file_says_to_save_it_as_utf8(tmp_path, encoding, name):
+    """Notepad's "Unicode" (UTF-16 with BOM FF FE) gave "not valid TOML: Invalid statement
+    (at line 1, column 1)"; without a BOM it is known by its NUL bytes."""
+    path = tmp_path / "notepad.toml"
+    path.write_bytes((SOLIDS + DRIVE + "C = [0.0, 1.0]\n").encode(encoding))
+    with pytest.raises(ModelError) as info:
+        load(path)
+    text = str(info.value)
+    assert text.startswith(f"{path}: the file is {name} text")
+    assert "save the file as UTF-8" in text and "TOML" not in text
+
+
+def test_utf8_with_a_byte_order_mark_loads(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes((SOLIDS + DRIVE + "C = [0.0, 1.0]\n").encode("utf-8-sig"))
+    model = load(path)
+    assert [s.name for s in model.solids] == ["ground", "crank"] and model.encoding == "utf-8"
