@@ -338,6 +338,22 @@ class VariationWarning(UserWarning):
     """
 
 
+class InputWarning(UserWarning):
+    """A value of the model that is allowed but most likely a mistake: the run goes on.
+
+    Issued by ``run`` (and kept in ``Results.warnings``), naming the solid or element and the
+    value: an angle of a radians model above a full turn (degrees given by mistake:
+    ``pam2exu check`` prints the same texts); initial rates (``Dx``, ``Dy``, ``Dfi``) of a
+    dynamic model that the constraints do not allow, replaced by the nearest that they do
+    (the given and the used values); a law whose value jumps within one step of the run.
+
+    Parameters
+    ----------
+    message : str
+        Where, which value, and what to change if it is a mistake.
+    """
+
+
 def warn_outside(text: str, category) -> None:
     """``warnings.warn`` at the caller's first line outside the pam2exu package."""
     package = os.path.dirname(os.path.abspath(__file__))

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import closest, echo
 from ..limits import VALUE, is_number, shown
 from ..kinematics import Quantity, State, pose
-from ..laws import LAW_ALIASES, LAWS, VALUES_OF_F, Law, law_names
+from ..laws import F_ORDERS, LAW_ALIASES, LAWS, VALUES_OF_F, Law, law_names
 
 #: What an output needs from an analysis, in the order analyses can provide it.
 POSITION, VELOCITY, ACCELERATION, FORCE = "position", "velocity", "acceleration", "force"
@@ -267,6 +267,22 @@ class Element:
         actuator's law constants depend on its law and kind)."""
         return self.params[key].angles
 
+    def given_angles(self) -> list[tuple[str, float]]:
+        """(label, value) of every angle its keys give, in the model's unit (not a rate):
+        ``Param.angles`` flags angles only, an actuator says which law constants are f.
+        Read after validation (the values are numbers)."""
+        out = []
+        for key in self.params:
+            flags, value = self.angle_values(key), getattr(self, key)
+            if not any(flags) or value is None:
+                continue
+            if isinstance(value, (list, tuple, np.ndarray)):
+                out += [(f"{key}{k + 1}", float(v)) for k, v in enumerate(value)
+                        if k < len(flags) and flags[k]]
+            else:
+                out.append((key, float(value)))
+        return out
+
     # ---- kinematics --------------------------------------------------------------------
     def constraint(self, st: State) -> tuple[Quantity, Any]:
         """(v, target): the equations v(q) − target(t) = 0, target a constant or a Law."""
@@ -353,6 +369,14 @@ class Actuator(Element):
         if key == "C":
             return VALUES_OF_F[LAW_ALIASES.get(self.law, self.law)] if self.angular else ()
         return super().angle_values(key)
+
+    def given_angles(self):
+        """An angular actuator's law constants that are values of f (not its rates)."""
+        law = LAW_ALIASES.get(self.law, self.law)
+        if not self.angular or law not in F_ORDERS:
+            return []
+        return [(f"law '{law}' C{k + 1}", c) for k, (c, order)
+                in enumerate(zip(constants(self.C), F_ORDERS[law])) if order == 0]
 
     def more_problems(self, scope):
         law = LAW_ALIASES.get(self.law, self.law)

@@ -2,9 +2,13 @@
 fails on the code before the fix."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from pam2exu import ModelError, load, loads
+
+ROOT = Path(__file__).resolve().parents[2]
 
 SOLIDS = """
 [[solid]]
@@ -123,3 +127,52 @@ def test_utf8_with_a_byte_order_mark_loads(tmp_path):
     path.write_bytes((SOLIDS + DRIVE + "C = [0.0, 1.0]\n").encode("utf-8-sig"))
     model = load(path)
     assert [s.name for s in model.solids] == ["ground", "crank"] and model.encoding == "utf-8"
+
+
+# ---- degrees in a radians model -----------------------------------------------------------------
+
+def test_run_warns_of_degrees_in_a_radians_model_as_check_does(tmp_path, capsys):
+    """fi = 30.0 and C = [30, 360]: check warned, run said nothing and turned the crank
+    360 rad. run issues InputWarning with check's texts, naming the solid and the element."""
+    import warnings
+
+    from pam2exu import InputWarning, run
+    from pam2exu.cli import main
+    text = (ROOT / "examples" / "four_bar.toml").read_text()
+    text = text.replace("fi = 0.02", "fi = 30.0").replace(
+        "C = [0.0, 6.283185307179586, 0.0, 0.0]", "C = [30.0, 360.0]")
+    path = tmp_path / "deg.toml"
+    path.write_text(text)
+    assert main(["check", str(path)]) == 0
+    printed = [line.removeprefix("warning: ") for line in capsys.readouterr().out.splitlines()
+               if line.startswith("warning: ")]
+    assert printed == [
+        "[[solid]] #2 'crank': fi = 30 rad is more than a full turn (2π = 6.28 rad): did you "
+        "give degrees? Write fi in radians (30° = 0.5236 rad), or set angles = \"deg\" in "
+        "[model] to give every angle of the model in degrees",
+        "[[element]] #6 'motor' (angular_actuator): law 'polynomial' C1 = 30 rad is more than "
+        "a full turn (2π = 6.28 rad): did you give degrees? Write C1 in radians (30° = "
+        "0.5236 rad), or set angles = \"deg\" in [model] to give every angle of the model in "
+        "degrees"]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = run(path, "kinematic", steps=4, outputs=["crank.fi"])
+    issued = [str(w.message) for w in caught if issubclass(w.category, InputWarning)]
+    assert issued == [f"{path}: {p}" for p in printed]
+    assert [w for w in res.warnings if "full turn" in w] == issued
+    assert float(res["crank.fi"][-1]) == pytest.approx(390.0, rel=1e-12)   # as written
+
+
+def test_degrees_models_and_rates_do_not_warn():
+    """A law's rates (C2 = 360 rad/s) and a harmonic's ω are no angles; a degrees model says
+    what it means."""
+    from pam2exu.model.angles import angle_warnings
+    text = (ROOT / "examples" / "four_bar.toml").read_text()
+    assert not angle_warnings(loads(text.replace("C = [0.0, 6.283185307179586, 0.0, 0.0]",
+                                                 "C = [0.0, 360.0, 50.0]")))
+    assert not angle_warnings(loads(text.replace("C = [0.0, 6.283185307179586, 0.0, 0.0]",
+                                                 'C = [1.0, 0.5, 60.0, 30.0]\nlaw = "harmonic"'
+                                                 ).replace('law = "polynomial"\n', "")))
+    assert not angle_warnings(loads(text.replace(
+        "C = [0.0, 6.283185307179586, 0.0, 0.0]", "C = [30.0, 360.0]").replace(
+        'name = "four-bar"', 'name = "four-bar"\nangles = "deg"')))
