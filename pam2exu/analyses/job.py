@@ -13,7 +13,7 @@ from ..elements import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY, Var
 from ..errors import InputWarning, ModelError, Problem, RedundancyWarning, warn_outside
 from ..kinematics import State, column
 from ..model import Model, load
-from ..model.angles import angle_warnings
+from ..model.mistakes import input_warnings
 from ..model.solid import SOLID_OUTPUTS
 from ..results import Results, select_columns
 from ..results.info import RunInfo
@@ -160,10 +160,10 @@ def warn_redundant(job: Job, q: np.ndarray) -> None:
 
 
 def warn_input(job: Job) -> None:
-    """Warn of the model's likely mistakes that still run (``InputWarning``): the angles of a
-    radians model above a full turn (``angle_warnings``, what ``pam2exu check`` prints)."""
+    """Warn of the model's likely mistakes that still run (``InputWarning``): what
+    ``model.mistakes.input_warnings`` lists and ``pam2exu check`` prints."""
     source = job.mech.model.source
-    for problem in angle_warnings(job.mech.model):
+    for problem in input_warnings(job.mech.model):
         warn(job, f"{source}: {problem}" if source else str(problem), InputWarning)
 
 

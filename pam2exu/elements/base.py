@@ -249,6 +249,11 @@ class Element:
         """Checks particular to one element type (after the generic ones passed)."""
         return []
 
+    def mistakes(self) -> list[str]:
+        """What its valid keys say that is allowed but most likely a mistake, one message
+        each (``model.mistakes.input_warnings``; ``run`` warns of them)."""
+        return []
+
     def bind(self, scope) -> None:
         """Resolve anchors to references (``ref1``, ``ref2``): called once the model is valid."""
         refs = [scope.resolve(kind, getattr(self, f"anc{k + 1}"))
@@ -385,6 +390,20 @@ class Actuator(Element):
             return [f"law '{self.law}' needs C1 < C2 (start and end of the motion, s), "
                     f"got C1 = {c1:g}, C2 = {c2:g}"]
         return []
+
+    def mistakes(self):
+        """A transition law given fewer than its four constants: the missing ones are 0 (the
+        format's rule), so C4 = 0 is where it goes (from C3, between C1 and C2)."""
+        law = LAW_ALIASES.get(self.law, self.law)
+        given = len(self.C) if isinstance(self.C, (list, tuple, np.ndarray)) else 1
+        if not LAWS[law][1] or given >= 4:
+            return []
+        c1, c2, c3, c4 = constants(self.C)
+        missing = ", ".join(f"C{k + 1}" for k in range(given, 4))
+        return [f"law '{self.law}' is given {given} constants, C = {list(self.C)}: {missing} "
+                f"{'is' if given == 3 else 'are'} taken as 0, so f goes from C3 = {c3:g} to "
+                f"C4 = {c4:g} between t = {c1:g} s and {c2:g} s; give the four constants "
+                "C = [C1, C2, C3, C4] (start [s], end [s], value before, value after)"]
 
     def time_law(self) -> Law:
         """The law f(t) with this element's constants (subclasses have ``law`` and ``C``)."""

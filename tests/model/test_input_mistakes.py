@@ -176,3 +176,62 @@ def test_degrees_models_and_rates_do_not_warn():
     assert not angle_warnings(loads(text.replace(
         "C = [0.0, 6.283185307179586, 0.0, 0.0]", "C = [30.0, 360.0]").replace(
         'name = "four-bar"', 'name = "four-bar"\nangles = "deg"')))
+
+
+# ---- laws whose value jumps ----------------------------------------------------------------------
+
+def _all_elements(sun_drive_law: str) -> str:
+    """examples/all_elements.toml with the law of its gear train's 'sun_drive' replaced."""
+    text = (ROOT / "examples" / "all_elements.toml").read_text()
+    old = 'law = "ramp"\nC = [0.2, 0.8, 0.0, 0.5]'
+    assert old in text
+    return text.replace(old, sun_drive_law)
+
+
+@pytest.mark.parametrize("C", ["[0.2, 0.200000000001, 0.0, 0.5]",       # a row inside it
+                               "[0.199999999999, 0.2, 0.0, 0.5]",       # ends on a row
+                               "[0.201, 0.201000000001, 0.0, 0.01]"])   # between two rows
+def test_a_ramp_shorter_than_a_step_names_the_element_and_its_constants(C):
+    """A ramp lasting 1e-12 s on the gear train (fuzz): before, "'sun_drive' turns 2.5e+09
+    rad per step" under [analysis], or a run whose sun jumped between two rows."""
+    import pam2exu
+    model = loads(_all_elements(f'law = "ramp"\nC = {C}'))
+    with pytest.raises(ModelError) as info:
+        pam2exu.run(model, "kinematic", steps=200, outputs=["sun.fi"])
+    (problem,) = info.value.problems
+    assert problem.where == "[[element]] #13 'sun_drive' (angular_actuator)"
+    assert problem.message.startswith(f"law 'ramp' with C = {C} goes from C3 = 0 to C4 = ")
+    assert "in C2 − C1 = 1e-12 s, less than a step of the run (0.005 s): its value jumps" \
+        in problem.message
+
+
+def test_a_tiny_jump_that_sub_steps_follow_still_runs():
+    """A ramp of 1e-12 s that moves 1e-9 rad: followed in sub-steps, the run is exact."""
+    import pam2exu
+    model = loads(_all_elements('law = "ramp"\nC = [0.201, 0.201000000001, 0.0, 1e-9]'))
+    res = pam2exu.run(model, "kinematic", steps=200, outputs=["sun_drive.f(t)"])
+    f = res["sun_drive.f(t)"]
+    assert f[40] == 0.0 and f[41] == 1e-9
+
+
+def test_a_transition_law_missing_constants_is_warned_of(tmp_path, capsys):
+    """bezier_c2 with C = [-0.2173, 0.3127, 32.0427] (fuzz): C4 is 0 by the format's rule,
+    most likely not what was meant. run warns, and check prints the same text."""
+    import warnings
+
+    from pam2exu import InputWarning, run
+    from pam2exu.cli import main
+    path = tmp_path / "three.toml"
+    path.write_text(_all_elements('law = "bezier_c2"\nC = [0.2, 0.8, 0.5]'))
+    expected = ("[[element]] #13 'sun_drive' (angular_actuator): law 'bezier_c2' is given 3 "
+                "constants, C = [0.2, 0.8, 0.5]: C4 is taken as 0, so f goes from C3 = 0.5 to "
+                "C4 = 0 between t = 0.2 s and 0.8 s; give the four constants "
+                "C = [C1, C2, C3, C4] (start [s], end [s], value before, value after)")
+    assert main(["check", str(path)]) == 0
+    assert f"warning: {expected}" in capsys.readouterr().out.splitlines()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = run(path, "kinematic", steps=20, outputs=["sun.fi"])
+    assert [str(w.message) for w in caught if w.category is InputWarning] == \
+        [f"{path}: {expected}"]
+    assert f"{path}: {expected}" in res.warnings
