@@ -23,13 +23,12 @@ ANGLE = 1e7
 VALUE = 1e12
 #: the analysis interval t_end [s]
 T_END = (1e-9, 1e9)
-#: steps of one run (results have steps + 1 rows)
-STEPS = 10_000_000
 #: characters of a solid's or element's name
 NAME = 100
 #: characters of the model's name (titles of pictures and tables show it whole)
 MODEL_NAME = 200
 #: position solves of one run: steps × the sub-steps that keep the motion per solve small
+#: (so also the most steps a run may have: results have steps + 1 rows)
 SOLVE_STEPS = 2_000_000
 #: bytes of the arrays one run holds (coordinates, rates and result columns)
 MEMORY = 4 * 2**30

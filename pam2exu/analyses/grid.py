@@ -143,7 +143,7 @@ def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
         if needed > every or worst is None:
             worst = (el, moved, unit)
         every = max(every, needed)
-    if every > 1 and steps * every > limits.SOLVE_STEPS:
+    if steps * every > limits.SOLVE_STEPS:
         el, moved, unit = worst
         verb = "turns" if unit == "rad" else "moves"
         _, most = driver_unit(el)

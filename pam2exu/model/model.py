@@ -105,9 +105,11 @@ class Analysis:
                        f"{low:g} s and {high:g} s")
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
             out.append(f"steps must be a positive whole number, got {echo(self.steps)}")
-        elif self.steps > limits.STEPS:
-            out.append(f"steps = {self.steps} is more than pam2exu runs ({limits.STEPS:,}): "
-                       "use fewer steps")
+        elif self.steps > limits.SOLVE_STEPS:
+            out.append(f"steps = {self.steps} is more than pam2exu runs: one run solves the "
+                       f"positions at most {limits.SOLVE_STEPS:,} times, once a step at least. "
+                       "Use fewer steps (every row is exact, whatever the step), or split "
+                       "the interval into several runs, each over a shorter t_end")
         if self.outputs is not None and (
                 not isinstance(self.outputs, (list, tuple))
                 or not all(isinstance(o, str) for o in self.outputs)):

@@ -235,3 +235,47 @@ def test_a_transition_law_missing_constants_is_warned_of(tmp_path, capsys):
     assert [str(w.message) for w in caught if w.category is InputWarning] == \
         [f"{path}: {expected}"]
     assert f"{path}: {expected}" in res.warnings
+
+
+# ---- the work of a run: bounded, and shown ----------------------------------------------------
+
+def test_more_steps_than_a_run_takes_is_refused_at_once(tmp_path):
+    """steps = 5000000 with one output ran 5 min 23 s, while the docs promise to refuse more
+    than 2,000,000 position solves: the bound is a model error, saying how to split."""
+    text = (ROOT / "examples" / "four_bar.toml").read_text()
+    assert "steps = 200" in text
+    error = error_of(text.replace("steps = 200", "steps = 5000000"), tmp_path)
+    (problem,) = error.problems
+    assert problem.where == "[analysis]"
+    assert problem.message.startswith("steps = 5000000 is more than pam2exu runs: one run "
+                                      "solves the positions at most 2,000,000 times")
+    assert "Use fewer steps" in problem.message and "several runs" in problem.message
+
+
+def test_a_long_run_shows_its_progress_on_stderr(monkeypatch):
+    """A run of several parts (PART_STEPS made 7 here: the rule, not a time, decides) draws
+    a bar on stderr when it is a terminal; the results are those of one part to within
+    Newton's tolerance."""
+    import io
+    import sys
+
+    import numpy as np
+
+    import pam2exu
+    from pam2exu.analyses import positions
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    monkeypatch.delenv("PAM2EXU_PROGRESS", raising=False)
+    path = ROOT / "examples" / "four_bar.toml"
+    whole = pam2exu.run(path, "kinematic", steps=50)
+    monkeypatch.setattr(positions, "PART_STEPS", 7)
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    parts = pam2exu.run(path, "kinematic", steps=50)
+    bar = sys.stderr.getvalue()
+    assert "solving the positions [" in bar and "100%" in bar and bar.endswith("\r")
+    for name in whole.columns:
+        scale = max(1.0, float(np.max(np.abs(whole[name]))))
+        assert np.max(np.abs(parts[name] - whole[name])) < 1e-11 * scale, name
