@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import unicodedata
 
 from .errors import echo
 
@@ -48,6 +49,20 @@ def is_number(v) -> bool:
 def out_of_range(value, limit: float) -> bool:
     """A finite number whose magnitude exceeds ``limit``."""
     return is_number(value) and abs(value) > limit
+
+
+def one_form(value):
+    """A string in one Unicode form (NFC); any other value unchanged.
+
+    A name typed with a combining accent (``a`` + U+0301) is then the same as ``á``
+    everywhere: anchors, result columns, CSV files (which read back in this form).
+
+    Examples
+    --------
+    >>> one_form("a\u0301") == "\u00e1", one_form(3)
+    (True, 3)
+    """
+    return unicodedata.normalize("NFC", value) if isinstance(value, str) else value
 
 
 def name_problem(name) -> str | None:

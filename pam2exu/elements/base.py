@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import closest, echo
-from ..limits import VALUE, is_number, shown
+from ..limits import VALUE, is_number, one_form, shown
 from ..kinematics import Quantity, State, pose
 from ..laws import F_ORDERS, LAW_ALIASES, LAWS, VALUES_OF_F, Law, law_names
 
@@ -195,6 +195,13 @@ class Element:
 
     #: 1-based position in the file's [[element]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
+
+    def __post_init__(self):
+        """The names it gives (its own, its anchors, a solid key's) in one Unicode form
+        (``limits.one_form``), as the solids' names."""
+        for key in ("name", "anc1", "anc2", *(k for k, p in self.params.items()
+                                               if p.kind == "solid")):
+            setattr(self, key, one_form(getattr(self, key)))
 
     # ---- declaration -------------------------------------------------------------------
     @classmethod

@@ -74,6 +74,14 @@ class Solid:
     #: 1-based position in the file's [[solid]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False)
 
+    def __post_init__(self):
+        """Its name, points' and lines' names in one Unicode form (``limits.one_form``)."""
+        self.name = limits.one_form(self.name)
+        for key in ("points", "lines"):
+            table = getattr(self, key)
+            if isinstance(table, dict):
+                setattr(self, key, {limits.one_form(k): v for k, v in table.items()})
+
     @property
     def where(self) -> str:
         """Where the solid is in the model, for messages: ``"[[solid]] #2 'crank'"``."""

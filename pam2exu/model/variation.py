@@ -110,6 +110,10 @@ class Variation:
     #: 1-based position in the file's [[variation]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
 
+    def __post_init__(self):
+        """Its anchor in one Unicode form (``limits.one_form``), as the solids' names."""
+        self.anchor = limits.one_form(self.anchor)
+
     @property
     def where(self) -> str:
         """Where it is in the model: ``"[[variation]] #2 (anchor 'crank.A')"``."""

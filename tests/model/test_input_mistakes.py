@@ -279,3 +279,31 @@ def test_a_long_run_shows_its_progress_on_stderr(monkeypatch):
     for name in whole.columns:
         scale = max(1.0, float(np.max(np.abs(whole[name]))))
         assert np.max(np.abs(parts[name] - whole[name])) < 1e-11 * scale, name
+
+
+# ---- names in one Unicode form -------------------------------------------------------------------
+
+def test_a_name_with_a_combining_accent_reads_back_from_csv(tmp_path):
+    """A solid named 'a' + U+0301 was written as given and read back NFC ('á'): the columns
+    differed. Names are put in one form (NFC) on input, anchors too, whichever way typed."""
+    import unicodedata
+
+    import numpy as np
+
+    import pam2exu
+    decomposed, composed = "cra\u0301nk", "cr\u00e1nk"
+    text = (ROOT / "examples" / "four_bar.toml").read_text()
+    text = (text.replace('name = "crank"', f'name = "{decomposed}"')
+            .replace('anc2 = "crank.O"', f'anc2 = "{decomposed}.O"')     # typed decomposed
+            .replace('anc1 = "crank.A"', f'anc1 = "{composed}.A"')       # typed composed
+            .replace('anc2 = "crank"', f'anc2 = "{decomposed}"'))
+    model = loads(text)
+    assert [s.name for s in model.solids][1] == composed
+    res = pam2exu.run(model, "kinematic", steps=4, outputs=[f"{decomposed}.*", "motor.f(t)"])
+    assert res.columns[0] == f"{composed}.x"
+    path = tmp_path / "accent.csv"
+    res.to_csv(path)
+    back = pam2exu.read_csv(path)
+    assert back.columns == res.columns
+    assert all(unicodedata.is_normalized("NFC", c) for c in back.columns)
+    np.testing.assert_array_equal(back.to_numpy(), res.to_numpy())
