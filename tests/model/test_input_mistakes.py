@@ -307,3 +307,20 @@ def test_a_name_with_a_combining_accent_reads_back_from_csv(tmp_path):
     assert back.columns == res.columns
     assert all(unicodedata.is_normalized("NFC", c) for c in back.columns)
     np.testing.assert_array_equal(back.to_numpy(), res.to_numpy())
+
+
+def test_a_results_table_made_by_hand_reads_back_the_same():
+    """Results built in Python with a decomposed name: its columns are in the one form, and
+    indexing by either spelling finds the column."""
+    import numpy as np
+
+    from pam2exu import Results, read_csv
+    res = Results([0.0, 1.0], {"a\u0301.x": np.array([0.5, 0.25])}, {"a\u0301.x": "m"})
+    assert res.columns == ["\u00e1.x"] and res.units["\u00e1.x"] == "m"
+    assert "a\u0301.x" in res and res["a\u0301.x"].tolist() == [0.5, 0.25]
+    import tempfile
+    from pathlib import Path
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "by_hand.csv"
+        res.to_csv(path)
+        assert read_csv(path).columns == res.columns
