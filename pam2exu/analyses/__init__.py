@@ -6,7 +6,7 @@ after an analysis issue.
 """
 from __future__ import annotations
 
-from ..errors import (ConditionWarning, ConsistencyWarning, InputWarning, ModelError,
+from ..errors import (ConditionWarning, ConsistencyWarning, InputWarning, ModelError, echo,
                       Pam2ExuError, RedundancyWarning, SolverError)
 from ..model.angles import UNITS as ANGLE_UNITS
 from ..results.units import in_angles
@@ -83,7 +83,7 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
         job = prepare(model, analysis, t_end, steps, outputs, solver, backend, tolerance)
         if angles not in (None, *ANGLE_UNITS):
             raise ModelError(f"angles must be 'rad' or 'deg' (the unit of the angular "
-                             f"results), got {angles!r}", job.mech.model.source)
+                             f"results), got {echo(angles)}", job.mech.model.source)
         warn_input(job)
         return in_angles(ANALYSES[job.analysis].run(job), angles or job.mech.model.angles)
     except Pam2ExuError:
