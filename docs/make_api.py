@@ -93,7 +93,8 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
      ("Issued with `warnings.warn` at the caller's line and kept in `Results.warnings`; "
       "filter them with the `warnings` module."),
      [("pam2exu", "RedundancyWarning"), ("pam2exu", "ConsistencyWarning"),
-      ("pam2exu", "ConditionWarning"), ("pam2exu", "VariationWarning")]),
+      ("pam2exu", "ConditionWarning"), ("pam2exu", "VariationWarning"),
+      ("pam2exu", "InputWarning")]),
 ]
 
 #: descriptions of data objects (they have no docstring of their own)

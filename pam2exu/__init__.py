@@ -16,7 +16,8 @@ from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot
 from .errors import (MobilityError, ModelError, OutputError, Pam2ExuError, SolverError,
                      TranslationError)
 from .export import export
-from .errors import ConditionWarning, ConsistencyWarning, RedundancyWarning, VariationWarning
+from .errors import (ConditionWarning, ConsistencyWarning, InputWarning, RedundancyWarning,
+                     VariationWarning)
 from .model import Law, Model, Solid, load, loads
 from .pictures import animate, draw
 from .results import CompareInputError, Comparison, Results, plot, read_csv
@@ -107,6 +108,10 @@ def run(model, analysis=None, **settings):
         The mechanism passes at or near a singular position.
     ConsistencyWarning
         kinetostatic: the power balance does not hold.
+    InputWarning
+        A value that is most likely a mistake: an angle above a full turn in a radians
+        model (degrees?), initial rates the constraints do not allow, a law that jumps
+        within a step; naming the solids and elements.
 
     See Also
     --------
@@ -185,4 +190,4 @@ __all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "Results",
            "Spring", "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError",
            "ModelError", "MobilityError", "SolverError", "TranslationError",
            "CompareInputError", "PictureError", "OutputError", "RedundancyWarning",
-           "ConsistencyWarning", "ConditionWarning", "VariationWarning"]
+           "ConsistencyWarning", "ConditionWarning", "VariationWarning", "InputWarning"]

@@ -344,8 +344,8 @@ def _check(args) -> int:
               f"{job.every} sub-steps per step")
     if model.encoding != "utf-8":
         print("the file is not UTF-8: it was read as Windows-1252")
-    from .model.angles import angle_warnings
-    for problem in angle_warnings(model):
+    from .model.mistakes import input_warnings
+    for problem in input_warnings(model):
         print(f"warning: {problem}")
     print()
     width = max([len(e.name) for e in mech.elements] + [4])

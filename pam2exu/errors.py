@@ -9,6 +9,33 @@ import warnings
 from dataclasses import dataclass
 
 
+#: characters of a user's value that a message quotes (``echo``)
+ECHOED = 80
+#: problems a ModelError's message lists (``ModelError.problems`` keeps them all)
+LISTED = 20
+
+
+def echo(value, width: int = ECHOED) -> str:
+    """A user's value as a message quotes it: a string in single quotes, anything else as
+    Python writes it, cut to ``width`` characters with how long it was.
+
+    Examples
+    --------
+    >>> echo("crank"), echo(["crank"]), echo(2.5)
+    ("'crank'", "['crank']", '2.5')
+    >>> echo("x" * 1000, width=5)
+    "'xxxxx… (1000 characters)'"
+    """
+    if isinstance(value, str):
+        text = value if len(value) <= width else f"{value[:width]}… ({len(value)} characters)"
+        return f"'{text}'"
+    try:
+        text = repr(value)
+    except Exception:                      # a value whose repr fails still gets a message
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= width else f"{text[:width]}… ({len(text)} characters)"
+
+
 class Pam2ExuError(Exception):
     """Base class of pam2exu's errors: the message is meant for the user, as is.
 
@@ -104,7 +131,10 @@ class ModelError(Pam2ExuError):
         if len(self.problems) == 1:
             return head + str(self.problems[0])
         lines = [f"{head}{len(self.problems)} problems in the model:"]
-        lines += [f"  - {p}" for p in self.problems]
+        lines += [f"  - {p}" for p in self.problems[:LISTED]]
+        if len(self.problems) > LISTED:
+            lines.append(f"  … and {len(self.problems) - LISTED} more (error.problems lists "
+                         "them all; fix these first)")
         return "\n".join(lines)
 
 
@@ -227,6 +257,8 @@ class OutputError(Pam2ExuError):
 
 def closest(name: str, candidates) -> str:
     """' (did you mean 'x'?)' for the nearest candidate, or ''."""
+    if len(str(name)) > 4 * ECHOED:       # no name is this long; difflib would take seconds
+        return ""
     match = difflib.get_close_matches(str(name), [str(c) for c in candidates], n=1, cutoff=0.5)
     return f" (did you mean '{match[0]}'?)" if match else ""
 
@@ -303,6 +335,22 @@ class VariationWarning(UserWarning):
     ----------
     message : str
         The entry, its anchor, and that no constraint element anchors it.
+    """
+
+
+class InputWarning(UserWarning):
+    """A value of the model that is allowed but most likely a mistake: the run goes on.
+
+    Issued by ``run`` (and kept in ``Results.warnings``), naming the solid or element and the
+    value: an angle of a radians model above a full turn (degrees given by mistake:
+    ``pam2exu check`` prints the same texts); initial rates (``Dx``, ``Dy``, ``Dfi``) of a
+    dynamic model that the constraints do not allow, replaced by the nearest that they do
+    (the given and the used values); a law whose value jumps within one step of the run.
+
+    Parameters
+    ----------
+    message : str
+        Where, which value, and what to change if it is a mistake.
     """
 
 

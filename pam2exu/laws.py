@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["Law", "LAWS", "LAW_ALIASES", "VALUES_OF_F", "law_names"]
+__all__ = ["Law", "LAWS", "LAW_ALIASES", "F_ORDERS", "VALUES_OF_F", "law_names"]
 
 
 def polynomial(t, C, xp=np):
@@ -85,17 +85,23 @@ LAWS: dict[str, tuple[Callable, bool]] = {
     "bezier_c2": (bezier_c2, True),
 }
 
+#: law name -> per constant, the unit it carries as a power of seconds under f's unit: 0 for
+#: f itself [u], 1 for [u/s], 2 for [u/s²], 3 for [u/s³]; None for a constant in its own unit
+#: (the times C1, C2 of a transition [s]; a harmonic's ω [rad/s] and phase [rad])
+F_ORDERS: dict[str, tuple[int | None, int | None, int | None, int | None]] = {
+    "polynomial": (0, 1, 2, 3),
+    "harmonic": (0, 0, None, None),
+    "ramp": (None, None, 0, 0),
+    "bezier_c1": (None, None, 0, 0),
+    "bezier_c2": (None, None, 0, 0),
+}
+
 #: law name -> which constants are in the unit of f (per s, s², s³): C1…C4 of a polynomial,
 #: C1 and C2 of a harmonic (C3 and C4 are the cosine's ω [rad/s] and phase [rad]), C3 and C4
 #: of a transition (C1 and C2 are times). In a model with angles = "deg" these constants of an
 #: angular actuator are degrees (deg/s, …); the others keep their units.
 VALUES_OF_F: dict[str, tuple[bool, bool, bool, bool]] = {
-    "polynomial": (True, True, True, True),
-    "harmonic": (True, True, False, False),
-    "ramp": (False, False, True, True),
-    "bezier_c1": (False, False, True, True),
-    "bezier_c2": (False, False, True, True),
-}
+    name: tuple(order is not None for order in orders) for name, orders in F_ORDERS.items()}
 
 #: Catalan PAM names
 LAW_ALIASES = {"polinomica": "polynomial", "harmonica": "harmonic", "rampa": "ramp"}

@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import unicodedata
+
+from .errors import echo
 
 #: |coordinate| of any point, origin, centre of mass or line [m]; also spring free
 #: lengths and the distances of linear actuators' laws
@@ -21,13 +24,12 @@ ANGLE = 1e7
 VALUE = 1e12
 #: the analysis interval t_end [s]
 T_END = (1e-9, 1e9)
-#: steps of one run (results have steps + 1 rows)
-STEPS = 10_000_000
 #: characters of a solid's or element's name
 NAME = 100
 #: characters of the model's name (titles of pictures and tables show it whole)
 MODEL_NAME = 200
 #: position solves of one run: steps × the sub-steps that keep the motion per solve small
+#: (so also the most steps a run may have: results have steps + 1 rows)
 SOLVE_STEPS = 2_000_000
 #: bytes of the arrays one run holds (coordinates, rates and result columns)
 MEMORY = 4 * 2**30
@@ -49,6 +51,20 @@ def out_of_range(value, limit: float) -> bool:
     return is_number(value) and abs(value) > limit
 
 
+def one_form(value):
+    """A string in one Unicode form (NFC); any other value unchanged.
+
+    A name typed with a combining accent (``a`` + U+0301) is then the same as ``á``
+    everywhere: anchors, result columns, CSV files (which read back in this form).
+
+    Examples
+    --------
+    >>> one_form("a\u0301") == "\u00e1", one_form(3)
+    (True, 3)
+    """
+    return unicodedata.normalize("NFC", value) if isinstance(value, str) else value
+
+
 def name_problem(name) -> str | None:
     """What is wrong with a solid's or element's name, or None.
 
@@ -63,7 +79,7 @@ def name_problem(name) -> str | None:
     "name 'a.b' contains '.', which separates a solid from its point or line: rename it"
     """
     if not isinstance(name, str) or not name.strip():
-        return f"name must be a non-empty string, got {_short(name)}"
+        return f"name must be a non-empty string, got {echo(name)}"
     if len(name) > NAME:
         return f"name is {len(name)} characters long: at most {NAME} are allowed"
     if not name.isprintable():
@@ -81,9 +97,3 @@ def shown(name, width: int = 40) -> str:
     """A name as messages show it: cut to ``width`` characters (a name of any type)."""
     text = str(name)
     return text if len(text) <= width else text[:width - 3] + "..."
-
-
-def _short(value) -> str:
-    """repr of a value, cut to 60 characters."""
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."

@@ -223,6 +223,7 @@ def test_the_ranges_on_the_model_format_page_are_those_of_limits():
     section = section.split("\n## ")[0]
     for value in (limits.LENGTH, limits.ANGLE, limits.VALUE, *limits.T_END):
         assert f"{value:.0e}" in section, value
-    assert f"{limits.STEPS:,}" in section and f"{limits.SOLVE_STEPS:,}" in section
+    assert f"| `steps` | 1 … {limits.SOLVE_STEPS:,} |" in section           # one solve a step
+    assert f"at most {limits.SOLVE_STEPS:,} position solves" in section
     assert f"{limits.MEMORY // 2**30} GiB" in section and f"at most {limits.NAME}" in section
     assert f"at most {limits.MODEL_NAME} characters" in section

@@ -6,12 +6,12 @@ after an analysis issue.
 """
 from __future__ import annotations
 
-from ..errors import (ConditionWarning, ConsistencyWarning, ModelError, Pam2ExuError,
-                      RedundancyWarning, SolverError)
+from ..errors import (ConditionWarning, ConsistencyWarning, InputWarning, ModelError, echo,
+                      Pam2ExuError, RedundancyWarning, SolverError)
 from ..model.angles import UNITS as ANGLE_UNITS
 from ..results.units import in_angles
 from ..registry import ANALYSES
-from .job import prepare
+from .job import prepare, warn_input
 
 
 def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
@@ -68,7 +68,7 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
 
     Warns
     -----
-    RedundancyWarning, ConditionWarning, ConsistencyWarning
+    RedundancyWarning, ConditionWarning, ConsistencyWarning, InputWarning
         See each class; the texts are kept in ``Results.warnings`` too.
 
     Examples
@@ -83,7 +83,8 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
         job = prepare(model, analysis, t_end, steps, outputs, solver, backend, tolerance)
         if angles not in (None, *ANGLE_UNITS):
             raise ModelError(f"angles must be 'rad' or 'deg' (the unit of the angular "
-                             f"results), got {angles!r}", job.mech.model.source)
+                             f"results), got {echo(angles)}", job.mech.model.source)
+        warn_input(job)
         return in_angles(ANALYSES[job.analysis].run(job), angles or job.mech.model.angles)
     except Pam2ExuError:
         raise
@@ -104,4 +105,5 @@ def unexpected(exc: Exception, job, model) -> SolverError:
         "the error's __cause__ in Python).")
 
 
-__all__ = ["ANALYSES", "run", "RedundancyWarning", "ConsistencyWarning", "ConditionWarning"]
+__all__ = ["ANALYSES", "run", "RedundancyWarning", "ConsistencyWarning", "ConditionWarning",
+           "InputWarning"]

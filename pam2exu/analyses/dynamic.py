@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from ..errors import ModelError, SolverError
+from ..errors import InputWarning, ModelError, SolverError
 from ..kinematics import State, pose
 from . import force_pass, free, native
 from .assembly import GUESS_STIFFNESS
@@ -72,6 +72,7 @@ def dynamic(job: Job):
     q0 = assemble(job, redundant, GUESS_STIFFNESS)
     require_inertia(mech, float(t[0]), q0)
     qd0 = nearest_velocities(mech, float(t[0]), q0, mech.initial_qd())
+    warn_rates(job, mech.initial_qd(), qd0)
     job.stage = f"integrating the equations of motion ({job.backend.label})"
     q, qd = motion(job, q0, qd0)
     job.stage = "projecting the integrated states onto the constraints"
@@ -264,6 +265,29 @@ def nearest_velocities(mech, t: float, q: np.ndarray, guess: np.ndarray) -> np.n
     eq = native.equations(mech, State([t], q[None]))
     J = eq.jacobian[0]
     return guess - np.linalg.pinv(J, rcond=1e-12) @ (J @ guess + eq.c_t[0])
+
+
+def warn_rates(job: Job, given: np.ndarray, used: np.ndarray) -> None:
+    """InputWarning naming each solid given a rate (Dx, Dy or Dfi ≠ 0) whose rates the run
+    changed by more than round-off (1e-9 (1 + max |given|)), with the given and used values
+    in the model's units."""
+    model = job.mech.model
+    degrees = model.angles == "deg"
+    roundoff = 1e-9 * (1.0 + float(np.max(np.abs(given), initial=0.0)))
+    used = np.where(np.abs(used) <= roundoff, 0.0, used)        # no -2.2e-16 in the text
+    for i, solid in enumerate(model.solids):
+        rows = slice(3 * i, 3 * i + 3)
+        if not np.any(given[rows]) or np.all(np.abs(used[rows] - given[rows]) <= roundoff):
+            continue
+        changes = [f"{key} = {float(getattr(solid, key)):.6g} {unit} given, "
+                   f"{math.degrees(u) if degrees and key == 'Dfi' else u:.6g} {unit} used"
+                   for key, u, g, unit in
+                   zip(("Dx", "Dy", "Dfi"), used[rows], given[rows],
+                       ("m/s", "m/s", "deg/s" if degrees else "rad/s"))
+                   if abs(u - g) > roundoff]
+        warn(job, f"{model.source + ': ' if model.source else ''}{solid.where}: the constraints "
+                  "do not allow the initial rates given, the run starts from the nearest that "
+                  f"they do: {'; '.join(changes)}", InputWarning)
 
 
 def project(mech, t, q, qd):

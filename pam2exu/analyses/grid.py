@@ -55,11 +55,41 @@ def driver_unit(el) -> tuple[str, float]:
 
 
 def motion_per_step(law, times: np.ndarray) -> float:
-    """max_k max(|f(t_k+1) − f(t_k)|, |f'(t_k)| Δt): the most the law moves in one step."""
+    """max_k max(|f(t_k+1) − f(t_k)|, |f'(t)| Δt): the most the law moves in one step, f'
+    taken at the grid's times and inside its transition (C1 … C2, which may fall between
+    two of them)."""
     with np.errstate(all="ignore"):
         f, df, _ = law(times)
         dt = float(times[1] - times[0])
-        return float(max(np.max(np.abs(np.diff(f))), np.max(np.abs(df)) * dt))
+        inside = transition_times(law, float(times[0]), float(times[-1]))
+        rate = max(np.max(np.abs(df)), np.max(np.abs(law(inside)[1]), initial=0.0))
+        return float(max(np.max(np.abs(np.diff(f))), rate * dt))
+
+
+def transition_times(law, start: float, end: float, count: int = 17) -> np.ndarray:
+    """``count`` equally spaced times of the law's transition C1 … C2 within [start, end]
+    (its middle, where a bezier moves fastest, among them); none for a law without one."""
+    if not law.breakpoints():
+        return np.empty(0)
+    c1, c2 = law.breakpoints()
+    low, high = max(c1, start), min(c2, end)
+    return np.linspace(low, high, count) if low < high else np.empty(0)
+
+
+def jump(el, dt: float) -> str | None:
+    """What to say when the actuator's law moves (C3 → C4) in less than ``dt`` [s], a step of
+    the run: its value jumps from one position solve to the next. None otherwise."""
+    law = el.time_law()
+    if not law.breakpoints():
+        return None
+    c1, c2, c3, c4 = law.C
+    unit, _ = driver_unit(el)
+    if c2 - c1 >= dt or c3 == c4:
+        return None
+    return (f"law '{law.name}' with C = {list(law.C)} goes from C3 = {c3:g} to C4 = {c4:g} "
+            f"{unit} in C2 − C1 = {c2 - c1:.3g} s, less than a step of the run ({dt:.3g} s): "
+            f"its value jumps. Make the motion last longer (C1 and C2 are the times it starts "
+            f"and ends [s]), or check the constants")
 
 
 def check_laws(mech, times: np.ndarray, ranges: bool = True) -> None:
@@ -113,11 +143,17 @@ def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
         if needed > every or worst is None:
             worst = (el, moved, unit)
         every = max(every, needed)
-    if every > 1 and steps * every > max(limits.SOLVE_STEPS, steps):
+    if steps * every > limits.SOLVE_STEPS:
         el, moved, unit = worst
         verb = "turns" if unit == "rad" else "moves"
         _, most = driver_unit(el)
         total = steps * every
+        why = jump(el, float(t_end) / steps)
+        if why:
+            raise ModelError(Problem(el.where, (
+                f"{why} (following it in steps of at most {most:g} {unit} would take "
+                f"{total:.2g} position solves, more than pam2exu runs: "
+                f"{limits.SOLVE_STEPS:,})")), mech.model.source)
         raise ModelError(Problem(
             "[analysis]",
             f"'{el.name}' {verb} {moved:.2g} {unit} per step (t_end = {t_end:g} s in {steps} "

@@ -10,9 +10,10 @@ import numpy as np
 from .. import points, registry
 from ..backend import Backend
 from ..elements import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY, Var
-from ..errors import ModelError, Problem, RedundancyWarning, warn_outside
+from ..errors import InputWarning, ModelError, Problem, RedundancyWarning, warn_outside
 from ..kinematics import State, column
 from ..model import Model, load
+from ..model.mistakes import input_warnings
 from ..model.solid import SOLID_OUTPUTS
 from ..results import Results, select_columns
 from ..results.info import RunInfo
@@ -156,6 +157,14 @@ def warn_redundant(job: Job, q: np.ndarray) -> None:
             f"velocities and accelerations are unique, the reactions of these elements "
             f"are not (they are given as the minimum-norm solution)")
     warn(job, text, RedundancyWarning)
+
+
+def warn_input(job: Job) -> None:
+    """Warn of the model's likely mistakes that still run (``InputWarning``): what
+    ``model.mistakes.input_warnings`` lists and ``pam2exu check`` prints."""
+    source = job.mech.model.source
+    for problem in input_warnings(job.mech.model):
+        warn(job, f"{source}: {problem}" if source else str(problem), InputWarning)
 
 
 def warn(job: Job, text: str, category) -> None:

@@ -9,10 +9,16 @@ import numpy as np
 from ..backend import Positions
 from ..elements import ACCELERATION, VELOCITY
 from ..kinematics import ANGLES
+from ..progress import Progress
 from . import native
 from .checks import check_residual
 from .failure import position_failure, singular_error
 from .job import Job, warn_redundant
+
+#: steps solved by one call of the backend: a longer run is solved in parts, one tick of its
+#: progress bar each (a part takes a few seconds: 5 s for the four-bar on a slow machine;
+#: each part costs a new Exudyn system, about 0.2 s, so parts are not made smaller)
+PART_STEPS = 50_000
 
 
 def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
@@ -32,9 +38,7 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     if len(job.times) == 1:                      # the assembly itself
         found = Positions(start[None], 1, None, start)
     else:
-        found = job.backend.solve_positions(mech, job.times, start, job.solver,
-                                            redundant=redundant,
-                                            rates=VELOCITY in job.levels)
+        found = solve_in_parts(job, start, redundant, VELOCITY in job.levels)
         if found.solved:         # step 0 is the assembly (Newton moved it by round-off)
             found.q[0] = start
     job.info["exudyn_seconds"] = _time.perf_counter() - clock
@@ -46,6 +50,40 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     if redundant:
         warn_redundant(job, found.q[0])
     return (found.q, found) if partial else found.q
+
+
+def solve_in_parts(job: Job, start: np.ndarray, redundant: bool, rates: bool) -> Positions:
+    """The backend's Positions at every time of the run from ``start``, solved in parts of
+    ``PART_STEPS`` steps, each from where the last ended, with a progress bar on a terminal
+    (``pam2exu.progress``) when there are several: a long run shows how far it is."""
+    mech, times = job.mech, job.times
+    n = len(times)
+    if n <= PART_STEPS + 1:
+        return job.backend.solve_positions(mech, times, start, job.solver,
+                                           redundant=redundant, rates=rates)
+    firsts = range(0, n - 1, PART_STEPS)
+    q = np.full((n, mech.nq), np.nan)
+    rates_of: dict[str, np.ndarray] = {}          # the backend's qd, qdd if it gives them
+    solved, error, last, iterations = 0, None, start, 0
+    with Progress(len(firsts), "solving the positions") as bar:
+        for done, a in enumerate(firsts, start=1):
+            b = min(a + PART_STEPS, n - 1)
+            part = job.backend.solve_positions(mech, times[a:b + 1], q[a] if a else start,
+                                               job.solver, redundant=redundant, rates=rates)
+            iterations += part.iterations
+            keep = slice(a + (1 if a else 0), a + part.solved)   # row a: the last part's
+            q[keep] = part.q[keep.start - a:part.solved]
+            for mine, theirs in (("qd", part.qd), ("qdd", part.qdd)):
+                if theirs is not None:
+                    rows = rates_of.setdefault(mine, np.full_like(q, np.nan))
+                    rows[a:a + part.solved] = theirs[:part.solved]
+            solved = a + max(part.solved, 1 if a else 0)
+            bar.update(done)
+            if part.solved < b - a + 1:
+                error, last = part.error, part.last
+                break
+    return Positions(q, solved, error, last, None, iterations, rates_of.get("qd"),
+                     rates_of.get("qdd"))
 
 
 def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.ndarray:

@@ -15,16 +15,21 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import closest
-from ..limits import VALUE, is_number, shown
+from ..errors import closest, echo
+from ..limits import VALUE, is_number, one_form, shown
 from ..kinematics import Quantity, State, pose
-from ..laws import LAW_ALIASES, LAWS, VALUES_OF_F, Law, law_names
+from ..laws import F_ORDERS, LAW_ALIASES, LAWS, VALUES_OF_F, Law, law_names
 
 #: What an output needs from an analysis, in the order analyses can provide it.
 POSITION, VELOCITY, ACCELERATION, FORCE = "position", "velocity", "acceleration", "force"
 #: the level of a joint's clearance parameters (``Element.clearance_parameters``): given by
 #: the clearance analysis only (shared/spec/clearance.md)
 CLEARANCE = "clearance"
+
+
+#: how an anchor of each kind is written
+ANCHOR_FORMS = {"solid": '"solid"', "point": '"solid.point", or "solid" for its origin',
+                "line": '"solid.line", or "solid" for its x axis'}
 
 
 @dataclass(frozen=True)
@@ -70,11 +75,22 @@ class Param:
         if value is None:
             return f"'{key}' is required ({self.meaning})" if self.required else None
         if self.kind == "constants":
-            values = list(value) if isinstance(value, (list, tuple, np.ndarray)) else [value]
+            if not isinstance(value, (list, tuple, np.ndarray)):
+                shape = ", ".join(f"C{k + 1}" for k in range(self.size))
+                if not is_number(value):
+                    return (f"'{key}' must be a list of numbers, {key} = [{shape}] "
+                            f"({self.meaning}), got {echo(value)}")
+                return (f"'{key}' must be a list, {key} = [{shape}] ({self.meaning}), got the "
+                        f"single number {value!r}: write {key} = [{value!r}] if it is C1, and "
+                        f"give the other constants")
+            values = list(value)
             if len(values) > self.size:
                 return (f"'{key}' has {len(values)} constants, at most {self.size} are allowed "
                         f"({self.meaning})")
-            bad = [repr(v) for v in values if not is_number(v)]
+            if any(isinstance(v, (list, tuple, dict, np.ndarray)) for v in values):
+                return (f"'{key}' must be a flat list of numbers, {key} = [C1, C2, …] "
+                        f"({self.meaning}), got a nested list {echo(value)}")
+            bad = [echo(v) for v in values if not is_number(v)]
             if bad:
                 return f"'{key}' must hold numbers, got {', '.join(bad)}"
             large = [f"C{k + 1} = {v:g}" for k, v in enumerate(values) if abs(v) > self.limit]
@@ -85,23 +101,23 @@ class Param:
             if isinstance(value, (list, tuple)) and len(value) == 1:
                 value = value[0]
             if not is_number(value):
-                return f"'{key}' must be a number ({self.meaning}), got {value!r}"
+                return f"'{key}' must be a number ({self.meaning}), got {echo(value)}"
             if abs(value) > self.limit:
                 return (f"'{key}' = {value:g} is out of range: it must lie within "
                         f"±{self.limit:g} ({self.meaning}; are the units right?)")
 
         elif self.kind == "law":
             if not isinstance(value, str) or (value not in LAWS and value not in LAW_ALIASES):
-                return (f"unknown law '{value}'{closest(value, law_names())}; "
+                return (f"unknown law {echo(value)}{closest(value, law_names())}; "
                         f"known laws: {', '.join(law_names())}")
         elif self.kind == "choice":
             if value not in self.choices:
                 return (f"'{key}' must be one of {', '.join(map(repr, self.choices))}, "
-                        f"got {value!r}{closest(value, self.choices)}")
+                        f"got {echo(value)}{closest(value, self.choices)}")
         elif self.kind == "solid" and not isinstance(value, str):
-            return f"'{key}' must be a solid name, got {value!r}"
+            return f"'{key}' must be a solid name, got {echo(value)}"
         elif self.kind == "boolean" and not isinstance(value, bool):
-            return f"'{key}' must be true or false ({self.meaning}), got {value!r}"
+            return f"'{key}' must be true or false ({self.meaning}), got {echo(value)}"
         return None
 
 
@@ -180,6 +196,13 @@ class Element:
     #: 1-based position in the file's [[element]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
 
+    def __post_init__(self):
+        """The names it gives (its own, its anchors, a solid key's) in one Unicode form
+        (``limits.one_form``), as the solids' names."""
+        for key in ("name", "anc1", "anc2", *(k for k, p in self.params.items()
+                                               if p.kind == "solid")):
+            setattr(self, key, one_form(getattr(self, key)))
+
     # ---- declaration -------------------------------------------------------------------
     @classmethod
     def keys(cls) -> list[str]:
@@ -201,10 +224,14 @@ class Element:
                 if value is None:
                     out.append(f"'{kind}' is missing: it must name a {self.anchors[k]}")
                     continue
+                if not isinstance(value, str):
+                    out.append(f"'{kind}' must be a string naming a {self.anchors[k]} "
+                               f"({ANCHOR_FORMS[self.anchors[k]]}), got {echo(value)}")
+                    continue
                 try:
                     scope.resolve(self.anchors[k], value)
                 except LookupError as exc:
-                    out.append(f"{kind} = '{value}': {exc}")
+                    out.append(f"{kind} = {echo(value)}: {exc}")
             elif value is not None:
                 out.append(f"a {self.type} takes no '{kind}' (remove it)")
         for key, param in self.params.items():
@@ -215,7 +242,7 @@ class Element:
                 try:
                     scope.solid(getattr(self, key))
                 except LookupError as exc:
-                    out.append(f"{key} = '{getattr(self, key)}': {exc}")
+                    out.append(f"{key} = {echo(getattr(self, key))}: {exc}")
         if not out and len(self.anchors) == 2 and self.equations:
             a, b = (scope.resolve(kind, getattr(self, f"anc{k + 1}"))
                     for k, kind in enumerate(self.anchors))
@@ -227,6 +254,11 @@ class Element:
 
     def more_problems(self, scope) -> list[str]:
         """Checks particular to one element type (after the generic ones passed)."""
+        return []
+
+    def mistakes(self) -> list[str]:
+        """What its valid keys say that is allowed but most likely a mistake, one message
+        each (``model.mistakes.input_warnings``; ``run`` warns of them)."""
         return []
 
     def bind(self, scope) -> None:
@@ -246,6 +278,22 @@ class Element:
         """Which values of ``key`` are angles or angular rates (``Param.angles``; an
         actuator's law constants depend on its law and kind)."""
         return self.params[key].angles
+
+    def given_angles(self) -> list[tuple[str, float]]:
+        """(label, value) of every angle its keys give, in the model's unit (not a rate):
+        ``Param.angles`` flags angles only, an actuator says which law constants are f.
+        Read after validation (the values are numbers)."""
+        out = []
+        for key in self.params:
+            flags, value = self.angle_values(key), getattr(self, key)
+            if not any(flags) or value is None:
+                continue
+            if isinstance(value, (list, tuple, np.ndarray)):
+                out += [(f"{key}{k + 1}", float(v)) for k, v in enumerate(value)
+                        if k < len(flags) and flags[k]]
+            else:
+                out.append((key, float(value)))
+        return out
 
     # ---- kinematics --------------------------------------------------------------------
     def constraint(self, st: State) -> tuple[Quantity, Any]:
@@ -334,6 +382,14 @@ class Actuator(Element):
             return VALUES_OF_F[LAW_ALIASES.get(self.law, self.law)] if self.angular else ()
         return super().angle_values(key)
 
+    def given_angles(self):
+        """An angular actuator's law constants that are values of f (not its rates)."""
+        law = LAW_ALIASES.get(self.law, self.law)
+        if not self.angular or law not in F_ORDERS:
+            return []
+        return [(f"law '{law}' C{k + 1}", c) for k, (c, order)
+                in enumerate(zip(constants(self.C), F_ORDERS[law])) if order == 0]
+
     def more_problems(self, scope):
         law = LAW_ALIASES.get(self.law, self.law)
         c1, c2 = constants(self.C)[:2]
@@ -341,6 +397,20 @@ class Actuator(Element):
             return [f"law '{self.law}' needs C1 < C2 (start and end of the motion, s), "
                     f"got C1 = {c1:g}, C2 = {c2:g}"]
         return []
+
+    def mistakes(self):
+        """A transition law given fewer than its four constants: the missing ones are 0 (the
+        format's rule), so C4 = 0 is where it goes (from C3, between C1 and C2)."""
+        law = LAW_ALIASES.get(self.law, self.law)
+        given = len(self.C) if isinstance(self.C, (list, tuple, np.ndarray)) else 1
+        if not LAWS[law][1] or given >= 4:
+            return []
+        c1, c2, c3, c4 = constants(self.C)
+        missing = ", ".join(f"C{k + 1}" for k in range(given, 4))
+        return [f"law '{self.law}' is given {given} constants, C = {list(self.C)}: {missing} "
+                f"{'is' if given == 3 else 'are'} taken as 0, so f goes from C3 = {c3:g} to "
+                f"C4 = {c4:g} between t = {c1:g} s and {c2:g} s; give the four constants "
+                "C = [C1, C2, C3, C4] (start [s], end [s], value before, value after)"]
 
     def time_law(self) -> Law:
         """The law f(t) with this element's constants (subclasses have ``law`` and ``C``)."""

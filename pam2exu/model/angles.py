@@ -14,7 +14,7 @@ import copy
 import math
 
 from ..elements import Element
-from ..errors import Problem
+from ..errors import Problem, echo
 from ..limits import is_number
 from .solid import Solid
 from .variation import Variation
@@ -104,22 +104,28 @@ def angles_problem(angles) -> str | None:
     """The message for a bad ``[model] angles`` (None when it is "rad" or "deg")."""
     if angles in UNITS:
         return None
-    return (f"angles must be \"rad\" (the default) or \"deg\", got {angles!r}: the unit of every "
+    return (f"angles must be \"rad\" (the default) or \"deg\", got {echo(angles)}: the unit of every "
             "angle the model gives (fi, line angles, an angular actuator's law, …)")
 
 
 def angle_warnings(model) -> list[Problem]:
-    """Solids of a radians model whose ``fi`` guess is more than a full turn: degrees, likely.
+    """The angles of a radians model that are more than a full turn: degrees, likely.
+
+    ``pam2exu check`` prints them and ``run`` issues them (``AngleWarning``): one text each.
 
     Parameters
     ----------
     model : Model
+        A valid model.
 
     Returns
     -------
     list of Problem
-        One per solid with |fi| > 2π in a model with ``angles = "rad"``: it names the solid
-        and says what to change. None for a degrees model.
+        One per solid whose ``fi`` guess, and per element whose given angle (an angular
+        actuator's law value C1 of a polynomial, C1 and C2 of a harmonic, C3 and C4 of a
+        transition; a transmission's C; a torsional spring's C3), has a magnitude above 2π in
+        a model with ``angles = "rad"``; each names the solid or element and says what to
+        change. None for a degrees model.
 
     Examples
     --------
@@ -131,8 +137,16 @@ def angle_warnings(model) -> list[Problem]:
     """
     if model.angles != "rad":
         return []
-    return [Problem(s.where, f"fi = {s.fi:g} rad is more than a full turn (2π = 6.28 rad): did "
-                             f"you give degrees? Write fi in radians ({s.fi:g}° = "
-                             f"{degrees_to_radians(s.fi):.4g} rad), or set angles = \"deg\" in "
-                             "[model] to give every angle of the model in degrees")
-            for s in model.solids if is_number(s.fi) and abs(s.fi) > 2.0 * math.pi]
+    found = [(s.where, "fi", s.fi) for s in model.solids if is_number(s.fi)]
+    found += [(el.where, label, value) for el in model.elements
+              for label, value in el.given_angles()]
+    return [Problem(where, _turn_message(label, value))
+            for where, label, value in found if abs(value) > 2.0 * math.pi]
+
+
+def _turn_message(label: str, value: float) -> str:
+    """What to say of an angle ``label = value`` [rad] above a full turn."""
+    return (f"{label} = {value:g} rad is more than a full turn (2π = 6.28 rad): did you give "
+            f"degrees? Write {label.split()[-1]} in radians ({value:g}° = "
+            f"{degrees_to_radians(value):.4g} rad), or set angles = \"deg\" in [model] to give "
+            "every angle of the model in degrees")

@@ -5,7 +5,8 @@ import tomllib
 from pathlib import Path
 
 from ..elements import ALIASES, ELEMENTS, misplaced_clearance
-from ..errors import ModelError, Problem, closest
+from ..errors import ModelError, Problem, closest, echo
+from ..limits import shown
 from .model import Analysis, Model
 from .solid import Solid
 from .variation import KEYS as _VARIATION_KEYS
@@ -75,9 +76,15 @@ def decode(raw: bytes, source: str) -> str:
     """A model file's text: UTF-8 (with or without BOM), else Windows-1252.
 
     Windows editors and PAM's exports save Windows-1252 ("ANSI"): its accented letters
-    (``Força``, ``molla_amortidor``) are read as they are meant. Bytes that are neither
-    are a ModelError that says to save the file as UTF-8.
+    (``Força``, ``molla_amortidor``) are read as they are meant. UTF-16 or UTF-32 text
+    (``wide_encoding``), and bytes that are neither, are a ModelError that says to save the
+    file as UTF-8.
     """
+    wide = wide_encoding(raw)
+    if wide:
+        raise ModelError(f"the file is {wide} text (Notepad's \"Unicode\"), which pam2exu does "
+                         "not read: save the file as UTF-8 (Notepad: File > Save as, Encoding: "
+                         "UTF-8)", source)
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as utf8:
@@ -87,6 +94,34 @@ def decode(raw: bytes, source: str) -> str:
             raise ModelError(
                 f"the file is not text in UTF-8 or Windows-1252 (byte 0x{raw[utf8.start]:02x} at "
                 f"position {utf8.start}): save it as UTF-8 text", source) from None
+
+
+#: byte-order marks of the encodings of 2 and 4 bytes a character (UTF-32's first: FF FE 00 00
+#: begins with UTF-16's FF FE)
+_WIDE_BOMS = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
+              (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
+
+
+def wide_encoding(raw: bytes) -> str | None:
+    """"UTF-16" or "UTF-32" when the bytes are text in that encoding, else None.
+
+    Known by the byte-order mark, or without one by NUL bytes (which no UTF-8 or
+    Windows-1252 text has): 2 or 4 bytes a character put a NUL beside every ASCII letter.
+
+    Examples
+    --------
+    >>> wide_encoding("[model]".encode("utf-16")), wide_encoding("[model]".encode("utf-16-le"))
+    ('UTF-16', 'UTF-16')
+    >>> wide_encoding("[model]".encode("utf-32-be")), wide_encoding("[model]".encode("utf-8-sig"))
+    ('UTF-32', None)
+    """
+    for bom, name in _WIDE_BOMS:
+        if raw.startswith(bom):
+            return name
+    head = raw[:4096]
+    if b"\x00" not in head:
+        return None
+    return "UTF-32" if head.count(b"\x00") > 0.6 * len(head) else "UTF-16"
 
 
 def loads(text: str, source: str = "<string>") -> Model:
@@ -149,14 +184,14 @@ def loads(text: str, source: str = "<string>") -> Model:
     problems: list[Problem] = []
     for key in data:
         if key not in _TABLES:
-            problems.append(Problem(f"[{key}]", f"unknown table{closest(key, _TABLES)}; "
+            problems.append(Problem(f"[{echo(key)[1:-1]}]", f"unknown table{closest(key, _TABLES)}; "
                                                 f"a model has {', '.join(_TABLES)}"))
     head = _table(data, "model", problems)
     _unknown_keys(head, _MODEL_KEYS, "[model]", problems)
     model = Model(name=head.get("name", Path(source).stem), gravity=head.get("gravity", 9.81),
                   source=source, angles=head.get("angles", "rad"))
     for k, entry in enumerate(_array(data, "solid", problems), start=1):
-        where = f"[[solid]] #{k}" + (f" '{entry['name']}'" if "name" in entry else "")
+        where = f"[[solid]] #{k}" + (f" '{shown(entry['name'])}'" if "name" in entry else "")
         _unknown_keys(entry, _SOLID_KEYS, where, problems)
         if "name" not in entry:
             problems.append(Problem(where, "'name' is missing"))
@@ -164,14 +199,14 @@ def loads(text: str, source: str = "<string>") -> Model:
         keys.setdefault("name", f"solid{k}")
         model.add_solid(Solid(**keys, position=k))
     for k, entry in enumerate(_array(data, "element", problems), start=1):
-        where = f"[[element]] #{k}" + (f" '{entry['name']}'" if "name" in entry else "")
+        where = f"[[element]] #{k}" + (f" '{shown(entry['name'])}'" if "name" in entry else "")
         kind = entry.get("type")
         if kind is None:
             problems.append(Problem(where, f"'type' is missing; one of {', '.join(ELEMENTS)}"))
             continue
         cls = ELEMENTS.get(ALIASES.get(kind, kind)) if isinstance(kind, str) else None
         if cls is None:
-            problems.append(Problem(where, f"unknown element type '{kind}'"
+            problems.append(Problem(where, f"unknown element type {echo(kind)}"
                                            f"{closest(kind, [*ELEMENTS, *ALIASES])}; known types: "
                                            f"{', '.join(ELEMENTS)}"))
             continue
@@ -216,6 +251,6 @@ def _array(data, key, problems) -> list[dict]:
 def _unknown_keys(entry: dict, allowed, where, problems) -> list[str]:
     bad = [key for key in entry if key not in allowed]
     for key in bad:
-        problems.append(Problem(where, f"unknown key '{key}'{closest(key, allowed)}; "
+        problems.append(Problem(where, f"unknown key {echo(key)}{closest(key, allowed)}; "
                                        f"allowed keys: {', '.join(allowed)}"))
     return bad

@@ -9,7 +9,7 @@ from dataclasses import dataclass, fields
 
 from .. import limits, registry
 from ..elements import ALIASES, ELEMENTS, Element, misplaced_clearance
-from ..errors import ModelError, Problem, VariationWarning, closest, warn_outside
+from ..errors import ModelError, Problem, VariationWarning, closest, echo, warn_outside
 from ..limits import is_number as _number
 from .angles import angles_problem
 from .mechanism import Mechanism
@@ -90,24 +90,26 @@ class Analysis:
         if not isinstance(self.type, str) or self.type not in registry.ANALYSES:
             names = list(registry.ANALYSES)
             aliases = [a.alias for a in registry.ANALYSES.values()]
-            out.append(f"unknown analysis type '{self.type}'"
+            out.append(f"unknown analysis type {echo(self.type)}"
                        f"{closest(str(self.type), names + aliases)}; known types: "
                        f"{', '.join(names)} (Catalan: {', '.join(aliases)})")
         if not isinstance(self.backend, str) or self.backend not in registry.BACKENDS:
             names = list(registry.BACKENDS)
-            out.append(f"unknown backend '{self.backend}'{closest(str(self.backend), names)}; "
+            out.append(f"unknown backend {echo(self.backend)}{closest(str(self.backend), names)}; "
                        f"known backends: {', '.join(names)}")
         low, high = limits.T_END
         if not _number(self.t_end) or self.t_end <= 0:
-            out.append(f"t_end must be a positive number of seconds, got {self.t_end!r}")
+            out.append(f"t_end must be a positive number of seconds, got {echo(self.t_end)}")
         elif not low <= self.t_end <= high:
             out.append(f"t_end = {self.t_end:g} s is out of range: it must lie between "
                        f"{low:g} s and {high:g} s")
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
-            out.append(f"steps must be a positive whole number, got {self.steps!r}")
-        elif self.steps > limits.STEPS:
-            out.append(f"steps = {self.steps} is more than pam2exu runs ({limits.STEPS:,}): "
-                       "use fewer steps")
+            out.append(f"steps must be a positive whole number, got {echo(self.steps)}")
+        elif self.steps > limits.SOLVE_STEPS:
+            out.append(f"steps = {self.steps} is more than pam2exu runs: one run solves the "
+                       f"positions at most {limits.SOLVE_STEPS:,} times, once a step at least. "
+                       "Use fewer steps (every row is exact, whatever the step), or split "
+                       "the interval into several runs, each over a shorter t_end")
         if self.outputs is not None and (
                 not isinstance(self.outputs, (list, tuple))
                 or not all(isinstance(o, str) for o in self.outputs)):
@@ -115,7 +117,7 @@ class Analysis:
             out.append("outputs must be a list of names or patterns, e.g. [\"crank.*\", \"Fx\"]")
         if not _number(self.tolerance) or not 0 < self.tolerance <= MAX_TOLERANCE:
             out.append(f"tolerance must be a number in (0, {MAX_TOLERANCE:g}], the error "
-                       f"allowed per unit of a coordinate or rate, got {self.tolerance!r}")
+                       f"allowed per unit of a coordinate or rate, got {echo(self.tolerance)}")
         return out
 
 
@@ -401,14 +403,14 @@ class Model:
         out: list[Problem] = []
         if not _number(self.gravity) or self.gravity < 0:
             out.append(Problem("[model]", f"gravity is the magnitude along −y, a number ≥ 0; "
-                                          f"got {self.gravity!r}"))
+                                          f"got {echo(self.gravity)}"))
         elif self.gravity > limits.VALUE:
             out.append(Problem("[model]", f"gravity = {self.gravity:g} m/s² is out of range "
                                           f"(at most {limits.VALUE:g})"))
         if angles_problem(self.angles):
             out.append(Problem("[model]", angles_problem(self.angles)))
         if not isinstance(self.name, str):
-            out.append(Problem("[model]", f"name must be a string, got {self.name!r}"))
+            out.append(Problem("[model]", f"name must be a string, got {echo(self.name)}"))
         elif len(self.name) > limits.MODEL_NAME:
             out.append(Problem("[model]", f"name is {len(self.name)} characters long: at most "
                                           f"{limits.MODEL_NAME} are allowed"))

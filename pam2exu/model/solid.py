@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 
 from ..elements.base import ACCELERATION, POSITION, VELOCITY, Var
 from .. import limits
-from ..errors import closest
+from ..errors import closest, echo
 from ..limits import is_number, shown
 
 
@@ -73,6 +73,14 @@ class Solid:
     EXTENSIONS: ClassVar[tuple[str, ...]] = ("Dx", "Dy", "Dfi")
     #: 1-based position in the file's [[solid]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        """Its name, points' and lines' names in one Unicode form (``limits.one_form``)."""
+        self.name = limits.one_form(self.name)
+        for key in ("points", "lines"):
+            table = getattr(self, key)
+            if isinstance(table, dict):
+                setattr(self, key, {limits.one_form(k): v for k, v in table.items()})
 
     @property
     def where(self) -> str:
@@ -248,42 +256,45 @@ def solid_problems(s: Solid, degrees: bool = False) -> list[str]:
     for key, limit, unit in _SOLID_NUMBERS:
         value = getattr(s, key)
         if not is_number(value):
-            out.append(f"{key} must be a number, got {value!r}")
+            out.append(f"{key} must be a number, got {echo(value)}")
         out += range_problems(key, value, *(_in_degrees(limit, unit) if degrees
                                            else (limit, unit)))
     for key in ("mass", "inertia"):
         if is_number(getattr(s, key)) and getattr(s, key) < 0:
             out.append(f"{key} is negative ({getattr(s, key)}): it must be ≥ 0")
     if not _pair(s.cog):
-        out.append(f"cog must be [x, y] in the local frame, got {s.cog!r}")
+        out.append(f"cog must be [x, y] in the local frame, got {echo(s.cog)}")
     else:
         out += _point_range("cog", s.cog)
     if not isinstance(s.points, dict):
-        out.append(f"points must be a table {{ A = [x, y] }}, got {s.points!r}")
+        out.append(f"points must be a table {{ A = [x, y] }}, got {echo(s.points)}")
     else:
         for name, p in s.points.items():
             if not _pair(p):
-                out.append(f"point '{name}' must be [x, y], got {p!r}")
+                out.append(f"point {echo(name)} must be [x, y], got {echo(p)}")
             else:
-                out += _point_range(f"point '{name}'", p)
+                out += _point_range(f"point {echo(name)}", p)
     if not isinstance(s.lines, dict):
-        out.append(f"lines must be a table {{ l = {{ point = [x, y], angle = a }} }}, got {s.lines!r}")
+        out.append(f"lines must be a table {{ l = {{ point = [x, y], angle = a }} }}, got "
+                   f"{echo(s.lines)}")
         return out
     for name, line in s.lines.items():
         if not isinstance(line, dict):
-            out.append(f"line '{name}' must be {{ point = [x, y], angle = a }}, got {line!r}")
+            out.append(f"line {echo(name)} must be {{ point = [x, y], angle = a }}, got "
+                       f"{echo(line)}")
             continue
         for key in line:
             if key not in LINE_KEYS:
-                out.append(f"line '{name}' has an unknown key '{key}'{closest(key, LINE_KEYS)}")
+                out.append(f"line {echo(name)} has an unknown key {echo(key)}"
+                           f"{closest(key, LINE_KEYS)}")
         if "point" in line and not _pair(line["point"]):
-            out.append(f"line '{name}': point must be [x, y], got {line['point']!r}")
+            out.append(f"line {echo(name)}: point must be [x, y], got {echo(line['point'])}")
         elif "point" in line:
-            out += _point_range(f"line '{name}' point", line["point"])
+            out += _point_range(f"line {echo(name)} point", line["point"])
         angle_range = _in_degrees(limits.ANGLE, "rad") if degrees else (limits.ANGLE, "rad")
         if "angle" in line and not is_number(line["angle"]):
-            out.append(f"line '{name}': angle must be a number [{angle_range[1]}], got "
-                       f"{line['angle']!r}")
-        out += range_problems(f"line '{name}' angle", line.get("angle"), *angle_range)
+            out.append(f"line {echo(name)}: angle must be a number [{angle_range[1]}], got "
+                       f"{echo(line['angle'])}")
+        out += range_problems(f"line {echo(name)} angle", line.get("angle"), *angle_range)
 
     return out

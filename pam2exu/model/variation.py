@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import limits
-from ..errors import closest
-from ..limits import is_number, shown
+from ..errors import closest, echo
+from ..limits import is_number
 from .solid import LineRef, PointRef, Scope, _table
 
 #: the keys of a [[variation]] table, in the contract's order
@@ -110,11 +110,15 @@ class Variation:
     #: 1-based position in the file's [[variation]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
 
+    def __post_init__(self):
+        """Its anchor in one Unicode form (``limits.one_form``), as the solids' names."""
+        self.anchor = limits.one_form(self.anchor)
+
     @property
     def where(self) -> str:
         """Where it is in the model: ``"[[variation]] #2 (anchor 'crank.A')"``."""
         at = f" #{self.position}" if self.position else ""
-        anchor = f" (anchor '{shown(self.anchor)}')" if self.anchor is not None else ""
+        anchor = f" (anchor {echo(self.anchor, 40)})" if self.anchor is not None else ""
         return f"[[variation]]{at}{anchor}"
 
     def omega(self, component: str) -> float:
@@ -199,13 +203,13 @@ class Variation:
             if value is None and key.startswith("w") and key != "w":
                 continue
             if not is_number(value):
-                out.append(f"'{key}' must be a number [{unit}], got {value!r}")
+                out.append(f"'{key}' must be a number [{unit}], got {echo(value)}")
             elif abs(value) > limit:
                 out.append(f"'{key}' = {value:g} {unit} is out of range: its magnitude must be "
                            f"at most {limit:g} {unit} (are the units right?)")
         low, high = limits.T_END
         if not is_number(self.tau):
-            out.append(f"'tau' must be a number of seconds, got {self.tau!r}")
+            out.append(f"'tau' must be a number of seconds, got {echo(self.tau)}")
         elif self.tau <= 0:
             out.append(f"'tau' = {self.tau:g} s: the time constant of the ramp must be > 0 "
                        f"(1 s is the slides' law)")
@@ -228,25 +232,25 @@ def _kind(scope: Scope, anchor) -> str:
     write when it names neither, a bare solid, or both)."""
     if not isinstance(anchor, str):
         raise LookupError(f"'anchor' must be \"solid.point\" or \"solid.line\", got "
-                          f"{anchor!r}" if anchor is not None else
+                          f"{echo(anchor)}" if anchor is not None else
                           "'anchor' is missing: name the point or line to vary, "
                           "\"solid.point\" or \"solid.line\"")
     name, dot, item = anchor.partition(".")
     if name not in scope.index:
-        raise LookupError(f"anchor '{anchor}': no solid '{name}'{closest(name, scope.index)}")
+        raise LookupError(f"anchor {echo(anchor)}: no solid '{name}'{closest(name, scope.index)}")
     solid = scope.solids[scope.index[name]]
     points, lines = _table(solid.points), _table(solid.lines)
     declared = ", ".join([*(f"'{name}.{p}'" for p in points),
                           *(f"'{name}.{ln}'" for ln in lines)]) or "none"
     if not dot:
-        raise LookupError(f"anchor '{anchor}' is a bare solid: a variation changes a declared "
+        raise LookupError(f"anchor {echo(anchor)} is a bare solid: a variation changes a declared "
                           f"point or line, name it as \"solid.point\" or \"solid.line\" "
                           f"(the points and lines of '{name}': {declared})")
     if item in points and item in lines:
-        raise LookupError(f"anchor '{anchor}': solid '{name}' has a point and a line named "
+        raise LookupError(f"anchor {echo(anchor)}: solid '{name}' has a point and a line named "
                           f"'{item}': rename one of them")
     if item not in points and item not in lines:
-        raise LookupError(f"anchor '{anchor}': solid '{name}' has no point or line "
+        raise LookupError(f"anchor {echo(anchor)}: solid '{name}' has no point or line "
                           f"'{item}'{closest(item, [*points, *lines])}; its points and "
                           f"lines: {declared}")
     return "point" if item in points else "line"

@@ -9,8 +9,7 @@ columns or the solid or element before the dot. ``compare``, ``read_csv``, ``plo
 from __future__ import annotations
 
 import fnmatch
-import unicodedata
-
+from ..limits import one_form
 from ..points import OPT_IN
 
 # PAM spellings of variable names -> pam2exu's (applied to the part after the last dot)
@@ -58,8 +57,9 @@ def canonical(column: str, names: dict[str, str]) -> tuple[str, tuple[str, ...]]
 
 
 def clean(name: str) -> str:
-    """Strip blanks and use one Unicode form (NFC), so 'Força' typed either way matches."""
-    return unicodedata.normalize("NFC", name.strip())
+    """Strip blanks and use one Unicode form (NFC, ``limits.one_form``, the form of the
+    model's names), so 'Força' typed either way matches."""
+    return one_form(name.strip())
 
 
 def spellings() -> str:

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, Problem, closest
+from ..limits import one_form
 from .info import RunInfo
 from .instant import Instants
 from .names import selects, spelled
@@ -92,13 +93,13 @@ class Results(Exports, Instants):
     def __init__(self, t, columns: dict[str, np.ndarray], units: dict[str, str] | None = None,
                  analysis: str = "", model: str = "", warnings=None, info=None):
         t = np.asarray(t, dtype=float)
-        self._names = ["t", *columns]
+        self._names = ["t", *map(one_form, columns)]      # names in one Unicode form
         self._data = np.empty((len(self._names), len(t)))
         self._data[0] = t
         for i, values in enumerate(columns.values(), start=1):
             self._data[i] = values
         self._index = {name: i for i, name in enumerate(self._names)}
-        self.units = {"t": "s", **(units or {})}
+        self.units = {"t": "s", **{one_form(k): v for k, v in (units or {}).items()}}
         self.analysis, self.model = analysis, model
         self.warnings = list(warnings or [])
         self.info = RunInfo(**dict(info or {}))
@@ -115,12 +116,12 @@ class Results(Exports, Instants):
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column ``name`` (``t`` included), a view; KeyError naming the nearest."""
-        if name not in self._index:
+        if (name := one_form(name)) not in self._index:
             raise KeyError(f"no column '{name}'{closest(name, self._names)}")
         return self._data[self._index[name]]
 
     def __contains__(self, name: str) -> bool:
-        return name in self._index
+        return one_form(name) in self._index
 
     def __len__(self) -> int:
         return self._data.shape[1]

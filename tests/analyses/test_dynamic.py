@@ -74,11 +74,37 @@ def test_free_pendulum_against_an_independent_integration(tolerance):
 
 
 def test_initial_velocities_are_the_nearest_consistent_ones():
-    """Dx = 1 m/s cannot hold at a pivot: the nearest velocities keep Dfi and drop Dx."""
-    res = _run(pendulum(-math.pi / 2, dfi=2.0, dx=1.0), t_end=0.1, steps=4)
+    """Dx = 1 m/s cannot hold at a pivot: the nearest velocities keep Dfi and drop Dx, and
+    run says so (issue 22: before, without a word)."""
+    with pytest.warns(pam2exu.InputWarning) as caught:
+        res = pam2exu.run(pendulum(-math.pi / 2, dfi=2.0, dx=1.0), t_end=0.1, steps=4)
+    assert [str(w.message) for w in caught] == [
+        "<string>: [[solid]] #2 'lever': the constraints do not allow the initial rates "
+        "given, the run starts from the nearest that they do: Dx = 1 m/s given, 0 m/s used"]
+    assert res.warnings == [str(caught[0].message)]
     assert res["lever.Dfi"][0] == pytest.approx(2.0, abs=1e-15)
     assert res["lever.Dx"][0] == pytest.approx(0.0, abs=1e-15)
     assert res["lever.Dy"][0] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_changed_initial_rates_name_each_solid_and_both_values():
+    """The free four-bar given Dfi = 2 rad/s on the crank and on the rocker, which the loop
+    does not allow together: a warning per solid with the values given and those the run
+    starts from (its first row); consistent rates (the pendulum's Dfi) give none."""
+    path = pam2exu.__file__.replace("pam2exu/__init__.py",
+                                    "examples/equilibrium/spring_four_bar.toml")
+    model = pam2exu.load(path)
+    model["crank"].Dfi = model["rocker"].Dfi = 2.0
+    with pytest.warns(pam2exu.InputWarning) as caught:
+        res = pam2exu.run(model, "dynamic", t_end=0.01, steps=2)
+    texts = [str(w.message) for w in caught]
+    assert len(texts) == 2                 # the coupler was given no rate: not named
+    for name in ("crank", "rocker"):
+        (text,) = [t for t in texts if f"'{name}':" in t]
+        assert f"Dfi = 2 rad/s given, {res[f'{name}.Dfi'][0]:.6g} rad/s used" in text
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pam2exu.run(pendulum(-math.pi / 2, dfi=2.0), t_end=0.01, steps=2)
 
 
 def test_pendulum_on_a_driven_slider_against_its_one_dof_equation():
