@@ -66,7 +66,9 @@ def position_failure(job: Job, found: Positions) -> SolverError:
             elements=tuple(f"'{e.name}' ({e.type})" for e in concerned))
     if worst and solved == 0:
         by_name = {f"'{el.name}' ({el.type})": el for el in mech.constraints}
-        loop = loops.diagnose(mech, [by_name[name] for name in elements], t)
+        loop = (loops.first_open(mech, t, start, can_hold,
+                                 {by_name[name].name: r for name, r in worst})
+                or loops.diagnose(mech, [by_name[name] for name in elements], t))
         if loop is not None:          # the joints of that loop only
             worst = [w for w in worst if by_name[w[0]].name in loop.elements]
             violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)

@@ -11,6 +11,12 @@ linear actuator its distance f(t). A loop of pins and actuators closes only if
 and, where actuators fix the angles of some solids, the part of the loop that is still free
 (a chain of links between two points whose places are known) must reach across the gap
 between those points: |Σ l − …| ≤ gap ≤ Σ l. ``diagnose`` says which loop and which of these fails.
+
+Which loop: ``first_open`` builds the mechanism part by part, as its structure does (the
+driven crank, the dyad that closes its loop, the dyad hung on that one …), solving each
+time what is built so far, and names the first part that cannot close, with the places the
+parts before it give its solids. ``diagnose`` (the loop through the worst-violated joint) is
+what is left when no part is found (an element outside the loops, such as a transmission).
 """
 from __future__ import annotations
 
@@ -198,9 +204,23 @@ def describe(mech, element, t: float) -> Diagnosis | None:
     cycle = cycle_through(mech, element)
     if cycle is None:
         return None
+    return describe_cycle(mech, cycle, t, known_poses(mech, t), _placers(mech, False))
+
+
+def _placers(mech, loops: bool) -> str:
+    """What places the solids whose poses are known: "the fixed links and the actuators
+    ('motor')", and the loops built before (``loops``)."""
+    drivers = ", ".join(f"'{el.name}'" for el in mech.drivers)
+    actuators = f"the actuators ({drivers})" if drivers else "the actuators"
+    return (f"the fixed links, {actuators} and the loops that close" if loops
+            else f"the fixed links and {actuators}")
+
+
+def describe_cycle(mech, cycle, t: float, poses, by: str) -> Diagnosis:
+    """Why the loop ``cycle`` (``cycle_through``'s edges) cannot close at time t, where
+    ``by`` (words) put the solids of ``poses`` (index → (origin, fi))."""
     members = tuple(e.element.name for e, _ in cycle)
     steps, nodes = _walk(mech, cycle)
-    poses = known_poses(mech, t)
     frame = held(mech)
     names = [_name(mech, steps[0][1])]
     for (e, *_), node in zip(steps, nodes):
@@ -229,7 +249,7 @@ def describe(mech, element, t: float) -> Diagnosis | None:
         return Diagnosis(head + f": the longest, {links[k][0]}, is longer than all the others "
                          f"together ({rest:.4g} m). Change the lengths so that none is longer "
                          "than the sum of the others", True, members)
-    reach = _reach(mech, steps, nodes, poses, t)
+    reach = _reach(steps, nodes, poses, t, by)
     if reach:
         return Diagnosis(head + ": " + reach, True, members)
     return Diagnosis(head + ": its lengths would close it, but not in the position its "
@@ -237,9 +257,10 @@ def describe(mech, element, t: float) -> Diagnosis | None:
                      "they drive", False, members)
 
 
-def _reach(mech, steps, nodes, poses, t: float) -> str | None:
-    """Where the actuators place some solids, the free chain between two placed points
-    that cannot reach across their distance, in words (None if none is found)."""
+def _reach(steps, nodes, poses, t: float, by: str) -> str | None:
+    """Where ``by`` (the actuators, …) place some solids (``poses``), the free chain between
+    two placed points that cannot reach across their distance, in words (None if none is
+    found)."""
     known = [k for k, node in enumerate(nodes) if node.solid_in in poses
              and node.solid_out in poses]
     if not known or len(known) == len(nodes):
@@ -271,9 +292,7 @@ def _reach(mech, steps, nodes, poses, t: float) -> str | None:
         total, longest = sum(lengths), max(lengths)
         shortest = max(0.0, 2 * longest - total)
         if gap > total * (1 + 1e-9) or gap < shortest * (1 - 1e-9):
-            drivers = ", ".join(f"'{el.name}'" for el in mech.drivers
-                                if el.type == "angular_actuator")
-            return (f"where the fixed links and the actuators ({drivers}) put them, "
+            return (f"where {by} put them, "
                     f"{start.label_out} and {end.label_in} are {gap:.4g} m apart, but the "
                     f"chain between them ({', '.join(parts)}) spans only "
                     f"{shortest:.4g} … {total:.4g} m. Change these lengths, or the "
@@ -293,3 +312,130 @@ def bar_of(mech, element) -> tuple[int, list] | None:
         if solid not in frame and len(ties) == 2:
             return solid, ties
     return None
+
+
+# ---- the loop that cannot close, in the order the mechanism is built ----------------------
+
+
+@dataclass(frozen=True)
+class _Unit:
+    """A part of the mechanism added at once: one tie, or the loop through it (``cycle``)."""
+
+    ties: frozenset
+    cycle: tuple | None
+
+
+def _units(mech) -> list[_Unit]:
+    """Every tie alone and every loop (the shortest one through each tie), once each."""
+    found, seen = [], set()
+    for e in edges(mech):
+        cycle = cycle_through(mech, e.element)
+        for unit in (_Unit(frozenset([e.element]), None),
+                     _Unit(frozenset(x.element for x, _ in cycle), tuple(cycle))
+                     if cycle is not None else None):
+            if unit is not None and unit.ties not in seen:
+                seen.add(unit.ties)
+                found.append(unit)
+    return found
+
+
+def _solids_of(unit: _Unit) -> set[int]:
+    return {s for el in unit.ties for s in (el.ref1.solid, el.ref2.solid)}
+
+
+def _mask(mech, elements) -> np.ndarray:
+    """The equations of ``elements``, as a mask of C's rows."""
+    keep = np.zeros(mech.n_equations, dtype=bool)
+    for el, rows in zip(mech.constraints, mech.rows):
+        if el in elements:
+            keep[rows] = True
+    return keep
+
+
+def _rigid(mech, jac, elements, new: set[int]) -> bool:
+    """Whether the equations of ``elements`` fix the solids ``new`` once the others they
+    touch are placed: their Jacobian columns (angles times the length scale) have full rank."""
+    if not new:
+        return True
+    cols = [3 * s + k for s in sorted(new) for k in range(3)]
+    J = jac[_mask(mech, elements)][:, cols] * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(new))
+    if J.shape[0] < J.shape[1]:
+        return False
+    sv = np.linalg.svd(J, compute_uv=False)
+    return bool(sv[-1] > 1e-9 * max(1.0, sv[0]))
+
+
+def _poses(q, solids) -> dict[int, tuple[np.ndarray, float]]:
+    """Pose (origin, fi) of each of ``solids`` in configuration q."""
+    return {s: (np.array(q[3 * s:3 * s + 2], dtype=float), float(q[3 * s + 2])) for s in solids}
+
+
+def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
+               worst: dict[str, float] | None = None) -> Diagnosis | None:
+    """The first part of the mechanism that cannot close at time t, building it as its
+    structure does: from the fixed links and the actuators, add each time the smallest tie
+    or loop that places its solids (Assur groups: the driven crank, then the four-bar's
+    dyad, then the dyad hung on it …), solving what is built so far (least squares from
+    ``q_start``). The first addition left violated by more than ``can_hold`` is the part
+    that cannot close; its diagnosis names its ties less those of the loops that closed
+    before it. None when every addition closes. ``worst``: the ties' violations at
+    the closest configuration of the whole mechanism, to start the loop's text at the worst.
+    """
+    from . import native
+    from ..kinematics import State
+
+    setters = [el for el in mech.constraints if el.drives or el.grounds]
+    placed = held(mech)
+    built: set = set()
+    closed: set = set()       # the ties of the loops that closed
+    units = _units(mech)
+    q = np.array(q_start, dtype=float)
+    by = _placers(mech, False)
+    while True:
+        jac = native.equations(mech, State([t], q[None])).jacobian[0]
+        choices = []
+        for order, unit in enumerate(units):
+            if unit.ties <= built:
+                continue
+            new = _solids_of(unit) - placed
+            inside = placed | new
+            rules = [el for el in setters if el.ref1.solid in inside
+                     and (el.ref2 is None or el.ref2.solid in inside)]
+            if _rigid(mech, jac, [*unit.ties, *rules], new):
+                choices.append((len(new), len(unit.ties), order, unit, new))
+        if not choices:
+            return None
+        *_, unit, new = min(choices, key=lambda c: c[:3])
+        keep = _mask(mech, [*setters, *built, *unit.ties])
+        left, found = native.closest_violation(mech, t, q, keep)
+        if not np.all(np.abs(left[keep]) <= can_hold):
+            return _open(mech, unit, closed, t, _poses(q, placed), by, worst or {})
+        built |= unit.ties
+        placed |= new
+        q = found
+        if unit.cycle is not None:
+            closed |= unit.ties
+            by = _placers(mech, True)
+
+
+def _open(mech, unit: _Unit, closed, t: float, poses, by: str,
+          worst: dict[str, float]) -> Diagnosis:
+    """The diagnosis of ``unit``, which cannot close where the parts built before it put
+    the solids (``poses``): its ties, less those of the loops that ``closed``."""
+    own = [el for el in mech.constraints if el in unit.ties and el not in closed]
+    names = tuple(el.name for el in own)
+    if unit.cycle is None:
+        el = own[0]
+        a = place(poses[el.ref1.solid], _point(el.ref1)) if el.ref1.solid in poses else None
+        b = place(poses[el.ref2.solid], _point(el.ref2)) if el.ref2.solid in poses else None
+        apart = (f": {by} put {el.ref1.label} and {el.ref2.label} "
+                 f"{float(np.linalg.norm(b - a)):.4g} m apart" if a is not None
+                 and b is not None else "")
+        return Diagnosis(f"'{el.name}' ({el.type}) cannot hold at t = {t:g} s{apart}",
+                         False, names)
+    first = max(own, key=lambda el: worst.get(el.name, 0.0))
+    cycle = cycle_through(mech, first)
+    if cycle is None or frozenset(e.element for e, _ in cycle) != unit.ties:
+        cycle = list(unit.cycle)
+    found = describe_cycle(mech, cycle, t, poses, by)
+    return Diagnosis(found.text, found.definite, names)

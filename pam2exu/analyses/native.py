@@ -449,8 +449,10 @@ class _Enough(Exception):
     """The diagnosis' search ran out of time (``closest_violation``)."""
 
 
-def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(C(q*, t), q*) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only).
+def closest_violation(mech, t: float, q_start: np.ndarray,
+                      keep: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(C(q*, t), q*) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only);
+    with ``keep`` (a mask of the equations), the minimum of those equations alone.
 
     The elements still violated at q* are those that cannot close at time t. Where
     C(q*) ≠ 0, Cqᵀ C = 0 there: the constraint Jacobian is singular at q*. The search
@@ -467,6 +469,8 @@ def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, 
     for el, rows in zip(mech.constraints, mech.rows):
         if el.drives or el.grounds:
             weight[rows] = 1e3
+    if keep is not None:
+        weight = np.where(keep, weight, 0.0)
     stop = time.perf_counter() + DIAGNOSIS_SECONDS
     best = [np.inf, q_start, None]
 
@@ -489,8 +493,10 @@ def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, 
         sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
                             else "trf", max_nfev=200 * mech.nq, xtol=1e-15, ftol=1e-15,
                             gtol=1e-15)
-        return sol.fun / weight, sol.x
+        found = sol.x
     except (_Enough, ValueError):       # out of time, or a residual that is not finite
         if best[2] is None:
             return np.full(mech.n_equations, np.inf), q_start
-        return best[2] / weight, best[1]
+        found = best[1]
+    with np.errstate(all="ignore"):
+        return residuals(mech, np.array([t]), found[None])[0], found

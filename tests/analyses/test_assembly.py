@@ -135,6 +135,39 @@ def test_four_bar_that_cannot_close_names_its_joints():
     assert info.value.time == 0.0
 
 
+def test_six_bar_whose_second_loop_cannot_close_names_that_loop():
+    """Watt six-bar: the example four-bar (crank at θ = 0) plus a dyad from the rocker's tip
+    C (= B, 0.3 m from O4) through a link C–D (0.25 m) and an output D–O6 (0.2 m) to a
+    ground pivot O6 = (0.9, 0). The four-bar closes (rocker at ψ of ``four_bar_pose``), so
+    C is at O4 + c e(ψ), |C − O6| = 0.660 m, beyond the dyad's reach 0.25 + 0.2 = 0.45 m.
+    Required (issue 22): the error names the loop C–D–O6 and its own joints C, D, O6 as
+    the ones that cannot close, the gap |C − O6| from the closed form and the dyad's span
+    0.05 … 0.45 m; not the four-bar's loop or joints (which close), and not the actuators.
+    Before: 'the loop ground –O4– rocker –B– coupler –A– crank –O2– ground cannot close …
+    check the actuators' values', blaming O4, B, A, O2."""
+    m = pam2exu.load(EXAMPLES / "four_bar.toml")
+    m["ground"].points["O6"] = [0.9, 0.0]
+    m["rocker"].points["C"] = [0.3, 0.0]
+    m.add_solid("link", x=0.3, y=0.28, fi=0.3, points={"C": [0.0, 0.0], "D": [0.25, 0.0]})
+    m.add_solid("output", x=0.9, y=0.0, fi=3.0, points={"O": [0.0, 0.0], "D": [0.2, 0.0]})
+    m.add("revolute", name="C", anc1="rocker.C", anc2="link.C")
+    m.add("revolute", name="D", anc1="link.D", anc2="output.D")
+    m.add("revolute", name="O6", anc1="ground.O6", anc2="output.O")
+    with pytest.raises(pam2exu.SolverError) as info:
+        pam2exu.run(m, analysis="assembly")
+    message = str(info.value)
+    assert "the loop ground –O6– output –D– link –C– rocker –O4– ground cannot close" \
+        in message, message
+    _, psi = four_bar_pose(0.0)
+    gap = math.hypot(d + c * math.cos(psi) - 0.9, c * math.sin(psi))
+    assert f"ground.O6 and rocker.C are {gap:.4g} m apart" in message, message
+    assert "spans only 0.05 … 0.45 m" in message
+    assert {name.split("'")[1] for name in info.value.elements} == {"C", "D", "O6"}
+    for joint in ("O2", "A", "B", "O4", "motor", "base"):
+        assert f"'{joint}' (" not in message.split("Exudyn said")[0], joint
+    assert "coupler –A– crank" not in message
+
+
 def test_kinematic_on_an_underdriven_model_names_the_free_solids():
     """The four-bar without its motor: kinematic needs every degree of freedom driven, so
     it raises MobilityError naming crank, coupler and rocker (the solids that can move)."""
