@@ -69,8 +69,9 @@ def position_failure(job: Job, found: Positions) -> SolverError:
         loop = (loops.first_open(mech, t, start, can_hold,
                                  {by_name[name].name: r for name, r in worst})
                 or loops.diagnose(mech, [by_name[name] for name in elements], t))
-        if loop is not None:          # the joints of that loop only
-            worst = [w for w in worst if by_name[w[0]].name in loop.elements]
+        ours = [w for w in worst if loop is not None and by_name[w[0]].name in loop.elements]
+        if ours:                      # the joints of that loop only
+            worst = ours
             violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)
             elements = tuple(n for n, _ in worst)
         return SolverError(

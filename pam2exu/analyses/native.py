@@ -449,16 +449,26 @@ class _Enough(Exception):
     """The diagnosis' search ran out of time (``closest_violation``)."""
 
 
-def closest_violation(mech, t: float, q_start: np.ndarray,
-                      keep: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(C(q*, t), q*) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only);
-    with ``keep`` (a mask of the equations), the minimum of those equations alone.
+def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(C(q*, t), q*) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only).
 
     The elements still violated at q* are those that cannot close at time t. Where
     C(q*) ≠ 0, Cqᵀ C = 0 there: the constraint Jacobian is singular at q*. The search
     stops after ``DIAGNOSIS_SECONDS`` with the best configuration found (a mechanism that
     cannot close leaves a flat valley that it would otherwise crawl along for long).
     """
+    left, q, _ = closest(mech, t, q_start)
+    return left, q
+
+
+def closest(mech, t: float, q_start: np.ndarray, keep: np.ndarray | None = None,
+            seconds: float | None = None,
+            tol: float = 1e-15) -> tuple[np.ndarray, np.ndarray, bool]:
+    """``closest_violation`` of the equations ``keep`` (a mask; default all), the others
+    left out of the sum, in at most ``seconds`` (default ``DIAGNOSIS_SECONDS``), to the
+    relative tolerance ``tol`` (of the least squares' x, cost and gradient): (C(q*, t) of
+    every equation, q*, whether the search converged rather than ran out of time or
+    evaluations)."""
     import time
 
     from scipy.optimize import least_squares
@@ -471,7 +481,7 @@ def closest_violation(mech, t: float, q_start: np.ndarray,
             weight[rows] = 1e3
     if keep is not None:
         weight = np.where(keep, weight, 0.0)
-    stop = time.perf_counter() + DIAGNOSIS_SECONDS
+    stop = time.perf_counter() + (DIAGNOSIS_SECONDS if seconds is None else seconds)
     best = [np.inf, q_start, None]
 
     def fun(q):
@@ -491,12 +501,12 @@ def closest_violation(mech, t: float, q_start: np.ndarray,
 
     try:
         sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
-                            else "trf", max_nfev=200 * mech.nq, xtol=1e-15, ftol=1e-15,
-                            gtol=1e-15)
-        found = sol.x
+                            else "trf", max_nfev=200 * mech.nq, xtol=tol, ftol=tol,
+                            gtol=tol)
+        found, converged = sol.x, sol.status > 0
     except (_Enough, ValueError):       # out of time, or a residual that is not finite
         if best[2] is None:
-            return np.full(mech.n_equations, np.inf), q_start
-        found = best[1]
+            return np.full(mech.n_equations, np.inf), q_start, False
+        found, converged = best[1], False
     with np.errstate(all="ignore"):
-        return residuals(mech, np.array([t]), found[None])[0], found
+        return residuals(mech, np.array([t]), found[None])[0], found, converged
