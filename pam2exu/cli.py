@@ -1,7 +1,8 @@
 """The ``pam2exu`` command: run and check PAM models, compare result files.
 
-Exit codes: 0 success, 1 solver failure, 2 model error (or bad command line, or an output
-file that cannot be written as asked: an unknown suffix, a missing optional library).
+Exit codes: 0 success, 1 solver failure, 2 model error (or bad command line, options that
+do not go together, or an output file that cannot be written as asked: an unknown suffix, a
+missing optional library; ``run`` checks these before it runs anything).
 ``compare``: 0 every variable within the tolerance, 1 some outside, 2 bad input.
 ``verify``: 0 the two backends agree, 1 they differ or a run fails, 2 bad input.
 ``plot``, ``draw``, ``animate``: 2 also for a picture that cannot be made as asked (an
@@ -222,14 +223,60 @@ def _picture_parsers(sub) -> None:
                                 help=argparse.SUPPRESS)
 
 
+class UsageError(Pam2ExuError):
+    """Options that do not go together, or one that needs another (exit 2, before the run)."""
+
+
+def _check_options(args) -> None:
+    """UsageError for options that need one another (before the model is read)."""
+    csv = [name for name, value, default in
+           (("--sep", args.sep, ","), ("--decimal", args.decimal, "."), ("--bom", args.bom, False))
+           if value != default]
+    if csv and not args.output:
+        raise UsageError(f"{' and '.join(csv)} {'is' if len(csv) == 1 else 'are'} for the CSV "
+                         f"file of -o: give -o OUT.csv, or drop {' and '.join(csv)}")
+    alone = [name for name, value in (("--x", args.x), ("--plot-file", args.plot_file))
+             if value is not None]
+    if alone and not args.plot:
+        raise UsageError(f"{' and '.join(alone)} {'is' if len(alone) == 1 else 'are'} for "
+                         f"--plot: give --plot VAR …, or drop {' and '.join(alone)}")
+    from .errors import PictureError
+    from .results.plot import image_format
+    for option, path in (("--energy", args.energy), ("--plot-file", args.plot_file)):
+        try:
+            if path is not None:
+                image_format(path)
+        except PictureError as exc:
+            raise UsageError(f"{option}: {exc}") from None
+
+
+def _check_analysis_options(args, model) -> None:
+    """UsageError for options the run's analysis does not use (``--tolerance``), ModelError
+    for ``--energy`` of an analysis without rates and forces: before the run."""
+    from .analyses.energy import require_rates
+    from .registry import analysis_type
+    name = args.analysis or model.analysis.type
+    kind = analysis_type(name) if isinstance(name, str) else None
+    if kind is None:
+        return                                   # run reports the settings
+    if args.tolerance is not None and not kind.integrates:
+        known = ", ".join(a.name for a in ANALYSES.values() if a.integrates)
+        raise UsageError(f"--tolerance is the time integration's ({known}); the {kind.name} "
+                         f"analysis does not use it: drop --tolerance")
+    if args.energy:
+        require_rates(kind.name, model.source)
+
+
 def _run(args) -> int:
     from .analyses import run
     from .model import load
     from .results.writers import check, write
     sep = "\t" if args.sep in ("tab", "\\t") else args.sep
+    _check_options(args)                         # nothing runs, nothing is written
     if args.output:                              # a bad file name fails before the run
         check(args.output, sep, args.decimal, args.bom)
     model = load(args.model)
+    _check_analysis_options(args, model)
     if args.at:                                  # times outside the run fail before it
         _check_at(args, model)
     backend = BACKENDS.get(args.backend or model.analysis.backend)
@@ -238,14 +285,16 @@ def _run(args) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")      # warnings are carried in res.warnings
         outputs = args.outputs
-        if args.plot:
-            # the plotted variables (and the x axis) are computed too; "*" is the default
-            # columns, to which a plot may add opt-in ones (coupler.P.x)
-            outputs = [*(outputs or ["*"]), *args.plot, *([args.x] if args.x else [])]
+        if args.plot or args.energy:
+            # the plotted variables (and the x axis) are computed too, and the energy
+            # account's columns (the default ones, "*", to which a plot may add opt-in ones
+            # such as coupler.P.x); --outputs selects what is shown and written
+            outputs = [*(["*"] if args.energy else []), *(outputs or ["*"]), *(args.plot or []),
+                       *([args.x] if args.x else [])]
         res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
                   outputs=outputs, solver=solver, backend=args.backend, angles=args.angles,
                   tolerance=args.tolerance)
-    table = res.select(args.outputs) if args.outputs and args.plot else res
+    table = res.select(args.outputs) if args.outputs and (args.plot or args.energy) else res
     from .results.extremes import extremes_path, extremes_table, write_extremes
     extremes = extremes_table(table)             # a clearance run's, else ""
     if args.output:
@@ -486,6 +535,8 @@ def main(argv=None) -> int:
             code, kind = 2, "model error"
         elif isinstance(exc, OutputError):
             code, kind = 2, "output error"
+        elif isinstance(exc, UsageError):
+            code, kind = 2, "command line"
         elif isinstance(exc, SolverError):
             code, kind = 1, "solver failure"
         elif isinstance(exc, Pam2ExuError):

@@ -57,6 +57,9 @@ class AnalysisType:
         One line for help texts.
     function : str or callable
         ``'module:function'`` of ``f(job) -> Results``, or the function itself.
+    integrates : bool
+        Its results come from a time integration to ``[analysis] tolerance`` (the others
+        ignore the tolerance).
     """
 
     name: str
@@ -67,6 +70,7 @@ class AnalysisType:
     summary: str
     function: str | Callable
     element_outputs: bool = True
+    integrates: bool = False
 
     def run(self, job):
         """Run the analysis on a prepared ``Job``."""
@@ -115,7 +119,7 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("dynamic", "dinamica", _ALL, driven=False, at_start=False,
                  summary="forward dynamics: the free degrees of freedom move under the "
                  "loads, to [analysis] tolerance",
-                 function="pam2exu.analyses.dynamic:dynamic"),
+                 function="pam2exu.analyses.dynamic:dynamic", integrates=True),
 )}
 
 #: the backends; the first is the default

@@ -110,3 +110,52 @@ def test_exudyn_console_quiet_unless_verbose(examples, capfd):
     loud = capfd.readouterr().out
     assert quiet.startswith("kinematic analysis")
     assert len(loud) > len(quiet) and "STATIC" in loud.upper()
+
+
+def test_energy_with_outputs_runs_once_and_writes_both(examples, tmp_path, capsys):
+    """Issue 22: ``--energy PNG --outputs X`` ran the whole analysis, then failed (exit 2,
+    "the result has no ground.x …: run without --outputs"). The account is computed from
+    every default column; --outputs selects what is written: the same largest |balance| as
+    without --outputs, and a CSV of t and crank.fi only."""
+    model = str(examples / "slider_crank.toml")
+    base = ["run", model, "-a", "kinetostatic", "--steps", "50"]
+    assert main([*base, "--energy", str(tmp_path / "all.png")]) == 0
+    whole = capsys.readouterr().out
+    out = tmp_path / "sel.csv"
+    assert main([*base, "--energy", str(tmp_path / "sel.png"), "--outputs", "crank.fi",
+                 "-o", str(out)]) == 0
+    chosen = capsys.readouterr().out
+    line = next(s for s in whole.splitlines() if s.startswith("energy: largest |balance|"))
+    assert line in chosen
+    assert (tmp_path / "sel.png").stat().st_size > 1000
+    assert next(csv.reader(open(out, encoding="utf-8"))) == ["t", "crank.fi"]
+
+
+@pytest.mark.parametrize("options, says", [
+    (["-a", "kinematic", "--energy", "e.png"], "a kinetostatic or dynamic run, not 'kinematic'"),
+    (["-a", "assembly", "--energy", "e.png", "-o", "r.csv"], "not 'assembly'"),
+    (["-a", "kinetostatic", "--energy", "e.xyz"], "--energy: cannot write 'e.xyz'"),
+    (["--plot", "crank.fi", "--plot-file", "p.xyz"], "--plot-file: cannot write 'p.xyz'"),
+    (["--plot-file", "p.png"], "--plot-file is for --plot"),
+    (["--x", "crank.fi"], "--x is for --plot"),
+    (["--sep", ";", "--decimal", ","], "--sep and --decimal are for the CSV file of -o"),
+    (["--bom"], "--bom is for the CSV file of -o"),
+    (["-a", "kinematic", "--tolerance", "1e-6", "-o", "r.csv"],
+     "the kinematic analysis does not use it: drop --tolerance"),
+])
+def test_option_conflicts_exit_2_before_the_run(examples, tmp_path, monkeypatch, capsys,
+                                                options, says):
+    """Issue 22: options that do not go together (or one that needs another, or a file the
+    run could not write at its end) exit 2 before anything runs or is written; before,
+    --energy and --plot-file were refused after the whole run (the CSV of -o written) and
+    --x, --plot-file, --sep, --bom and --tolerance were silently ignored (exit 0)."""
+    import pam2exu.analyses
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the analysis ran")
+    monkeypatch.setattr(pam2exu.analyses, "run", no_run)
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(examples / "slider_crank.toml"), "--steps", "20", *options]) == 2
+    err = capsys.readouterr().err
+    assert says in err and err.count("\n") == 1, err
+    assert not list(tmp_path.iterdir())

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import cumulative_simpson
 
+from ..elements.base import ACCELERATION, FORCE, VELOCITY
 from ..kinematics import State
 from ..model import Model, load
 from ..results import Results
@@ -60,7 +61,7 @@ def energy(model, analysis: str | None = None, **settings) -> Results:
     if not isinstance(model, Model):
         model = load(model)
     kind = analysis or model.analysis.type
-    _require_rates(kind, model.source)
+    require_rates(kind, model.source)
     return account(model, run(model, kind, angles="rad", **settings))
 
 
@@ -74,7 +75,7 @@ def account(model, res: Results) -> Results:
     res = in_angles(res, "rad")
     if not isinstance(model, Model):
         model = load(model)
-    _require_rates(res.analysis, model.source)
+    require_rates(res.analysis, model.source)
     mech = model.mechanism()
     names = [(s.name, k) for s in mech.solids for k in ("x", "y", "fi")]
     wanted = [f"{n}.{d}{k}" for d in ("", "D", "DD") for n, k in names] + [
@@ -104,13 +105,24 @@ def account(model, res: Results) -> Results:
                    res.warnings, res.info)
 
 
-def _require_rates(kind: str, source) -> None:
+def require_rates(kind: str, source) -> None:
+    """ModelError unless the analysis ``kind`` gives what the account needs: velocities,
+    accelerations and forces over an interval (kinetostatic, dynamic). An unknown name
+    passes: ``run`` says which names there are."""
     from ..errors import ModelError
+    from ..registry import ANALYSES, analysis_type
 
-    if kind not in ("kinetostatic", "dynamic"):
+    found = analysis_type(kind)
+    if found is not None and not _gives_rates(found):
+        names = [a.name for a in ANALYSES.values() if _gives_rates(a)]
         raise ModelError(f"the energy account needs velocities, accelerations and forces: "
-                         f"a kinetostatic or dynamic run, not {kind!r} (-a kinetostatic or "
-                         "-a dynamic)", source)
+                         f"a {' or '.join(names)} run, not {kind!r} "
+                         f"({' or '.join('-a ' + n for n in names)})", source)
+
+
+def _gives_rates(kind) -> bool:
+    """Whether an ``AnalysisType`` gives velocities, accelerations and forces in time."""
+    return {VELOCITY, ACCELERATION, FORCE} <= kind.levels and not kind.at_start
 
 
 def _since_start(t: np.ndarray, power: np.ndarray) -> np.ndarray:

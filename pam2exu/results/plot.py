@@ -68,13 +68,26 @@ def save(fig, path: str | Path) -> Path:
         The canvas cannot write that format.
     """
     path = Path(path)
-    fmt = path.suffix[1:].lower()
-    formats = fig.canvas.get_supported_filetypes()
+    fig.savefig(path, dpi=fig.dpi, format=image_format(path))
+    return path
+
+
+def image_format(path: str | Path) -> str:
+    """The image format of a file's suffix ('png', 'svg', …), or PictureError: what ``save``
+    writes, checked before a run too.
+
+    Raises
+    ------
+    PictureError
+        The Agg canvas cannot write that format.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    fmt = Path(path).suffix[1:].lower()
+    formats = FigureCanvasAgg.get_supported_filetypes()
     if fmt not in formats:
         raise PictureError(f"cannot write '{path}': the image format is chosen by the file "
                            f"suffix, one of {', '.join('.' + f for f in sorted(formats))}")
-    fig.savefig(path, dpi=fig.dpi, format=fmt)
-    return path
+    return fmt
 
 
 def label(name: str, unit: str) -> str:
