@@ -239,7 +239,7 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
     d significant digits matches one within half a unit of its last digit
     (``written_precision``, ``times_match``). When the times differ, the result is
     interpolated onto the reference times inside the result's interval (reference rows
-    outside it are not compared) and the interpolation's own error is estimated.
+    outside it are not compared) and the interpolation's own error is bounded.
     ``pam2exu compare`` calls this function; the user guide is docs/compare.md.
 
     Parameters

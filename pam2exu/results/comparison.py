@@ -56,7 +56,7 @@ class VariableComparison:
     scale: float                # max_k |reference(t_k)|
     tolerance: float            # atol + rtol * scale
     passed: bool                # max_abs_error <= tolerance
-    interpolation_error: float  # estimate of the interpolation's own error; nan if none
+    interpolation_error: float  # bound of the interpolation's own error; nan if none
     unit: str = ""
 
 
@@ -181,7 +181,7 @@ class Comparison:
             times = (f"times differ: the result is interpolated onto the reference times "
                      f"({kind}) within t = {lo:g} … {hi:g} s; {self.rows_compared} of "
                      f"{self.reference_rows} reference rows compared, {self.rows_outside} "
-                     f"outside that interval (not compared); 'interp. error' estimates the "
+                     f"outside that interval (not compared); 'interp. error' bounds the "
                      f"interpolation's own error")
         return [f"result: {self.result} ({self.result_rows} rows)",
                 f"reference: {self.reference} ({self.reference_rows} rows)",

@@ -3,8 +3,8 @@ free-body diagram (``Results.at``, ``pam2exu run MODEL --at T``).
 
 At a time of the table's grid the values are that row's; between rows they are
 interpolated by the not-a-knot cubic spline ``pam2exu compare`` uses
-(``interpolation.interpolate``), and the text says so, with each value's estimated
-interpolation error (``interpolation.interpolation_error``).
+(``interpolation.interpolate``), and the text says so, with a bound of each value's
+interpolation error (``interpolation.error_bound``).
 """
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import closest
-from .interpolation import interpolate, interpolation_error
+from .interpolation import error_bound, interpolate
 
 #: a time within this fraction of a step of a row is that row's time (no interpolation)
 GRID_TOLERANCE = 1e-9
@@ -42,8 +42,8 @@ class Instant(Mapping):
     between : (int, int) or None
         The rows ``t`` lies between when interpolated.
     errors : dict
-        Column → estimated interpolation error (empty at a grid time; NaN with fewer
-        than 7 rows).
+        Column → bound of the interpolation error (empty at a grid time; NaN with fewer
+        than 5 rows).
     kinds : dict
         Owner → what it is (``"solid"``, ``"revolute"``, …), for the block titles; empty
         when unknown (``kinds_of(model)``).
@@ -95,7 +95,7 @@ class Instant(Mapping):
         if self.interpolated:
             i, j = self.between
             how = (f"interpolated by the cubic spline of pam2exu compare between rows {i} and "
-                   f"{j}; the last column is its estimated error")
+                   f"{j}; the last column bounds its error")
         else:
             how = f"row {self.row} of the table"
         lines = [f"{self.title}values at t = {self.t:.6g} s ({how})"]
@@ -107,7 +107,7 @@ class Instant(Mapping):
                 var, value = c.partition(".")[2], self.by_column[c]
                 line = f"  {var:<{width}} {value:>14.7g}  {self.units.get(c, ''):<7}"
                 if self.interpolated:
-                    line += f" ±{self.errors.get(c, math.nan):.1g}"
+                    line += f" ±{rounded_up(self.errors.get(c, math.nan))}"
                 lines.append(line.rstrip())
         return "\n".join(lines)
 
@@ -115,6 +115,15 @@ class Instant(Mapping):
 
     def __repr__(self) -> str:
         return self.text()
+
+
+def rounded_up(bound: float, digits: int = 2) -> str:
+    """A bound printed with ``digits`` significant digits, rounded up (so that it still
+    bounds): 1.401e-9 → '1.5e-09'; 'nan' when unknown."""
+    if not math.isfinite(bound) or bound <= 0:
+        return f"{bound:.{digits}g}"
+    scale = 10.0 ** (math.floor(math.log10(bound)) - digits + 1)
+    return f"{math.ceil(bound / scale * (1 - 1e-12)) * scale:.{digits}g}"
 
 
 def at(res, t: float, kinds: dict | None = None) -> Instant:
@@ -161,7 +170,7 @@ def at(res, t: float, kinds: dict | None = None) -> Instant:
                        row=k, **common)
     data = res.to_numpy()[:, 1:].T
     value = interpolate(times, data, np.array([t]))[:, 0]
-    error = interpolation_error(times, data, np.array([t]))
+    error = error_bound(times, data, np.array([t]))[:, 0]
     j = int(np.searchsorted(times, t))
     return Instant(t, dict(zip(res.columns, map(float, value))), units, between=(j - 1, j),
                    errors=dict(zip(res.columns, map(float, error))), **common)
@@ -188,7 +197,7 @@ class Instants:
         Instant
             Column → value (a dict-like), with ``row`` (the row at a grid time, else None),
             ``between`` (the two rows it is interpolated between), ``errors`` (each value's
-            estimated interpolation error), ``owners()``, ``group(name)``; printed, one
+            interpolation error's bound), ``owners()``, ``group(name)``; printed, one
             block per solid and element with values and units.
 
         Raises

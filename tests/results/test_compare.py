@@ -94,8 +94,10 @@ def test_abs_error_of_non_finite_values():
 ], ids=["cubic", "linear"])
 def test_interpolated_onto_reference_times(method, bound):
     """sin(2πt) on 41 points (h = 0.025) against the exact sin on a 0.01 grid to t = 1.2:
-    the reported error is the interpolation error, below its textbook bound, and the 20 rows
-    after t = 1 are outside the overlap."""
+    the reported error is the interpolation error, below its textbook bound; the
+    interpolation error column bounds it (issue 22: it was an estimate, max |I_h − I_2h| / 15,
+    2× too small between rows) without overstating it more than 6× (measured 5.6×, cubic:
+    the not-a-knot ends), and the 20 rows after t = 1 are outside the overlap."""
     t = np.linspace(0.0, 1.0, 41)
     t_ref = np.arange(121) * 0.01
     res = Results(t, {"a.x": np.sin(W * t)})
@@ -105,7 +107,7 @@ def test_interpolated_onto_reference_times(method, bound):
     assert (c.rows_compared, c.rows_outside) == (101, 20)
     row = c["a.x"]
     assert 0.1 * bound < row.max_abs_error <= bound
-    assert row.max_abs_error / 3 < row.interpolation_error < 3 * row.max_abs_error
+    assert row.max_abs_error <= row.interpolation_error < 6 * row.max_abs_error
     if method == "linear":                        # largest where |f''| is: near the peaks
         assert abs(np.sin(W * row.t_at_max)) > 0.95
     text = c.to_markdown()
