@@ -282,18 +282,18 @@ def _run(args) -> int:
     backend = BACKENDS.get(args.backend or model.analysis.backend)
     # the backend's settings (an unknown name: run's model error names the known ones)
     solver = backend.create().Settings(verbose=1 if args.verbose else 0) if backend else None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")      # warnings are carried in res.warnings
-        outputs = args.outputs
-        if args.plot or args.energy:
-            # the plotted variables (and the x axis) are computed too, and the energy
-            # account's columns (the default ones, "*", to which a plot may add opt-in ones
-            # such as coupler.P.x); --outputs selects what is shown and written
-            outputs = [*(["*"] if args.energy else []), *(outputs or ["*"]), *(args.plot or []),
-                       *([args.x] if args.x else [])]
-        res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
-                  outputs=outputs, solver=solver, backend=args.backend, angles=args.angles,
-                  tolerance=args.tolerance)
+    outputs = args.outputs
+    if args.plot or args.energy:
+        # the plotted variables (and the x axis) are computed too, and the energy account's
+        # columns (the default ones, "*", to which a plot may add opt-in ones such as
+        # coupler.P.x); --outputs selects what is shown and written
+        outputs = [*(["*"] if args.energy else []), *(outputs or ["*"]), *(args.plot or []),
+                   *([args.x] if args.x else [])]
+    res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
+              outputs=outputs, solver=solver, backend=args.backend, angles=args.angles,
+              tolerance=args.tolerance)
+    for w in res.warnings:                       # those not issued as they arose
+        _WARNINGS.say(w)
     table = res.select(args.outputs) if args.outputs and (args.plot or args.energy) else res
     from .results.extremes import extremes_path, extremes_table, write_extremes
     extremes = extremes_table(table)             # a clearance run's, else ""
@@ -304,13 +304,11 @@ def _run(args) -> int:
             print("checks: " + "; ".join(table.checks()))
         if extremes:                             # beside the result
             print(f"wrote the extremes to {write_extremes(table, extremes_path(path))}")
-        for w in res.warnings:
-            print(f"warning: {w}", file=sys.stderr)
     elif not args.at:
-        print(table.summary())
+        print(table.summary(warnings=False))     # the warnings went to stderr
     if args.at:                                  # every variable at those times
         from .results.instant import kinds_of, report
-        print(report(table, args.at, kinds_of(model)))
+        print(report(table, args.at, kinds_of(model), warnings=False))
     if extremes:
         print(extremes)
     code = _run_plot(args, res) if args.plot else 0
@@ -395,7 +393,7 @@ def _check(args) -> int:
         print("the file is not UTF-8: it was read as Windows-1252")
     from .model.mistakes import input_warnings
     for problem in input_warnings(model):
-        print(f"warning: {problem}")
+        _WARNINGS.say(str(problem))
     print()
     width = max([len(e.name) for e in mech.elements] + [4])
     for e in mech.elements:
@@ -449,13 +447,11 @@ def _compare(args) -> int:
 
 
 def _verify(args) -> int:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")      # warnings are carried in each run's Results
-        found = verify(args.model, analysis=args.analysis, steps=args.steps,
-                       t_end=args.t_end, backends=(BACKENDS_COMPARED[0], args.against))
-    for backend, res in zip(found.backends, (found.reference, found.result)):
-        for w in res.warnings:
-            print(f"warning ({backend}): {w}", file=sys.stderr)
+    found = verify(args.model, analysis=args.analysis, steps=args.steps,
+                   t_end=args.t_end, backends=(BACKENDS_COMPARED[0], args.against))
+    for res in (found.reference, found.result):
+        for w in res.warnings:                   # those not issued as they arose
+            _WARNINGS.say(w)
     print(found.to_markdown())
     return 0 if found.ok else 1
 
@@ -519,8 +515,44 @@ def _export(args) -> int:
     return 0
 
 
+class _Warnings:
+    """The warnings of one command, each printed once on stderr as one line ``pam2exu:
+    warning: …``: those issued (``warnings.warn``, through ``show``) and those a result
+    carries (``say``). A text already said with a prefix (the model file's name) is not said
+    again without it, nor the other way round."""
+
+    def __init__(self):
+        self.said: list[str] = []
+
+    def say(self, text) -> None:
+        text = " ".join(str(text).split())
+        if any(text == old or old.endswith(": " + text) or text.endswith(": " + old)
+               for old in self.said):
+            return
+        self.said.append(text)
+        print(f"pam2exu: warning: {text}", file=sys.stderr)
+
+    def show(self, message, category, filename, lineno, file=None, line=None) -> None:
+        """``warnings.showwarning``: the message only (no source line)."""
+        self.say(message)
+
+
+_WARNINGS = _Warnings()
+
+
 def main(argv=None) -> int:
+    global _WARNINGS
     args = _parser().parse_args(argv)
+    _WARNINGS = _Warnings()
+    with warnings.catch_warnings():
+        # every warning reaches ``show`` (which says each text once), pam2exu's own
+        # (UserWarning) each time it is issued
+        warnings.simplefilter("always", UserWarning)
+        warnings.showwarning = _WARNINGS.show
+        return _main(args)
+
+
+def _main(args) -> int:
     try:
         return {"run": _run, "check": _check, "elements": _elements, "compare": _compare,
                 "verify": _verify, "export": _export, "plot": _plot, "draw": _draw,

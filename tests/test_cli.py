@@ -159,3 +159,77 @@ def test_option_conflicts_exit_2_before_the_run(examples, tmp_path, monkeypatch,
     err = capsys.readouterr().err
     assert says in err and err.count("\n") == 1, err
     assert not list(tmp_path.iterdir())
+
+
+def _unused_variation(examples, tmp_path) -> Path:
+    """The example four-bar with a [[variation]] of its coupler point P, which no joint
+    uses: a VariationWarning when the model is read."""
+    path = tmp_path / "unused_variation.toml"
+    path.write_text((examples / "four_bar.toml").read_text(encoding="utf-8")
+                    + '\n[[variation]]\nanchor = "coupler.P"\ndx = 1e-3\nw = 1.0\n',
+                    encoding="utf-8")
+    return path
+
+
+def test_warnings_are_one_clean_line_on_stderr(examples, tmp_path):
+    """Issue 22: a warning printed through ``warnings.showwarning`` showed its source line
+    (``sys.exit(main())`` under the console script, '<frozen runpy>:88: VariationWarning:'
+    under python -m). The command prints it as the one line 'pam2exu: warning: …'."""
+    path = _unused_variation(examples, tmp_path)
+    r = subprocess.run([sys.executable, "-m", "pam2exu", "run", str(path), "--steps", "3"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.splitlines() == [
+        f"pam2exu: warning: {path}: [[variation]] #1 (anchor 'coupler.P'): no constraint "
+        "element anchors the point 'coupler.P': the variation has no effect"]
+
+
+@pytest.mark.parametrize("command", [
+    ["run", "-a", "clearance", "--steps", "3"], ["run", "--steps", "3"],
+    ["run", "--steps", "3", "--at", "0.1"], ["check"], ["verify", "--steps", "3"],
+    ["draw", "--t", "0.3", "-o", "fig.png"]])
+def test_a_warning_is_printed_once(examples, tmp_path, monkeypatch, capsys, command):
+    """Issue 22: the unused-variation warning was printed twice by ``run -a clearance``
+    (when the model was read, and again from the result's warnings, which carry it without
+    the file's name). Every command says it once, on stderr, and nothing on stdout."""
+    path = _unused_variation(examples, tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main([command[0], str(path), *command[1:]]) == 0
+    out, err = capsys.readouterr()
+    said = [line for line in err.splitlines() if "the variation has no effect" in line]
+    assert len(said) == 1 and said[0].startswith("pam2exu: warning: "), err
+    assert "warning:" not in out
+
+
+def test_any_warning_of_the_package_is_printed_cleanly(examples, monkeypatch, capsys):
+    """Warnings that ``pam2exu.run`` issues (RedundancyWarning on the parallelogram with a
+    fifth bar, and any other class the package adds, here a made-up one issued twice and
+    kept in the result as well) reach stderr as one line each, once, and the summary on
+    stdout does not repeat them. Before: issued warnings were silenced during the run and
+    the result's were printed in the summary."""
+    import warnings
+
+    import pam2exu.analyses
+    from pam2exu.errors import warn_outside
+
+    class NewWarning(UserWarning):
+        pass
+    real = pam2exu.analyses.run
+
+    def run(*args, **kwargs):
+        res = real(*args, **kwargs)
+        for _ in range(2):
+            warn_outside("a new\nwarning of the package", NewWarning)
+        warnings.warn("a plain warnings.warn", UserWarning)
+        res.warnings.append("a new warning of the package")
+        return res
+    monkeypatch.setattr(pam2exu.analyses, "run", run)
+    data = Path(__file__).resolve().parent / "data"
+    assert main(["run", str(data / "parallelogram5.toml"), "--steps", "4"]) == 0
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert "pam2exu: warning: a new warning of the package" in lines
+    assert "pam2exu: warning: a plain warnings.warn" in lines
+    assert len([s for s in lines if "redundant constraint equation" in s]) == 1
+    assert len(lines) == 3 and all(s.startswith("pam2exu: warning: ") for s in lines), err
+    assert "warning:" not in out and out.startswith("kinematic analysis")

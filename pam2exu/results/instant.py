@@ -230,14 +230,14 @@ def kinds_of(model) -> dict[str, str]:
             **{e.name: e.type for e in model.elements}}
 
 
-def report(res, times, kinds: dict | None = None) -> str:
+def report(res, times, kinds: dict | None = None, warnings: bool = True) -> str:
     """``pam2exu run --at``: the ``Instant`` text at each time, then the run's checks, its
-    notes and warnings (as ``Results.summary`` ends)."""
+    notes and (``warnings``) its warnings, as ``Results.summary`` ends."""
     blocks = [at(res, t, kinds).text() for t in times]
     tail = []
     if res.checks():
         tail.append("checks: " + "; ".join(res.checks()))
     if "undefined" in res.info:
         tail.append(f"note: {res.info['undefined']}")
-    tail += [f"warning: {w}" for w in res.warnings]
+    tail += [f"warning: {w}" for w in res.warnings] if warnings else []
     return "\n\n".join(blocks) + ("\n\n" + "\n".join(tail) if tail else "")

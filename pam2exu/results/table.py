@@ -230,7 +230,7 @@ class Results(Exports, Instants):
         return Results(self.t, {n: self[n] for n in names}, self.units, self.analysis,
                        self.model, self.warnings, self.info)
 
-    def summary(self, max_rows: int = 60) -> str:
+    def summary(self, max_rows: int = 60, warnings: bool = True) -> str:
         """A short text table: unit, first and last value, minimum and maximum of each column.
 
         What ``pam2exu run`` prints: a head line (analysis, model, rows, interval), one line
@@ -240,6 +240,8 @@ class Results(Exports, Instants):
         ----------
         max_rows : int
             Most columns listed; a last line says how many more there are.
+        warnings : bool
+            End with the warnings (``pam2exu run`` prints them on stderr instead).
 
         Returns
         -------
@@ -272,8 +274,7 @@ class Results(Exports, Instants):
         checks = self.checks()
         if checks:
             lines += ["", "checks: " + "; ".join(checks)]
-        for w in self.warnings:
-            lines.append(f"warning: {w}")
+        lines += [f"warning: {w}" for w in self.warnings] if warnings else []
         return "\n".join(lines)
 
     def checks(self) -> list[str]:

@@ -176,17 +176,18 @@ def test_check_warns_on_a_fi_in_degrees(tmp_path, capsys):
     text = FOUR_BAR.read_text().replace("fi = 0.02", "fi = 47")
     (tmp_path / "m.toml").write_text(text)
     assert main(["check", str(tmp_path / "m.toml")]) == 0
-    out = capsys.readouterr().out
-    warnings = [line for line in out.splitlines() if line.startswith("warning:")]
+    err = capsys.readouterr().err                # the CLI's warnings: one line each, stderr
+    warnings = [line for line in err.splitlines() if "warning:" in line]
     assert warnings == [
-        "warning: [[solid]] #2 'crank': fi = 47 rad is more than a full turn (2π = 6.28 rad): "
+        "pam2exu: warning: [[solid]] #2 'crank': fi = 47 rad is more than a full turn (2π = "
+        "6.28 rad): "
         "did you give degrees? Write fi in radians (47° = 0.8203 rad), or set angles = \"deg\" "
         "in [model] to give every angle of the model in degrees"]
     assert not angle_warnings(loads(text.replace("fi = 47", "fi = -6.28")))
     assert not angle_warnings(loads(text.replace('name = "four-bar"',
                                                  'name = "four-bar"\nangles = "deg"')))
     assert main(["check", str(FOUR_BAR)]) == 0
-    assert "warning" not in capsys.readouterr().out
+    assert "warning" not in str(capsys.readouterr())
 
 
 def test_run_cli_angles_deg(tmp_path, capsys):
