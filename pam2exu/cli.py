@@ -186,7 +186,8 @@ def _picture_parsers(sub) -> None:
     draw = sub.add_parser(
         "draw", help="draw the mechanism at a configuration (PNG, SVG, PDF)",
         description="Draw the solids and elements of a model: assembled at t = 0, or at "
-                    "time T of a kinematic run. See docs/pictures.md.")
+                    "time T of a kinematic run (dynamic, for a model whose analysis is "
+                    "dynamic). See docs/pictures.md.")
     draw.add_argument("model", help="model file (TOML)")
     draw.add_argument("--t", type=float, default=0.0, metavar="T",
                       help="time [s] (default 0: the assembly)")
@@ -202,10 +203,10 @@ def _picture_parsers(sub) -> None:
     draw.add_argument("--ic", action="store_true",
                       help="mark each moving solid's instantaneous centre of rotation at T")
     anim = sub.add_parser(
-        "animate", help="animate the model's kinematic run (GIF; MP4 with ffmpeg)",
-        description="An animation of the kinematic run over the model's interval, with the "
-                    "paths of traced points. A progress bar shows on a terminal. See "
-                    "docs/pictures.md.")
+        "animate", help="animate the model's kinematic or dynamic run (GIF; MP4 with ffmpeg)",
+        description="An animation of the kinematic run (dynamic, for a model whose analysis "
+                    "is dynamic) over the model's interval, with the paths of traced "
+                    "points. A progress bar shows on a terminal. See docs/pictures.md.")
     anim.add_argument("model", help="model file (TOML)")
     anim.add_argument("-o", "--output", metavar="ANIM.gif",
                       help="animation file: .gif, or .mp4 when ffmpeg is installed "

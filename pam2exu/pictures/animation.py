@@ -1,6 +1,7 @@
 """``animate``: the motion of a mechanism as a GIF, an MP4 or HTML for a notebook.
 
-The frames are the positions of a kinematic run (``poses.configurations``), each drawn by a
+The frames are the positions of a kinematic run (dynamic, for a model whose analysis is
+dynamic: ``poses.configurations``), each drawn by a
 ``Scene``, with a clock and the paths of traced points. The writers: a GIF is written with
 Pillow by ``_write_gif``, which draws the static part of the figure once and only the moving
 artists at each frame, on one palette; an MP4 by matplotlib's ffmpeg writer, checked before
@@ -16,8 +17,8 @@ from ..errors import ModelError, Problem
 from ..kinematics import State
 from ..progress import Progress
 from ..results.plot import DPI, PictureError, figure
-from .poses import _model, configurations
-from .scene import Scene
+from .poses import _model, configurations, motion
+from .scene import Scene, fit_title
 
 #: figure size of an animation [in] (smaller than a drawing: every frame is stored)
 ANIMATION_SIZE = (6.4, 4.8)
@@ -64,10 +65,11 @@ def _writer(path: Path, fps: float):
 def animate(model, path: str | Path | None = None, steps: int | None = None,
             t_end: float | None = None, trace=(), fps: float | None = None, dpi: float = DPI,
             size: tuple[float, float] = ANIMATION_SIZE, html: bool = False) -> Path | str:
-    """Write an animation of the model's kinematic run; returns the path (or, with
-    ``html=True``, the animation as HTML for a notebook).
+    """Write an animation of the model's kinematic run (dynamic run, for a model whose
+    analysis is dynamic); returns the path (or, with ``html=True``, the animation as HTML
+    for a notebook).
 
-    The frames are the positions of a kinematic run over [0, t_end] (the branch ``run``
+    The frames are the positions of that run over [0, t_end] (the branch ``run``
     follows), with a clock and the paths of the traced points. A progress bar shows on
     stderr while the frames are written, when it is a terminal. ``pam2exu animate`` calls
     this function.
@@ -75,7 +77,8 @@ def animate(model, path: str | Path | None = None, steps: int | None = None,
     Parameters
     ----------
     model : Model, str or Path
-        A model, or the path of a model file; every degree of freedom must be driven.
+        A model, or the path of a model file; every degree of freedom must be driven,
+        unless its analysis is dynamic.
     path : str or Path, optional
         ``.gif`` (Pillow), or ``.mp4`` when ffmpeg is installed; None with ``html=True``.
     steps : int, optional
@@ -139,7 +142,7 @@ def animate(model, path: str | Path | None = None, steps: int | None = None,
     fig = figure(*size, dpi)
     ax = fig.add_subplot()
     scene = Scene(ax, mech, q, np.vstack(paths) if paths else ())
-    ax.set_title(f"'{mech.name}' — kinematic run, t = 0 … {t_end:g} s")
+    fit_title(fig, ax, f"'{mech.name}' — {motion(model)} run, t = 0 … {t_end:g} s")
     clock = ax.text(0.015, 0.975, "", transform=ax.transAxes, ha="left", va="top",
                     fontsize=10, family="monospace", zorder=10,
                     bbox=dict(facecolor="white", edgecolor="none", alpha=0.8))

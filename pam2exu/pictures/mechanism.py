@@ -18,8 +18,8 @@ import numpy as np
 from ..kinematics import State
 from ..results.plot import DPI, PictureError, figure, save
 from .animation import ANIMATION_SIZE, FPS, FRAMES, animate
-from .poses import _model, configurations, pose
-from .scene import LABEL_ROOM, MARGIN, Scene, extent
+from .poses import _model, configurations, motion, pose
+from .scene import LABEL_ROOM, MARGIN, Scene, extent, fit_title
 
 __all__ = ["draw", "animate", "configurations", "pose", "extent", "Scene", "DRAW_SIZE",
            "ANIMATION_SIZE", "FAR_CENTRE", "MARGIN", "LABEL_ROOM", "FPS", "FRAMES"]
@@ -120,8 +120,7 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         when = f"t = {t:g} s ({analysis} run)"
     else:
         mech, q = pose(model, t)
-        run_kind = "dynamic" if model.analysis.type == "dynamic" else "kinematic"
-        when = f"t = {t:g} s ({run_kind} run)" if t else "assembled at t = 0"
+        when = f"t = {t:g} s ({motion(model)} run)" if t else "assembled at t = 0"
     lo, hi = extent(mech, q)
     mech_size = float(max(hi - lo)) or 1.0
     extra = []
@@ -151,7 +150,7 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     if guess:
         unmet = _mark_unmet(scene, q, mech_size)
         when += f"; {len(unmet)} constraint{'s' * (len(unmet) != 1)} not met" if unmet else ""
-    ax.set_title(f"'{mech.name}' — {when}")
+    fit_title(fig, ax, f"'{mech.name}' — {when}")
     _settle(fig, scene)
     if path is not None:
         save(fig, path)

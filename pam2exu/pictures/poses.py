@@ -25,6 +25,13 @@ def _model(model):
     return model if isinstance(model, Model) else load(model)
 
 
+def motion(model) -> str:
+    """The run a picture of ``model`` over time shows: ``'dynamic'`` for a model whose
+    [analysis] type is dynamic (its free solids move under the loads), else
+    ``'kinematic'``."""
+    return "dynamic" if model.analysis.type == "dynamic" else "kinematic"
+
+
 def configurations(model, t_end: float | None = None, steps: int | None = None,
                    analysis: str | None = None) -> tuple[object, np.ndarray, np.ndarray]:
     """(mechanism, t (n,), q (n, 3·solids)) of a run: the assembly (one row at t = 0), or
@@ -66,7 +73,7 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
     model = _model(model)
     mech = model.mechanism()
     if analysis is None:
-        analysis = "dynamic" if model.analysis.type == "dynamic" else "kinematic"
+        analysis = motion(model)
     if analysis == "assembly":
         res = run(model, analysis="assembly", outputs=list(_POSE[:3]), angles="rad")
     else:

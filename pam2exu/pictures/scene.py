@@ -21,6 +21,36 @@ MARGIN = 0.12
 LABEL_ROOM = np.array([0.9, 0.9])
 
 
+#: the smallest font a title is shrunk to when its wrapped lines are still too wide [pt]
+SMALLEST_TITLE = 6.0
+
+
+def fit_title(fig, ax, text: str) -> None:
+    """Give ``ax`` the title ``text``, wrapped onto more lines (then in a smaller font) as
+    far as needed to stay inside the figure: centred over the axes, each half of it must fit
+    between the axes' centre and the figure's nearer edge."""
+    import textwrap
+    ax.set_title(text)
+    renderer = fig.canvas.get_renderer()
+
+    def excess() -> float:
+        """How much wider than its room the title is (≤ 1: it fits), after a layout."""
+        fig.canvas.draw()
+        box, axes = ax.title.get_window_extent(renderer), ax.get_window_extent(renderer)
+        centre = 0.5 * (axes.x0 + axes.x1)
+        room = 2.0 * min(centre - fig.bbox.x0, fig.bbox.x1 - centre) * 0.98
+        return box.width / max(room, 1.0)
+
+    over = excess()
+    if over <= 1.0:
+        return
+    ax.set_title("\n".join(textwrap.wrap(text, max(12, int(len(text) / over * 0.95)))))
+    size = ax.title.get_fontsize()
+    while (over := excess()) > 1.0 and size > SMALLEST_TITLE:
+        size = max(SMALLEST_TITLE, size / over)
+        ax.title.set_fontsize(size)
+
+
 def extent(mech, q_all, extra=()) -> tuple[np.ndarray, np.ndarray]:
     """Lower-left and upper-right corners [m] of the origin, every solid's origin and
     points, and every element's anchor points, over every row of q_all (n, 3·solids), and

@@ -53,6 +53,12 @@ def abs_error(result: np.ndarray, reference: np.ndarray) -> np.ndarray:
     return err
 
 
+def relative_error(error: float, scale: float, atol: float) -> float:
+    """error / scale [–]; nan where it means nothing: a reference zero to within atol
+    (scale ≤ atol: a column of zeros and round-off, where error / scale could be 512)."""
+    return error / scale if scale > atol and scale > 0 else math.nan
+
+
 def scale_of(reference: np.ndarray) -> float:
     """max |reference| over its finite values (0 when it has none)."""
     finite = np.abs(reference[np.isfinite(reference)])
@@ -366,20 +372,25 @@ def compare(result, reference, rtol: float = RTOL, atol: float = ATOL, columns=N
         interp_err = interpolation_error(res.t, source, ref.t[inside], method)
         overlap = (lo, hi)
     t_ref = ref.t[inside]
-    rows = []
+    rows, zeros = [], []
     for k, (name, j) in enumerate(zip(common, jr)):
         target = ref.values[j][inside]
         err = (angle_error if angle[k] else abs_error)(values[k], target)
         at = int(np.argmax(err))
         worst, scale = float(err[at]), math.pi if angle[k] else scale_of(target)
         tol = tolerance(scale, rtol, atol)
+        if 0 < scale <= atol:
+            zeros.append(name)
         rows.append(VariableComparison(
-            name=name, max_abs_error=worst,
-            max_rel_error=worst / scale if scale > 0 else math.nan,
+            name=name, max_abs_error=worst, max_rel_error=relative_error(worst, scale, atol),
             t_at_max=float(t_ref[at]) if worst > 0 else math.nan, scale=scale,
             tolerance=tol, passed=bool(worst <= tol),
             interpolation_error=float(interp_err[k]),
             unit=res.units.get(name) or ref.units.get(name) or ""))
+    if zeros:
+        notes.append(f"no relative error for {listing(zeros)}: the reference is zero to "
+                     f"within atol (scale ≤ {atol:g}), so the error is judged by its size "
+                     f"alone, against atol")
     return Comparison(rows, only_res, only_ref, res.label, ref.label, float(rtol), float(atol),
                       len(res.t), len(ref.t), int(inside.sum()), None if matched else method,
                       overlap, notes, digits, dt, wrapped)

@@ -32,7 +32,8 @@ class VariableComparison:
         non-finite value at some t_k. For an angle compared modulo 2π, the difference is
         first reduced to (−π, π].
     max_rel_error : float
-        max_abs_error / scale [–]; nan when scale == 0.
+        max_abs_error / scale [–]; nan when scale ≤ atol (a reference zero to within
+        atol: a column of zeros and round-off).
     t_at_max : float
         First reference time of the maximum [s]; nan when there is no error.
     scale : float
@@ -51,7 +52,7 @@ class VariableComparison:
 
     name: str
     max_abs_error: float        # max_k |result(t_k) - reference(t_k)|
-    max_rel_error: float        # max_abs_error / scale; nan when scale == 0
+    max_rel_error: float        # max_abs_error / scale; nan when scale <= atol
     t_at_max: float             # first reference time of the maximum [s]; nan when no error
     scale: float                # max_k |reference(t_k)|
     tolerance: float            # atol + rtol * scale

@@ -569,3 +569,24 @@ def test_a_name_holding_a_semicolon_is_read_from_its_quotes(tmp_path):
     comparison = compare(res, path, rtol=0.0, atol=0.0)
     assert comparison.passed and sorted(v.name for v in comparison.rows) == ["a;b.x", "c.y"]
     assert not comparison.notes                       # not read with ";" as separator
+
+
+def test_a_column_of_zeros_has_no_relative_error():
+    """Issue 22: a column zero to round-off (reference ≤ 1e-17, result 5.12e-15 at most)
+    was reported 'max rel error 512 … pass'. Its relative error is not given (nan, '–' in
+    the table, empty in CSV), a note names it and says it is judged against atol; it still
+    passes (5.12e-15 ≤ atol = 1e-12), and a real error of 1e-6 still fails. A column of
+    size 1 keeps its relative error."""
+    t = np.linspace(0.0, 1.0, 11)
+    noise = 1e-17 * np.cos(7 * t)
+    res = Results(t, {"a.y": noise + 5.12e-15 * t, "b.y": 1e-6 * t, "c.x": np.sin(t) + 1e-12 * t})
+    ref = Results(t, {"a.y": noise, "b.y": noise, "c.x": np.sin(t)})
+    c = compare(res, ref)
+    assert c["a.y"].max_abs_error == pytest.approx(5.12e-15, rel=1e-12)
+    assert np.isnan(c["a.y"].max_rel_error) and c["a.y"].passed
+    assert np.isnan(c["b.y"].max_rel_error) and not c["b.y"].passed
+    assert c["c.x"].max_rel_error == pytest.approx(1e-12 / np.sin(1.0), rel=1e-6)
+    assert any("no relative error for a.y, b.y: the reference is zero to within atol"
+               in n for n in c.notes), c.notes
+    line = next(s for s in c.to_markdown().splitlines() if s.startswith("| a.y |"))
+    assert line.split("|")[3].strip() == "–"
