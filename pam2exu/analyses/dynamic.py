@@ -238,7 +238,8 @@ def mass_matrix(mech, st: State) -> np.ndarray:
 
 def accelerations(mech, t, q, qd) -> np.ndarray:
     """q̈ (n, nq) from [[M, C_qᵀ], [C_q, 0]] [q̈; μ] = [Q − b; γ], b the inertia terms at
-    q̈ = 0 (least squares where redundant constraints make it singular)."""
+    q̈ = 0 (least squares where redundant constraints make it singular); exactly 0 for the
+    solids held by fixed links."""
     st = State(t, q, qd)
     M = mass_matrix(mech, st)
     b, _ = force_pass.inertia_forces(mech, st, np.zeros_like(q))
@@ -246,7 +247,9 @@ def accelerations(mech, t, q, qd) -> np.ndarray:
     eq = native.equations(mech, st)
     A = _saddle(M, eq.jacobian)
     rhs = np.concatenate([Q - b, eq.gamma], axis=1)
-    return _solve(A, rhs)[:, :mech.nq]
+    qdd = _solve(A, rhs)[:, :mech.nq]
+    qdd[:, ~moving_columns(mech)] = 0.0
+    return qdd
 
 
 def impulse(mech, t: float, q: np.ndarray, qd_before: np.ndarray) -> np.ndarray:
@@ -261,10 +264,14 @@ def impulse(mech, t: float, q: np.ndarray, qd_before: np.ndarray) -> np.ndarray:
 
 def nearest_velocities(mech, t: float, q: np.ndarray, guess: np.ndarray) -> np.ndarray:
     """q̇ = q̇_g − C_q⁺ (C_q q̇_g + C_t): the velocities that satisfy the velocity equations
-    nearest to the guess in the Euclidean norm (SI units)."""
+    nearest to the guess in the Euclidean norm (SI units); the solids held by fixed links
+    at rest, exactly."""
+    free = moving_columns(mech)
     eq = native.equations(mech, State([t], q[None]))
-    J = eq.jacobian[0]
-    return guess - np.linalg.pinv(J, rcond=1e-12) @ (J @ guess + eq.c_t[0])
+    J = eq.jacobian[0][:, free]
+    qd = np.zeros(mech.nq)
+    qd[free] = guess[free] - np.linalg.pinv(J, rcond=1e-12) @ (J @ guess[free] + eq.c_t[0])
+    return qd
 
 
 def warn_rates(job: Job, given: np.ndarray, used: np.ndarray) -> None:
@@ -292,15 +299,31 @@ def warn_rates(job: Job, given: np.ndarray, used: np.ndarray) -> None:
 
 def project(mech, t, q, qd):
     """(q, q̇) moved by least norm onto C(q, t) = 0 (Gauss–Newton) and then onto
-    C_q q̇ + C_t = 0: corrections of the size of the integration error."""
+    C_q q̇ + C_t = 0: corrections of the size of the integration error. The solids held by
+    fixed links are put exactly where the links hold them, at rest (the least-norm
+    corrections would leave round-off there, 1e-31)."""
+    free = moving_columns(mech)
     q, qd = q.copy(), qd.copy()
+    q[:, ~free], qd[:, ~free] = mech.initial_q()[~free], 0.0     # the fixed links' poses
     for _ in range(PROJECTIONS):
         eq = native.equations(mech, State(t, q))
-        q -= np.einsum("nqm,nm->nq", np.linalg.pinv(eq.jacobian, rcond=1e-12), eq.residual)
+        q[:, free] -= np.einsum("nqm,nm->nq", np.linalg.pinv(eq.jacobian[:, :, free],
+                                                             rcond=1e-12), eq.residual)
     eq = native.equations(mech, State(t, q))
     defect = np.einsum("nmq,nq->nm", eq.jacobian, qd) + eq.c_t
-    qd -= np.einsum("nqm,nm->nq", np.linalg.pinv(eq.jacobian, rcond=1e-12), defect)
+    qd[:, free] -= np.einsum("nqm,nm->nq", np.linalg.pinv(eq.jacobian[:, :, free],
+                                                          rcond=1e-12), defect)
     return q, qd
+
+
+def moving_columns(mech) -> np.ndarray:
+    """Mask (nq,) of the coordinates of the solids not held by a fixed link."""
+    free = np.ones(mech.nq, dtype=bool)
+    for el in mech.constraints:
+        if el.grounds:
+            free[pose(el.ref1.solid)] = False
+    return free
+
 
 
 def require_inertia(mech, t: float, q: np.ndarray) -> None:

@@ -230,3 +230,28 @@ def test_the_reactions_pass_the_free_body_checks():
         scale = max(np.max(np.abs(f)) for f, _ in forces)
         np.testing.assert_allclose(total, s.mass * accel_G(name), atol=1e-9 * scale)
         np.testing.assert_allclose(moment, s.inertia * res[f"{name}.DDfi"], atol=1e-9 * scale * 0.4)
+
+
+@pytest.mark.parametrize("where", [(0.0, 0.0, 0.0), (0.2, -0.1, 0.3)])
+def test_a_fixed_solid_is_reported_exactly_where_it_is_held(where):
+    """Issue 22: the ground of a dynamic run was reported at fi = 3e-81 … 9e-32 and moving
+    at 7e-31 m/s: the least-norm projections onto the constraints (``dynamic.project``,
+    ``nearest_velocities``) spread round-off onto the coordinates a fixed link holds. They
+    are now the fixed link's pose exactly (==, the ground also moved to x, y, fi = 0.2,
+    −0.1, 0.3), at rest exactly, on both backends, and the free crank still falls."""
+    path = pam2exu.__file__.replace("pam2exu/__init__.py",
+                                    "examples/equilibrium/spring_four_bar.toml")
+    text = open(path, encoding="utf-8").read()
+    model = pam2exu.loads(text.replace('type = "equilibrium"',
+                                       'type = "dynamic"\nt_end = 0.1\nsteps = 5'))
+    ground = model["ground"]
+    ground.x, ground.y, ground.fi = where
+    for backend in ("exudyn", "natural"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = pam2exu.run(model, backend=backend)
+        for k, value in zip(("x", "y", "fi"), where):
+            assert np.all(res[f"ground.{k}"] == value), (backend, k, res[f"ground.{k}"])
+            for rate in ("D", "DD"):
+                assert np.all(res[f"ground.{rate}{k}"] == 0.0), (backend, rate + k)
+        assert abs(res["crank.fi"][-1] - res["crank.fi"][0]) > 1e-3
