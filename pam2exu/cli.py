@@ -17,6 +17,7 @@ import warnings
 
 from . import __version__
 from .errors import ModelError, OutputError, Pam2ExuError, SolverError
+from .console import UsageError, Warnings, check_analysis_options, check_at, check_options
 from .registry import ANALYSES, BACKENDS, DEFAULT_BACKEND
 from .verify import BACKENDS_COMPARED, verify
 
@@ -224,62 +225,18 @@ def _picture_parsers(sub) -> None:
                                 help=argparse.SUPPRESS)
 
 
-class UsageError(Pam2ExuError):
-    """Options that do not go together, or one that needs another (exit 2, before the run)."""
-
-
-def _check_options(args) -> None:
-    """UsageError for options that need one another (before the model is read)."""
-    csv = [name for name, value, default in
-           (("--sep", args.sep, ","), ("--decimal", args.decimal, "."), ("--bom", args.bom, False))
-           if value != default]
-    if csv and not args.output:
-        raise UsageError(f"{' and '.join(csv)} {'is' if len(csv) == 1 else 'are'} for the CSV "
-                         f"file of -o: give -o OUT.csv, or drop {' and '.join(csv)}")
-    alone = [name for name, value in (("--x", args.x), ("--plot-file", args.plot_file))
-             if value is not None]
-    if alone and not args.plot:
-        raise UsageError(f"{' and '.join(alone)} {'is' if len(alone) == 1 else 'are'} for "
-                         f"--plot: give --plot VAR …, or drop {' and '.join(alone)}")
-    from .errors import PictureError
-    from .results.plot import image_format
-    for option, path in (("--energy", args.energy), ("--plot-file", args.plot_file)):
-        try:
-            if path is not None:
-                image_format(path)
-        except PictureError as exc:
-            raise UsageError(f"{option}: {exc}") from None
-
-
-def _check_analysis_options(args, model) -> None:
-    """UsageError for options the run's analysis does not use (``--tolerance``), ModelError
-    for ``--energy`` of an analysis without rates and forces: before the run."""
-    from .analyses.energy import require_rates
-    from .registry import analysis_type
-    name = args.analysis or model.analysis.type
-    kind = analysis_type(name) if isinstance(name, str) else None
-    if kind is None:
-        return                                   # run reports the settings
-    if args.tolerance is not None and not kind.integrates:
-        known = ", ".join(a.name for a in ANALYSES.values() if a.integrates)
-        raise UsageError(f"--tolerance is the time integration's ({known}); the {kind.name} "
-                         f"analysis does not use it: drop --tolerance")
-    if args.energy:
-        require_rates(kind.name, model.source)
-
-
 def _run(args) -> int:
     from .analyses import run
     from .model import load
     from .results.writers import check, write
     sep = "\t" if args.sep in ("tab", "\\t") else args.sep
-    _check_options(args)                         # nothing runs, nothing is written
+    check_options(args)                          # nothing runs, nothing is written
     if args.output:                              # a bad file name fails before the run
         check(args.output, sep, args.decimal, args.bom)
     model = load(args.model)
-    _check_analysis_options(args, model)
+    check_analysis_options(args, model)
     if args.at:                                  # times outside the run fail before it
-        _check_at(args, model)
+        check_at(args, model)
     backend = BACKENDS.get(args.backend or model.analysis.backend)
     # the backend's settings (an unknown name: run's model error names the known ones)
     solver = backend.create().Settings(verbose=1 if args.verbose else 0) if backend else None
@@ -327,24 +284,6 @@ def _run_energy(args, model, res) -> int:
         plot(acc, None, args.energy)
         return args.energy
     return _picture("energy", make, args.debug)
-
-
-def _check_at(args, model) -> None:
-    """ModelError (exit 2) for a ``--at`` time outside the run's interval, 0 … t_end (only 0
-    for an analysis at t = 0)."""
-    from .errors import Problem
-    from .registry import analysis_type
-    kind = analysis_type(args.analysis or model.analysis.type)
-    end = args.t_end if args.t_end is not None else model.analysis.t_end
-    if kind is None or not isinstance(end, (int, float)):
-        return                                   # run reports the settings
-    end = 0.0 if kind.at_start else float(end)
-    bad = [t for t in args.at if not 0.0 <= t <= end]
-    if bad:
-        times = (f"the {kind.name} analysis solves t = 0 only" if kind.at_start else
-                 f"give times in the run's interval, t = 0 … {end:g} s")
-        raise ModelError(Problem("--at", f"t = {bad[0]:g} s is outside the run: {times}"),
-                         model.source)
 
 
 def _run_plot(args, res) -> int:
@@ -516,39 +455,15 @@ def _export(args) -> int:
     return 0
 
 
-class _Warnings:
-    """The warnings of one command, each printed once on stderr as one line ``pam2exu:
-    warning: …``: those issued (``warnings.warn``, through ``show``) and those a result
-    carries (``say``). A text already said with a prefix (the model file's name) is not said
-    again without it, nor the other way round."""
-
-    def __init__(self):
-        self.said: list[str] = []
-
-    def say(self, text) -> None:
-        text = " ".join(str(text).split())
-        if any(text == old or old.endswith(": " + text) or text.endswith(": " + old)
-               for old in self.said):
-            return
-        self.said.append(text)
-        print(f"pam2exu: warning: {text}", file=sys.stderr)
-
-    def show(self, message, category, filename, lineno, file=None, line=None) -> None:
-        """``warnings.showwarning``: the message only (no source line)."""
-        self.say(message)
-
-
-_WARNINGS = _Warnings()
+_WARNINGS = Warnings()                    # the running command's (``main`` makes one each)
 
 
 def main(argv=None) -> int:
     global _WARNINGS
     args = _parser().parse_args(argv)
-    _WARNINGS = _Warnings()
+    _WARNINGS = Warnings()
     with warnings.catch_warnings():
-        # every warning reaches ``show`` (which says each text once), pam2exu's own
-        # (UserWarning) each time it is issued
-        warnings.simplefilter("always", UserWarning)
+        warnings.simplefilter("always", UserWarning)    # each reaches show, which dedupes
         warnings.showwarning = _WARNINGS.show
         return _main(args)
 

@@ -422,9 +422,8 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
             return None
         *_, unit, new = min(choices, key=lambda c: c[:3])
         keep = _mask(mech, [*setters, *built, *unit.ties])
-        left, found, converged = native.closest(mech, t, q, keep,
-                                                 max(0.0, stop - time.perf_counter()),
-                                                 tol=VERDICT_TOL)
+        left, found, converged = native.closest_violation(
+            mech, t, q, keep, max(0.0, stop - time.perf_counter()), tol=VERDICT_TOL)
         if not converged:                # out of time: no verdict
             return None
         if not np.all(np.abs(left[keep]) <= can_hold):

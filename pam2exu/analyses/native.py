@@ -449,38 +449,27 @@ class _Enough(Exception):
     """The diagnosis' search ran out of time (``closest_violation``)."""
 
 
-def closest_violation(mech, t: float, q_start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(C(q*, t), q*) at q* = argmin |C(q, t)|² from q_start (diagnosis of a failure only).
+def closest_violation(mech, t: float, q_start: np.ndarray, keep: np.ndarray | None = None,
+                      seconds: float | None = None,
+                      tol: float = 1e-15) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(C(q*, t), q*, converged) at q* = argmin |C(q, t)|² from q_start (diagnosis only):
+    of the equations ``keep`` (a mask; C is of all), to the relative tolerance ``tol``;
+    ``converged`` False when the search ran out of evaluations or of time.
 
     The elements still violated at q* are those that cannot close at time t. Where
     C(q*) ≠ 0, Cqᵀ C = 0 there: the constraint Jacobian is singular at q*. The search
-    stops after ``DIAGNOSIS_SECONDS`` with the best configuration found (a mechanism that
-    cannot close leaves a flat valley that it would otherwise crawl along for long).
+    stops after ``seconds`` (default ``DIAGNOSIS_SECONDS``) with the best configuration
+    found (a mechanism that cannot close leaves a flat valley it would crawl along).
     """
-    left, q, _ = closest(mech, t, q_start)
-    return left, q
-
-
-def closest(mech, t: float, q_start: np.ndarray, keep: np.ndarray | None = None,
-            seconds: float | None = None,
-            tol: float = 1e-15) -> tuple[np.ndarray, np.ndarray, bool]:
-    """``closest_violation`` of the equations ``keep`` (a mask; default all), the others
-    left out of the sum, in at most ``seconds`` (default ``DIAGNOSIS_SECONDS``), to the
-    relative tolerance ``tol`` (of the least squares' x, cost and gradient): (C(q*, t) of
-    every equation, q*, whether the search converged rather than ran out of time or
-    evaluations)."""
     import time
 
     from scipy.optimize import least_squares
 
     # actuators and fixed links can always hold (they only set a coordinate): weight them
     # so that what is left shows in the joints that cannot close
-    weight = np.ones(mech.n_equations)
+    weight = np.ones(mech.n_equations) if keep is None else np.where(keep, 1.0, 0.0)
     for el, rows in zip(mech.constraints, mech.rows):
-        if el.drives or el.grounds:
-            weight[rows] = 1e3
-    if keep is not None:
-        weight = np.where(keep, weight, 0.0)
+        weight[rows] *= 1e3 if el.drives or el.grounds else 1.0
     stop = time.perf_counter() + (DIAGNOSIS_SECONDS if seconds is None else seconds)
     best = [np.inf, q_start, None]
 
@@ -501,8 +490,7 @@ def closest(mech, t: float, q_start: np.ndarray, keep: np.ndarray | None = None,
 
     try:
         sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq
-                            else "trf", max_nfev=200 * mech.nq, xtol=tol, ftol=tol,
-                            gtol=tol)
+                            else "trf", max_nfev=200 * mech.nq, xtol=tol, ftol=tol, gtol=tol)
         found, converged = sol.x, sol.status > 0
     except (_Enough, ValueError):       # out of time, or a residual that is not finite
         if best[2] is None:

@@ -362,28 +362,11 @@ class Model:
         self.variations.append(variation)
         return variation
 
-    def __repr__(self) -> str:
-        """One line: name, file, counts and the analysis, e.g. ``<Model 'four-bar' from
-        examples/four_bar.toml: 4 solids, 6 elements; kinematic analysis, t = 0 … 1 s in 200
-        steps>`` (never raises, even for a model with problems)."""
-        a = self.analysis
-        kind = registry.analysis_type(a.type) if isinstance(a.type, str) else None
-        interval = ("" if kind is not None and kind.at_start
-                    else f", t = 0 … {a.t_end:g} s in {a.steps} steps"
-                    if isinstance(a.t_end, (int, float)) and isinstance(a.steps, int)
-                    else f", t_end = {a.t_end!r}, steps = {a.steps!r}")
-        source = f" from {self.source}" if self.source else ""
-        count = (f"{len(self.solids)} solid{'s' * (len(self.solids) != 1)}, "
-                 f"{len(self.elements)} element{'s' * (len(self.elements) != 1)}")
-        extra = (f", {len(self.variations)} variation{'s' * (len(self.variations) != 1)}"
-                 if self.variations else "")
-        return f"<Model {self.name!r}{source}: {count}{extra}; {a.type} analysis{interval}>"
-
-    __str__ = __repr__
+    def __repr__(self) -> str:       # one line: name, file, counts, analysis (describe.py)
+        return registry.resolve("pam2exu.model.describe:one_line")(self)
 
     def _repr_html_(self) -> str:
-        """The model in a notebook: solids, elements and a drawing (``pam2exu.notebook``,
-        resolved lazily: the drawing needs the analyses)."""
+        """The model in a notebook (``pam2exu.notebook``, lazily: it needs the analyses)."""
         return registry.resolve("pam2exu.notebook:model_html")(self)
 
     def __getitem__(self, name: str) -> Solid | Element:

@@ -1,0 +1,94 @@
+"""What the command line checks before a run, and how it prints warnings.
+
+``check_options`` refuses options that need one another (``--x`` without ``--plot``, the CSV
+options without ``-o``, an image suffix that cannot be written) before the model is read;
+``check_analysis_options`` and ``check_at`` those the run's analysis cannot use, before it
+runs: nothing runs, nothing is written (``UsageError`` or ``ModelError``, exit 2).
+``Warnings`` prints every warning of a command once, as one line ``pam2exu: warning: …``.
+"""
+from __future__ import annotations
+
+import sys
+
+from .errors import ModelError, Pam2ExuError, PictureError, Problem
+from .registry import ANALYSES, analysis_type
+
+
+class UsageError(Pam2ExuError):
+    """Options that do not go together, or one that needs another (exit 2, before the run)."""
+
+
+def check_options(args) -> None:
+    """UsageError for options that need one another (before the model is read)."""
+    csv = [name for name, value, default in
+           (("--sep", args.sep, ","), ("--decimal", args.decimal, "."), ("--bom", args.bom, False))
+           if value != default]
+    if csv and not args.output:
+        raise UsageError(f"{' and '.join(csv)} {'is' if len(csv) == 1 else 'are'} for the CSV "
+                         f"file of -o: give -o OUT.csv, or drop {' and '.join(csv)}")
+    alone = [name for name, value in (("--x", args.x), ("--plot-file", args.plot_file))
+             if value is not None]
+    if alone and not args.plot:
+        raise UsageError(f"{' and '.join(alone)} {'is' if len(alone) == 1 else 'are'} for "
+                         f"--plot: give --plot VAR …, or drop {' and '.join(alone)}")
+    from .results.plot import image_format
+    for option, path in (("--energy", args.energy), ("--plot-file", args.plot_file)):
+        try:
+            if path is not None:
+                image_format(path)
+        except PictureError as exc:
+            raise UsageError(f"{option}: {exc}") from None
+
+
+def check_analysis_options(args, model) -> None:
+    """UsageError for options the run's analysis does not use (``--tolerance``), ModelError
+    for ``--energy`` of an analysis without rates and forces: before the run."""
+    from .analyses.energy import require_rates
+    name = args.analysis or model.analysis.type
+    kind = analysis_type(name) if isinstance(name, str) else None
+    if kind is None:
+        return                                   # run reports the settings
+    if args.tolerance is not None and not kind.integrates:
+        known = ", ".join(a.name for a in ANALYSES.values() if a.integrates)
+        raise UsageError(f"--tolerance is the time integration's ({known}); the {kind.name} "
+                         f"analysis does not use it: drop --tolerance")
+    if args.energy:
+        require_rates(kind.name, model.source)
+
+
+def check_at(args, model) -> None:
+    """ModelError (exit 2) for a ``--at`` time outside the run's interval, 0 … t_end (only 0
+    for an analysis at t = 0)."""
+    kind = analysis_type(args.analysis or model.analysis.type)
+    end = args.t_end if args.t_end is not None else model.analysis.t_end
+    if kind is None or not isinstance(end, (int, float)):
+        return                                   # run reports the settings
+    end = 0.0 if kind.at_start else float(end)
+    bad = [t for t in args.at if not 0.0 <= t <= end]
+    if bad:
+        times = (f"the {kind.name} analysis solves t = 0 only" if kind.at_start else
+                 f"give times in the run's interval, t = 0 … {end:g} s")
+        raise ModelError(Problem("--at", f"t = {bad[0]:g} s is outside the run: {times}"),
+                         model.source)
+
+
+class Warnings:
+    """The warnings of one command, each printed once on stderr as one line ``pam2exu:
+    warning: …``: those issued (``warnings.warn``, through ``show``) and those a result
+    carries (``say``). A text already said with a prefix (the model file's name) is not said
+    again without it, nor the other way round."""
+
+    def __init__(self):
+        self.said: list[str] = []
+
+    def say(self, text) -> None:
+        text = " ".join(str(text).split())
+        if any(text == old or old.endswith(": " + text) or text.endswith(": " + old)
+               for old in self.said):
+            return
+        self.said.append(text)
+        print(f"pam2exu: warning: {text}", file=sys.stderr)
+
+    def show(self, message, category, filename, lineno, file=None, line=None) -> None:
+        """``warnings.showwarning``: the message only (no source line)."""
+        self.say(message)
