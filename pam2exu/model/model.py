@@ -353,8 +353,7 @@ class Model:
                 raise ModelError([f"a variation has no key '{k}'{closest(k, VARIATION_KEYS)}; "
                                   f"its keys are: {', '.join(VARIATION_KEYS)}" for k in unknown],
                                  self.source)
-            variation = Variation(variation, **keys) if variation is not None \
-                else Variation(**keys)
+            variation = Variation(**keys) if variation is None else Variation(variation, **keys)
         elif keys:
             raise TypeError("add_variation: keys given with a Variation object")
         if variation.position is None:
@@ -365,8 +364,7 @@ class Model:
     def __repr__(self) -> str:       # one line: name, file, counts, analysis (describe.py)
         return registry.resolve("pam2exu.model.describe:one_line")(self)
 
-    def _repr_html_(self) -> str:
-        """The model in a notebook (``pam2exu.notebook``, lazily: it needs the analyses)."""
+    def _repr_html_(self) -> str:    # in a notebook (pam2exu.notebook: needs the analyses)
         return registry.resolve("pam2exu.notebook:model_html")(self)
 
     def __getitem__(self, name: str) -> Solid | Element:
