@@ -144,8 +144,10 @@ def test_run_warns_of_degrees_in_a_radians_model_as_check_does(tmp_path, capsys)
     path = tmp_path / "deg.toml"
     path.write_text(text)
     assert main(["check", str(path)]) == 0
-    printed = [line.removeprefix("warning: ") for line in capsys.readouterr().out.splitlines()
-               if line.startswith("warning: ")]
+    # the CLI's warnings: one line each on stderr (issue 22)
+    printed = [line.removeprefix("pam2exu: warning: ")
+               for line in capsys.readouterr().err.splitlines()
+               if line.startswith("pam2exu: warning: ")]
     assert printed == [
         "[[solid]] #2 'crank': fi = 30 rad is more than a full turn (2π = 6.28 rad): did you "
         "give degrees? Write fi in radians (30° = 0.5236 rad), or set angles = \"deg\" in "
@@ -228,7 +230,7 @@ def test_a_transition_law_missing_constants_is_warned_of(tmp_path, capsys):
                 "C4 = 0 between t = 0.2 s and 0.8 s; give the four constants "
                 "C = [C1, C2, C3, C4] (start [s], end [s], value before, value after)")
     assert main(["check", str(path)]) == 0
-    assert f"warning: {expected}" in capsys.readouterr().out.splitlines()
+    assert f"pam2exu: warning: {expected}" in capsys.readouterr().err.splitlines()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         res = run(path, "kinematic", steps=20, outputs=["sun.fi"])
