@@ -271,9 +271,7 @@ class Results(Exports, Instants):
         if len(self.columns) > max_rows:
             lines.append(f"… and {len(self.columns) - max_rows} more columns (write them all "
                          f"with -o results.csv)")
-        checks = self.checks()
-        if checks:
-            lines += ["", "checks: " + "; ".join(checks)]
+        lines += ["", "checks: " + "; ".join(self.checks())] if self.checks() else []
         lines += [f"warning: {w}" for w in self.warnings] if warnings else []
         return "\n".join(lines)
 
