@@ -373,8 +373,8 @@ def _poses(q, solids) -> dict[int, tuple[np.ndarray, float]]:
 #: the least squares' relative tolerance in ``first_open``: enough to tell a part that
 #: closes (to the solver's tolerance) from one that stays open by more than ``can_hold``
 VERDICT_TOL = 1e-10
-#: ``first_open``'s solves together may take this many times ``native.DIAGNOSIS_SECONDS``
-#: (a guard against crawling along a flat valley only: the Watt six-bar of the tests takes
+#: ``first_open``'s solves together may do this many times ``native.DIAGNOSIS_WORK`` (a
+#: guard against crawling along a flat valley only: the Watt six-bar of the tests takes
 #: 0.3 s for its three solves)
 OPEN_BUDGET = 4
 
@@ -385,16 +385,12 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
     structure does: from the fixed links and the actuators, add each time the smallest tie
     or loop that places its solids (Assur groups: the driven crank, then the four-bar's
     dyad, then the dyad hung on it …), solving what is built so far (least squares from
-    ``q_start``, all of them within ``OPEN_BUDGET`` times ``native.DIAGNOSIS_SECONDS``;
-    None when that time runs out). The first addition left violated by more than ``can_hold`` is the part
+    ``q_start``, all of them within ``OPEN_BUDGET`` times ``native.DIAGNOSIS_WORK``;
+    None when that work is spent). The first addition left violated by more than ``can_hold`` is the part
     that cannot close; its diagnosis names its ties less those of the loops that closed
     before it. None when every addition closes. ``worst``: the ties' violations at
     the closest configuration of the whole mechanism, to start the loop's text at the worst.
     """
-    import time
-
-    import scipy.optimize  # noqa: F401  (imported before the clock starts)
-
     from . import native
     from ..kinematics import State
 
@@ -405,7 +401,7 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
     units = _units(mech)
     q = np.array(q_start, dtype=float)
     by = _placers(mech, False)
-    stop = time.perf_counter() + OPEN_BUDGET * native.DIAGNOSIS_SECONDS
+    budget = native.Budget(mech, OPEN_BUDGET)
     while True:
         jac = native.equations(mech, State([t], q[None])).jacobian[0]
         choices = []
@@ -423,8 +419,8 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
         *_, unit, new = min(choices, key=lambda c: c[:3])
         keep = _mask(mech, [*setters, *built, *unit.ties])
         left, found, converged = native.closest_violation(
-            mech, t, q, keep, max(0.0, stop - time.perf_counter()), tol=VERDICT_TOL)
-        if not converged:                # out of time: no verdict
+            mech, t, q, keep, budget, tol=VERDICT_TOL)
+        if not converged:                # out of work: no verdict
             return None
         if not np.all(np.abs(left[keep]) <= can_hold):
             return _open(mech, unit, closed, t, _poses(q, placed), by, worst or {})
