@@ -174,6 +174,9 @@ class SolverError(Pam2ExuError):
     elements : tuple of str
         Descriptions of the elements whose constraints are violated most, worst first
         (``"'B' (revolute)"``); empty when not known.
+    partial : Results, optional
+        The rows computed before the failure, where the analysis keeps them (the clearance
+        analysis does; ``pam2exu run --partial -o FILE`` writes them).
 
     Attributes
     ----------
@@ -183,17 +186,20 @@ class SolverError(Pam2ExuError):
         As the parameter.
     elements : tuple of str
         As the parameter.
+    partial : Results or None
+        As the parameter (None: no row kept).
 
     Examples
     --------
     >>> error = SolverError("did not converge", time=0.25, step=50)
-    >>> error.time, error.step, error.elements
-    (0.25, 50, ())
+    >>> error.time, error.step, error.elements, error.partial
+    (0.25, 50, (), None)
     """
 
     def __init__(self, message: str, time: float | None = None, step: int | None = None,
-                 elements: tuple[str, ...] = ()):
+                 elements: tuple[str, ...] = (), partial=None):
         self.time, self.step, self.elements = time, step, tuple(elements)
+        self.partial = partial
         super().__init__(message)
 
 

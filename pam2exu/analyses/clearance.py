@@ -22,7 +22,8 @@ from ..kinematics import PER_SOLID, State
 from ..model.solid import LineRef
 from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect
-from .least_norm import RANK, Closure, applicability, follow, lagrange_jacobian, time_rate
+from .least_norm import (RANK, Applicability, Closure, Stop, applicability, follow,
+                         lagrange_jacobian, split, time_rate)
 from .native import target_values
 from .positions import assemble
 
@@ -51,23 +52,90 @@ def clearance(job: Job):
     require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m)), t0)
     job.stage = "following the clearance of least norm (the slides' ODE)"
     y0 = np.r_[np.zeros(p), q0, np.zeros(m)]
-    y, ok = follow(closures.evaluate, time_rate(closures.evaluate, p), job.times, y0, p, nq)
-    if not ok.all():
-        t = float(job.times[int(np.argmin(ok))])
-        raise SolverError(
-            f"t={t:g}: the clearance of least norm could not be followed to here (h_y turned "
-            "singular, or Newton on the Lagrange conditions did not converge): the clearance "
-            "followed is no longer a strict minimum (a singular position or a bifurcation)",
-            time=t)
+    y, ok, stop = follow(closures.evaluate, time_rate(closures.evaluate, p, start=t0),
+                         job.times, y0, p, nq)
     job.stage = "checking the clearance is a strict minimum at every row"
     rows = range(0, len(job.times), job.every)
     for k in rows:
+        if not ok[k]:
+            break
         q, lam = y[k, p:p + nq], y[k, p + nq:]
-        require_strict_minimum(closures.evaluate(float(job.times[k]), q, lam),
-                               float(job.times[k]))
+        t = float(job.times[k])
+        try:
+            require_strict_minimum(closures.evaluate(t, q, lam), t, source(closures),
+                                   closures)
+        except SolverError as error:
+            raise _with_rows(error, job, closures, y, k) from None
+    if stop is not None:
+        raise _with_rows(not_followed(closures, job, stop), job, closures, y,
+                         int(np.argmin(ok)))
     if p:
         _warn_far_from_first_order(job, closures, y[:, :p], list(rows), mob.redundant > 0)
     return collect(job, y[:, p:p + nq], extra=closures.columns(y[:, :p]))
+
+
+def source(closures: "Closures") -> str:
+    """The model file, for messages ("the model" when it was built in Python)."""
+    return closures.mech.model.source or "the model"
+
+
+def _with_rows(error: SolverError, job: Job, closures: "Closures", y: np.ndarray,
+               end: int) -> SolverError:
+    """``error`` with ``partial``: the Results of the rows before index ``end`` of the grid
+    (None when there are none)."""
+    kept = range(0, end, job.every)
+    if len(kept):
+        last = kept[-1] + 1
+        part = replace(job, times=job.times[:last], warnings=list(job.warnings))
+        error.partial = collect(part, y[:last, closures.p:closures.p + closures.nq],
+                                extra=closures.columns(y[:last, :closures.p]))
+    return error
+
+
+def not_followed(closures: "Closures", job: Job, stop: Stop) -> SolverError:
+    """The SolverError for ``follow`` stopping before the end: where it stopped, how, the
+    condition nearest to failing there, and what to try."""
+    t, t_end = stop.time, float(job.times[-1])
+    j, q, lam = split(stop.y, closures.p, closures.nq)
+    found = applicability(closures.evaluate(t, q, lam))
+    how = {Stop.SINGULAR: "the integration cannot step past it (the equations of the least "
+                          "clearance are singular there: h_y)",
+           Stop.WORK: f"the integration took {stop.steps} steps in one output step without "
+                      f"reaching the next row, its steps shrinking as the path nears a "
+                      f"singular position (the work limit, least_norm.MAX_STEPS)",
+           Stop.NEWTON: "the least clearance found by the integration cannot be refined "
+                        "there (Newton's method on the Lagrange conditions does not "
+                        "converge)"}[stop.cause]
+    return SolverError(
+        f"t={t:.6g}: the clearance of least norm of {source(closures)} could not be followed "
+        f"beyond t = {t:.6g} s (of 0 … {t_end:g} s): {how}. There "
+        f"{_nearest_failure(found, closures)}. {TRY} (t_end below {t:.6g} s); {_kept(t)}.",
+        time=t,
+        step=int(np.ceil(np.searchsorted(job.times, t) / job.every)))
+
+
+def _nearest_failure(found: Applicability, closures: "Closures | None" = None) -> str:
+    """Which condition of the method is nearest to failing, in the designer's words, with
+    its number: the smallest of σ_min/σ_max of [F_j F_q] (i), of F_q (ii), and of the
+    reduced Hessian's eigenvalue (the contract's item 3)."""
+    worst = min((found.ratio_i, "i"), (found.ratio_ii, "ii"), (found.hessian, "3"))[1]
+    if worst == "i":
+        names = (", ".join(f"'{n}'" for n in loaded_elements(closures, found.self_stress))
+                 if closures is not None else "")
+        return (f"the joints lock into a new self-stress that the clearances barely take up"
+                f"{f' (through {names})' if names else ''}: a singular position of the "
+                f"mechanism (condition (i): σ_min/σ_max of [F_j F_q] = {found.ratio_i:.3g})")
+    if worst == "ii":
+        names = (", ".join(f"'{n}'" for n in free_solids(closures.mech, found.free))
+                 if closures is not None else "")
+        return (f"the joints and the command nearly stop fixing the positions"
+                f"{f' of {names}' if names else ''}: a singular position such as a dead "
+                f"centre, where cranks line up with a rod (condition (ii): σ_min/σ_max of "
+                f"F_q = {found.ratio_ii:.3g})")
+    return (f"the least clearance is close to branching: the minimum followed turns into a "
+            f"saddle, usually near a singular position such as a dead centre (smallest "
+            f"eigenvalue of the reduced Hessian = {found.hessian:.3g}, condition 3 of a "
+            f"strict minimum)")
 
 
 def first_order(closures: "Closures", t: float, q_nominal: np.ndarray) -> np.ndarray:
@@ -213,33 +281,46 @@ def require_applicable(closures: Closures, c: Closure, t: float) -> None:
     """Raise the contract's error where the method does not apply at the start (λ = 0):
     (i) a self-stress that loads no clearance parameter: ModelError naming the elements;
     (ii) positions the closure and the command leave free: MobilityError naming the
-    solids. Both messages begin with ``t=<time>:``."""
+    solids. Both messages begin with ``t=<time>:`` and name the model file."""
     found = applicability(c)
     if found.self_stress.shape[1]:
         names = ", ".join(f"'{n}'" for n in loaded_elements(closures, found.self_stress))
         raise ModelError(
-            f"t={t:g}: condition (i) fails: the closure equations have a self-stress that no "
-            f"clearance parameter takes up (σ_min/σ_max of [F_j F_q] = "
-            f"{found.ratio_i:.3g}); it loads the elements {names}: declare clearance = true "
-            "on one of them (a revolute, pin_slot or prismatic), so that its clearance can "
-            "absorb the variations")
+            f"t={t:g}: the clearance analysis of {source(closures)} cannot start: the "
+            f"elements {names} close an over-constrained loop with no clearance in it, so "
+            f"no clearance can absorb the variations that strain it (condition (i): a "
+            f"self-stress that loads no clearance parameter, σ_min/σ_max of [F_j F_q] = "
+            f"{found.ratio_i:.3g}): declare clearance = true on one of them (a revolute, "
+            f"pin_slot or prismatic)")
     if found.free.shape[1] or found.hessian <= RANK:
         names = ", ".join(f"'{n}'" for n in free_solids(closures.mech, found.free))
         raise MobilityError(
-            f"t={t:g}: condition (ii) fails: the closure equations and the command do not "
-            f"fix every position (σ_min/σ_max of F_q = {found.ratio_ii:.3g}); the solids "
-            f"{names} are left free: an undriven degree of freedom (drive it with an "
-            "actuator) or a singular position (start elsewhere)")
+            f"t={t:g}: the clearance analysis of {source(closures)} cannot start: the joints "
+            f"and the actuators leave the solids {names} free to move (condition (ii): "
+            f"σ_min/σ_max of F_q = {found.ratio_ii:.3g}): drive the free degree of freedom "
+            f"with an actuator, or, at a singular position such as a dead centre, start "
+            f"elsewhere (the actuator's law at t = 0, or the solids' fi)")
 
 
-def require_strict_minimum(c: Closure, t: float) -> None:
+def require_strict_minimum(c: Closure, t: float, source: str = "the model",
+                           closures: Closures | None = None) -> None:
     """Raise SolverError where, at a later time, (i) or the reduced Hessian's condition
-    fails: the clearance followed is no longer a strict minimum."""
+    fails: the clearance followed is no longer a strict minimum (``closures``, when given,
+    names the elements or solids concerned)."""
     found = applicability(c)
     if found.ratio_i <= RANK or found.hessian <= RANK:
         raise SolverError(
-            f"t={t:g}: the clearance followed is no longer a strict minimum (σ_min/σ_max of "
-            f"[F_j F_q] = {found.ratio_i:.3g}, smallest eigenvalue of the reduced Hessian = "
-            f"{found.hessian:.3g}): a singular position or a bifurcation; the results stop "
-            "there", time=t)
+            f"t={t:g}: the clearance followed is no longer a strict minimum in {source}: "
+            f"{_nearest_failure(found, closures)}. The least-norm clearance may leave for "
+            f"another branch here. {TRY} (t_end below {t:g} s); {_kept(t)}", time=t)
 
+
+#: what a designer can change when the least-norm clearance cannot be followed
+TRY = ("Try clearance = true on another joint of the loop, smaller variations (dx, dy, "
+       "dangle), or a shorter interval")
+
+
+def _kept(t: float) -> str:
+    """What is kept of a run stopped at t > 0."""
+    return (f"the rows before t = {t:.6g} s are kept (SolverError.partial; pam2exu run "
+            f"--partial -o FILE.csv writes them)" if t > 0 else "no row is kept")

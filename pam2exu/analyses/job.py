@@ -15,6 +15,7 @@ from ..kinematics import State, column
 from ..model import Model, load
 from ..model.mistakes import input_warnings
 from ..model.solid import SOLID_OUTPUTS
+from ..model.variation import pace_problems
 from ..results import Results, select_columns
 from ..results.info import RunInfo
 from . import grid, native
@@ -104,6 +105,10 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
         raise ModelError(problems, model.source)
     mech = model.mechanism()
     kind = registry.ANALYSES[settings.type]
+    if CLEARANCE in kind.levels:                 # the analysis that reads the variations
+        too_fast = pace_problems(mech.variations, settings.t_end, settings.steps)
+        if too_fast:
+            raise ModelError([Problem(*p) for p in too_fast], model.source)
     available = available_columns(mech, kind.name)
     try:
         if settings.outputs is None:             # the default: every column not opt-in

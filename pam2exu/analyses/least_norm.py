@@ -23,7 +23,7 @@ différentielle pour modéliser les mécanismes sur-contraints avec jeu" (2014),
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -152,41 +152,104 @@ def kkt_residual(j: np.ndarray, c: Closure) -> float:
     return float(np.max(np.abs(A @ lam - b), initial=0.0))
 
 
-def time_rate(evaluate: Evaluate, p: int, step: float = 1e-6) -> Callable:
-    """h_t(t, q, λ) at fixed y by central differences in t (error O(step²)): the ODE only
-    tracks the branch, the corrector of ``follow`` makes every output meet h = 0."""
+def time_rate(evaluate: Evaluate, p: int, step: float = 1e-6, start: float = 0.0) -> Callable:
+    """h_t(t, q, λ) at fixed y by central differences in t (error O(step²)), forward ones
+    (−3h(t) + 4h(t + s) − h(t + 2s))/(2s) where t − step is before ``start`` (the
+    variations are not defined there): the ODE only tracks the branch, the corrector of
+    ``follow`` makes every output meet h = 0."""
     def h_t(t, q, lam):
         j = np.zeros(p)
-        ahead, behind = (lagrange(j, lam, evaluate(t + s, q, lam)) for s in (step, -step))
-        return (ahead - behind) / (2 * step)
+        at = [lagrange(j, lam, evaluate(t + s, q, lam))
+              for s in ((step, -step) if t - step >= start else (0.0, step, 2 * step))]
+        if len(at) == 2:
+            return (at[0] - at[1]) / (2 * step)
+        return (-3 * at[0] + 4 * at[1] - at[2]) / (2 * step)
     return h_t
 
 
+#: the integrator's steps allowed in one interval of the output grid before ``follow`` stops
+#: (``Stop.WORK``): the shipped examples take at most 4, a variation at the grid's limit
+#: (ω Δt = π, ``model.variation.PHASE_PER_STEP``) about 30; a path that crawls (steps
+#: shrinking near a singular position) ends instead of running for hours
+MAX_STEPS = 100
+
+
+@dataclass
+class Stop:
+    """Where and why ``follow`` stopped before the last output time."""
+
+    #: the integration could not go on: h_y singular, or the step size fell to round-off
+    SINGULAR = "singular"
+    #: more than ``MAX_STEPS`` steps in one output interval
+    WORK = "work"
+    #: Newton on h = 0 did not converge at an output time
+    NEWTON = "newton"
+
+    time: float            # the last time reached [s]
+    cause: str             # SINGULAR, WORK or NEWTON
+    y: np.ndarray          # y = (j, q, λ) there
+    steps: int = 0         # the steps taken in the output interval where it stopped
+
+
+class Followed(NamedTuple):
+    """What ``follow`` found: every row up to ``stop`` (NaN after it, ``converged`` False)."""
+
+    y: np.ndarray            # (len(times), p + nq + m)
+    converged: np.ndarray    # (len(times),) bool
+    stop: Stop | None        # None: it reached the last output time
+
+
 def follow(evaluate: Evaluate, h_t: Callable, times: np.ndarray, y0: np.ndarray, p: int,
-           nq: int, rtol: float = 1e-10, atol: float = 1e-12):
-    """(y (len(times), p + nq + m), converged (len(times),)): from y0 at times[0], the
-    slides' ODE y' = −h_y⁻¹ h_t integrated by scipy's ``solve_ivp`` (DOP853) through every
-    output time, then Newton on h = 0 at each output time from the integrated value."""
-    from scipy.integrate import solve_ivp
+           nq: int, rtol: float = 1e-10, atol: float = 1e-12,
+           max_steps: int | None = None) -> Followed:
+    """The slides' ODE y' = −h_y⁻¹ h_t from y0 at times[0], integrated by scipy's DOP853
+    step by step through every output time (its dense output there, as ``solve_ivp`` with
+    ``t_eval``), then Newton on h = 0 at each output time from the integrated value.
+
+    It stops at the first of: h_y singular or the step size fallen to round-off
+    (``Stop.SINGULAR``), more than ``max_steps`` steps in one output interval
+    (``Stop.WORK``; None: ``MAX_STEPS``), Newton not converging at an output time
+    (``Stop.NEWTON``); the rows before are kept.
+    """
+    from scipy.integrate import DOP853
+
+    max_steps = MAX_STEPS if max_steps is None else max_steps
 
     def rhs(t, y):
         j, q, lam = split(y, p, nq)
         return -np.linalg.solve(lagrange_jacobian(evaluate(t, q, lam)), h_t(t, q, lam))
 
     times = np.asarray(times, dtype=float)
-    out = np.empty((len(times), len(y0)))
+    out = np.full((len(times), len(y0)), np.nan)
     ok = np.zeros(len(times), dtype=bool)
     out[0], ok[0] = y0, True
-    if len(times) > 1:
-        path = solve_ivp(rhs, (times[0], times[-1]), y0, method="DOP853", t_eval=times[1:],
-                         rtol=rtol, atol=atol)
-        found = path.y.T if path.success else np.full((len(times) - 1, len(y0)), np.nan)
-        for k, y in enumerate(found, start=1):
-            if np.isfinite(y).all():
-                out[k], ok[k] = newton(evaluate, float(times[k]), y, p, nq)
-            else:
-                out[k] = np.nan
-    return out, ok
+    if len(times) == 1:
+        return Followed(out, ok, None)
+    try:
+        solver = DOP853(rhs, times[0], y0, times[-1], rtol=rtol, atol=atol)
+    except np.linalg.LinAlgError:
+        return Followed(out, ok, Stop(float(times[0]), Stop.SINGULAR, y0))
+    k, steps = 1, 0
+    while k < len(times):
+        t, y = float(solver.t), solver.y
+        try:
+            solver.step()
+        except np.linalg.LinAlgError:
+            return Followed(out, ok, Stop(t, Stop.SINGULAR, y, steps))
+        if solver.status == "failed" or not np.isfinite(solver.y).all():
+            return Followed(out, ok, Stop(t, Stop.SINGULAR, y, steps))
+        steps += 1
+        if times[k] <= solver.t:
+            passed = np.searchsorted(times, solver.t, side="right")
+            for row, y in zip(range(k, passed), solver.dense_output()(times[k:passed]).T):
+                out[row], ok[row] = newton(evaluate, float(times[row]), y, p, nq)
+                if not ok[row]:
+                    out[row] = np.nan
+                    return Followed(out, ok, Stop(float(times[row]), Stop.NEWTON, y, steps))
+            k, steps = passed, 0
+        elif steps >= max_steps:
+            return Followed(out, ok, Stop(float(solver.t), Stop.WORK, solver.y, steps))
+    return Followed(out, ok, None)
 
 
 def step_by_step(evaluate: Evaluate, times: np.ndarray, y0: np.ndarray, p: int, nq: int):

@@ -3,6 +3,7 @@ local dimensions u moving away from their nominal u0 along a ramped cosine, the 
 clearance analysis follows. The other analyses ignore them (nominal dimensions)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,6 +19,10 @@ KEYS = ("anchor", "dx", "dy", "dangle", "w", "wx", "wy", "wangle", "tau")
 #: ω key, range, unit)
 COMPONENTS = (("x", "dx", "wx", limits.LENGTH, "m"), ("y", "dy", "wy", limits.LENGTH, "m"),
               ("angle", "dangle", "wangle", limits.ANGLE, "rad"))
+#: the most a variation's cos(ω t) may advance between two output rows, ω t_end/steps [rad]:
+#: at π the rows sample each period twice (the Nyquist limit); beyond it they alias the
+#: variation into a slower false one, and following it between rows is work for nothing
+PHASE_PER_STEP = math.pi
 
 
 def ramped_cosine(t, delta: float, omega: float, tau: float) -> tuple[np.ndarray, np.ndarray]:
@@ -225,6 +230,27 @@ class Variation:
                     f"'{key}', or vary a line" for key in ("dangle", "wangle")
                     if getattr(self, key) not in (None, 0, 0.0)]
         return out
+
+
+def pace_problems(variations: list[Variation], t_end: float, steps: int) -> \
+        list[tuple[str, str]]:
+    """(where, message) of every varied component whose ω t_end/steps, the phase its
+    cos(ω t) advances between two output rows, exceeds ``PHASE_PER_STEP``."""
+    out = []
+    for v in variations:
+        for name, delta, own, *_ in COMPONENTS:
+            omega = abs(v.omega(name))
+            if getattr(v, delta) == 0 or omega * t_end / steps <= PHASE_PER_STEP:
+                continue
+            key = own if getattr(v, own) is not None else "w"
+            out.append((v.where, (
+                f"'{key}' = {omega:g} rad/s is too fast for the output grid: {delta} turns "
+                f"by ω·t_end/steps = {omega * t_end / steps:.3g} rad between two rows "
+                f"(t_end = {t_end:g} s, steps = {steps}), and the rows cannot follow more "
+                f"than π ({PHASE_PER_STEP:.4g} rad, two rows per period): give steps ≥ "
+                f"{math.ceil(omega * t_end / PHASE_PER_STEP)}, a shorter t_end, or '{key}' "
+                f"≤ {PHASE_PER_STEP * steps / t_end:.4g} rad/s")))
+    return out
 
 
 def _kind(scope: Scope, anchor) -> str:

@@ -78,7 +78,7 @@ def minimised(t, start):
 def paths():
     times = np.linspace(0.0, 6.0, 61)
     y0 = np.r_[0.0, 0.0, X0, 0.0, 0.0, 0.0]
-    ode = ln.follow(circles, ln.time_rate(circles, 2), times, y0, 2, 2)
+    ode = ln.follow(circles, ln.time_rate(circles, 2), times, y0, 2, 2)[:2]
     newton = ln.step_by_step(circles, times, y0, 2, 2)
     return times, ode, newton
 
@@ -113,7 +113,8 @@ def test_with_no_variation_the_clearance_is_zero():
     times = np.linspace(0.0, 1.0, 11)
     y0 = np.r_[0.0, 0.0, X0, 0.0, 0.0, 0.0]
     fixed = lambda t, q, lam: circles(0.0, q, lam)          # noqa: E731
-    y, ok = ln.follow(fixed, ln.time_rate(fixed, 2), times, y0, 2, 2)
+    y, ok, stop = ln.follow(fixed, ln.time_rate(fixed, 2), times, y0, 2, 2)
+    assert stop is None
     assert ok.all() and np.max(np.abs(y[:, :2])) < 1e-14
     np.testing.assert_allclose(y[:, 2:4], np.tile(X0, (len(times), 1)), atol=1e-14)
 
@@ -134,3 +135,58 @@ def test_the_conditions_name_what_fails():
     assert found.ratio_ii <= ln.RANK and found.free.shape == (2, 1)
     np.testing.assert_allclose(c.Fq[0] @ found.free, 0.0, atol=1e-14)
     assert ln.applicability(c).self_stress.shape == (3, 0)   # none where (i) holds
+
+
+# ---- where the branch ends: a fold at t = 5, like a crank at its dead centre ----------------
+
+FOLD = 5.0
+C_FOLD = 0.3
+
+
+def fold(t, q, lam):
+    """F = (q² + t − 5, q + j − 0.3): the first row fixes q = √(5 − t) (no clearance),
+    which ends at t = 5 where F_q = 2q vanishes (a dead centre); W = 2 λ1."""
+    return ln.Closure(np.array([q[0] ** 2 + t - FOLD, q[0] - C_FOLD]),
+                      np.array([[2 * q[0]], [1.0]]), np.array([[0.0], [1.0]]),
+                      np.array([[2 * lam[0]]]))
+
+
+def test_follow_stops_where_the_branch_ends_and_keeps_the_rows_before():
+    """Issue 22, item 4: the branch q = √(5 − t), j = 0.3 − q ends at t = 5. ``follow``
+    stops within one output step of it and of where scipy's own solve_ivp (the old
+    integration) stops, and keeps every row before, equal to the closed form (before, a
+    failed integration made every row NaN)."""
+    from scipy.integrate import solve_ivp
+    times = np.linspace(0.0, 6.0, 25)                       # Δt = 0.25
+    y0 = np.array([C_FOLD - np.sqrt(FOLD), np.sqrt(FOLD), 0.0, 0.0])
+    h_t = ln.time_rate(fold, 1)
+    y, ok, stop = ln.follow(fold, h_t, times, y0, 1, 1)
+    # its steps shrink towards the fold: the work limit ends the crawl, 1.5e-8 s before it
+    assert stop is not None and stop.cause == ln.Stop.WORK
+    dt = times[1] - times[0]
+    assert FOLD - 1e-6 < stop.time < FOLD
+    kept = times < stop.time
+    assert ok[kept].all() and not ok[~kept].any() and np.isnan(y[~kept]).all()
+    assert kept.sum() == 20                                 # t = 0 … 4.75
+    np.testing.assert_allclose(y[kept, 1], np.sqrt(FOLD - times[kept]), atol=1e-12)
+    np.testing.assert_allclose(y[kept, 0], C_FOLD - np.sqrt(FOLD - times[kept]), atol=1e-12)
+
+    def rhs(t, y):
+        c = fold(t, y[1:2], y[2:])
+        return -np.linalg.solve(ln.lagrange_jacobian(c), h_t(t, y[1:2], y[2:]))
+    old = solve_ivp(rhs, (0.0, 6.0), y0, method="DOP853", rtol=1e-10, atol=1e-12)
+    assert not old.success and abs(old.t[-1] - stop.time) < dt
+
+
+def test_follow_bounds_its_work_per_output_step():
+    """Issue 22, item 6: a closure varying at 1e6 rad/s against output steps of 0.1 s
+    made the integration crawl for ever; ``follow`` now stops after ``max_steps`` steps in
+    one output interval (``Stop.WORK``), before the first row after t = 0."""
+    def fast(t, q, lam):
+        return ln.Closure(B @ q - c_of(t) - 1e-3 * np.cos(1e6 * t), B, A, np.zeros((2, 2)))
+    times = np.linspace(0.0, 1.0, 11)
+    y0 = np.r_[0.0, 0.0, linear_reference(0.0)[1], 0.0, 0.0, 0.0]
+    y, ok, stop = ln.follow(fast, ln.time_rate(fast, 2), times, y0, 2, 2, max_steps=50)
+    assert stop.cause == ln.Stop.WORK and stop.steps == 50
+    assert 0.0 < stop.time < times[1]
+    assert ok.tolist() == [True] + [False] * 10
