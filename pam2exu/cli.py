@@ -61,6 +61,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--at", nargs="+", type=float, metavar="T",
                      help="print every variable at these times [s], one block per solid and "
                           "element (between rows: the cubic spline of compare, said so)")
+    run.add_argument("--partial", action="store_true",
+                     help="if the run fails, write the rows computed before the failure to "
+                          "-o (the clearance analysis keeps them); the exit status stays 1")
     run.add_argument("--verbose", action="store_true", help="show Exudyn's solver output")
     run.add_argument("--plot", nargs="+", metavar="VAR",
                      help="plot these variables against t (names or patterns, as --outputs)")
@@ -227,12 +230,16 @@ def _picture_parsers(sub) -> None:
 
 def _run(args) -> int:
     from .analyses import run
+    from .errors import Problem
     from .model import load
     from .results.writers import check, write
     sep = "\t" if args.sep in ("tab", "\\t") else args.sep
     check_options(args)                          # nothing runs, nothing is written
     if args.output:                              # a bad file name fails before the run
         check(args.output, sep, args.decimal, args.bom)
+    elif args.partial:
+        raise ModelError(Problem("--partial", "it writes the rows kept before a failure to "
+                                              "the result file: give -o FILE.csv"))
     model = load(args.model)
     check_analysis_options(args, model)
     if args.at:                                  # times outside the run fail before it
@@ -247,9 +254,15 @@ def _run(args) -> int:
         # coupler.P.x); --outputs selects what is shown and written
         outputs = [*(["*"] if args.energy else []), *(outputs or ["*"]), *(args.plot or []),
                    *([args.x] if args.x else [])]
-    res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
-              outputs=outputs, solver=solver, backend=args.backend, angles=args.angles,
-              tolerance=args.tolerance)
+    try:
+        res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
+                  outputs=outputs, solver=solver, backend=args.backend, angles=args.angles,
+                  tolerance=args.tolerance)
+    except SolverError as exc:
+        if args.partial and args.output and exc.partial is not None:
+            path = write(exc.partial, args.output, sep, args.decimal, args.bom)
+            print(f"wrote the {len(exc.partial)} rows before the failure to {path}")
+        raise
     for w in res.warnings:                       # those not issued as they arose
         _WARNINGS.say(w)
     table = res.select(args.outputs) if args.outputs and (args.plot or args.energy) else res

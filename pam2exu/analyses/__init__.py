@@ -86,6 +86,10 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
                              f"results), got {echo(angles)}", job.mech.model.source)
         warn_input(job)
         return in_angles(ANALYSES[job.analysis].run(job), angles or job.mech.model.angles)
+    except SolverError as exc:       # the rows kept before it, in the run's angle unit
+        if exc.partial is not None:
+            exc.partial = in_angles(exc.partial, angles or job.mech.model.angles)
+        raise
     except Pam2ExuError:
         raise
     except Exception as exc:         # a fault of pam2exu: say what was being done
