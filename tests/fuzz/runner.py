@@ -94,7 +94,9 @@ EXTRA_FRACTION = 0.3
 EXTRA_RUNS = (["-o", "out.xlsx"], ["-o", "out.parquet"], ["--at", "0"], ["--at", "0.37", "0"],
               ["--at", "-1"], ["--at", "1e300"], ["--energy", "energy.png"],
               ["--angles", "deg"], ["--angles", "deg", "-o", "out.csv"],
-              ["--backend", "natural"], ["--backend", "natural", "-o", "out.csv"])
+              ["--backend", "natural"], ["--backend", "natural", "-o", "out.csv"],
+              ["-a", "clearance", "--t-end", str(CLEARANCE_T_END), "--steps", "10", "--partial",
+               "-o", "out.csv"])
 #: the options whose argument is a file the command line is asked to write
 WRITES = ("-o", "--energy", "--plot-file")
 #: fraction of the cases whose other analysis runs on the natural backend
@@ -415,6 +417,18 @@ def _cli(argv, scratch) -> bool:
     text = err.strip()
     if (code in (1, 2) and err.startswith("pam2exu: ") and "unexpected error" not in err
             and SELF_DECLARED not in err):
+        out = argv[argv.index("-o") + 1] if "-o" in argv else None
+        if "--partial" in argv and out and os.path.isfile(out):   # the rows before a failure
+            try:
+                back = pam2exu.read_csv(out)
+            except CaseTimeout:
+                raise
+            except BaseException as exc:     # noqa: BLE001
+                raise _Fault("csv", via, f"the --partial CSV does not read back: "
+                             f"{type(exc).__name__}: {_cut(exc)}", sub="partial")
+            if not np.isfinite(back.to_numpy()).all():
+                raise _Fault("non-finite", via, f"{out} (--partial) holds NaN/inf values",
+                             sub="partial csv")
         return False
     if "unexpected error" in err or SELF_DECLARED in err:
         _, _, exc = _cli_call(["--debug", *argv])       # locate it
