@@ -17,7 +17,7 @@ import warnings
 
 from . import __version__
 from .errors import ModelError, OutputError, Pam2ExuError, SolverError
-from .console import UsageError, Warnings, check_analysis_options, check_at, check_options
+from .console import UsageError, Warnings, checked_model, run_outputs
 from .registry import ANALYSES, BACKENDS, DEFAULT_BACKEND
 from .verify import BACKENDS_COMPARED, verify
 
@@ -230,33 +230,15 @@ def _picture_parsers(sub) -> None:
 
 def _run(args) -> int:
     from .analyses import run
-    from .errors import Problem
-    from .model import load
-    from .results.writers import check, write
+    from .results.writers import write
     sep = "\t" if args.sep in ("tab", "\\t") else args.sep
-    check_options(args)                          # nothing runs, nothing is written
-    if args.output:                              # a bad file name fails before the run
-        check(args.output, sep, args.decimal, args.bom)
-    elif args.partial:
-        raise ModelError(Problem("--partial", "it writes the rows kept before a failure to "
-                                              "the result file: give -o FILE.csv"))
-    model = load(args.model)
-    check_analysis_options(args, model)
-    if args.at:                                  # times outside the run fail before it
-        check_at(args, model)
+    model = checked_model(args, sep)             # nothing runs, nothing is written before
     backend = BACKENDS.get(args.backend or model.analysis.backend)
     # the backend's settings (an unknown name: run's model error names the known ones)
     solver = backend.create().Settings(verbose=1 if args.verbose else 0) if backend else None
-    outputs = args.outputs
-    if args.plot or args.energy:
-        # the plotted variables (and the x axis) are computed too, and the energy account's
-        # columns (the default ones, "*", to which a plot may add opt-in ones such as
-        # coupler.P.x); --outputs selects what is shown and written
-        outputs = [*(["*"] if args.energy else []), *(outputs or ["*"]), *(args.plot or []),
-                   *([args.x] if args.x else [])]
     try:
         res = run(model, analysis=args.analysis, t_end=args.t_end, steps=args.steps,
-                  outputs=outputs, solver=solver, backend=args.backend, angles=args.angles,
+                  outputs=run_outputs(args), solver=solver, backend=args.backend, angles=args.angles,
                   tolerance=args.tolerance)
     except SolverError as exc:
         if args.partial and args.output and exc.partial is not None:

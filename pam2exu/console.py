@@ -26,6 +26,9 @@ def check_options(args) -> None:
     if csv and not args.output:
         raise UsageError(f"{' and '.join(csv)} {'is' if len(csv) == 1 else 'are'} for the CSV "
                          f"file of -o: give -o OUT.csv, or drop {' and '.join(csv)}")
+    if args.partial and not args.output:
+        raise UsageError("--partial writes the rows kept before a failure to the result file "
+                         "of -o: give -o OUT.csv, or drop --partial")
     alone = [name for name, value in (("--x", args.x), ("--plot-file", args.plot_file))
              if value is not None]
     if alone and not args.plot:
@@ -38,6 +41,32 @@ def check_options(args) -> None:
                 image_format(path)
         except PictureError as exc:
             raise UsageError(f"{option}: {exc}") from None
+
+
+def checked_model(args, sep: str):
+    """``run``'s model, read after its options are checked and before anything runs: the
+    options that need one another, the output file (a bad name or suffix), then the options
+    the model's analysis does not use and the --at times outside its run."""
+    from .model import load
+    from .results.writers import check
+    check_options(args)
+    if args.output:
+        check(args.output, sep, args.decimal, args.bom)
+    model = load(args.model)
+    check_analysis_options(args, model)
+    if args.at:
+        check_at(args, model)
+    return model
+
+
+def run_outputs(args) -> list[str] | None:
+    """The columns ``run`` computes: --outputs, and with --plot or --energy also the plotted
+    variables (and the x axis) and the energy account's (the default ones, "*", to which a
+    plot may add opt-in ones such as coupler.P.x); --outputs then selects what is shown."""
+    if not (args.plot or args.energy):
+        return args.outputs
+    return [*(["*"] if args.energy else []), *(args.outputs or ["*"]), *(args.plot or []),
+            *([args.x] if args.x else [])]
 
 
 def check_analysis_options(args, model) -> None:

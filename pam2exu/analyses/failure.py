@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 from .. import registry
 from ..backend import Positions
 from ..errors import SolverError
-from . import loops, native
+from . import closest, loops, native
 
 if TYPE_CHECKING:                 # annotations only: job.py imports the checks, which import this
     from .job import Job
@@ -24,7 +24,7 @@ def position_failure(job: Job, found: Positions) -> SolverError:
     t = float(times[solved])
     start = q[solved - 1] if solved > 0 else found.last
     said = f"{job.backend.label} said: {found.error}"
-    left, _, _ = native.closest_violation(mech, t, start)
+    left, _, _ = closest.closest_violation(mech, t, start)
     # Newton aims at tolerance × L: what the closest configuration leaves above 1000 times
     # that cannot be closed
     can_hold = 1e3 * job.solver.tolerance * mech.scale()

@@ -373,7 +373,7 @@ def _poses(q, solids) -> dict[int, tuple[np.ndarray, float]]:
 #: the least squares' relative tolerance in ``first_open``: enough to tell a part that
 #: closes (to the solver's tolerance) from one that stays open by more than ``can_hold``
 VERDICT_TOL = 1e-10
-#: ``first_open``'s solves together may do this many times ``native.DIAGNOSIS_WORK`` (a
+#: ``first_open``'s solves together may do this many times ``closest.DIAGNOSIS_WORK`` (a
 #: guard against crawling along a flat valley only: the Watt six-bar of the tests takes
 #: 0.3 s for its three solves)
 OPEN_BUDGET = 4
@@ -385,13 +385,13 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
     structure does: from the fixed links and the actuators, add each time the smallest tie
     or loop that places its solids (Assur groups: the driven crank, then the four-bar's
     dyad, then the dyad hung on it …), solving what is built so far (least squares from
-    ``q_start``, all of them within ``OPEN_BUDGET`` times ``native.DIAGNOSIS_WORK``;
+    ``q_start``, all of them within ``OPEN_BUDGET`` times ``closest.DIAGNOSIS_WORK``;
     None when that work is spent). The first addition left violated by more than ``can_hold`` is the part
     that cannot close; its diagnosis names its ties less those of the loops that closed
     before it. None when every addition closes. ``worst``: the ties' violations at
     the closest configuration of the whole mechanism, to start the loop's text at the worst.
     """
-    from . import native
+    from . import closest, native
     from ..kinematics import State
 
     setters = [el for el in mech.constraints if el.drives or el.grounds]
@@ -401,7 +401,7 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
     units = _units(mech)
     q = np.array(q_start, dtype=float)
     by = _placers(mech, False)
-    budget = native.Budget(mech, OPEN_BUDGET)
+    budget = closest.Budget(mech, OPEN_BUDGET)
     while True:
         jac = native.equations(mech, State([t], q[None])).jacobian[0]
         choices = []
@@ -418,7 +418,7 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
             return None
         *_, unit, new = min(choices, key=lambda c: c[:3])
         keep = _mask(mech, [*setters, *built, *unit.ties])
-        left, found, converged = native.closest_violation(
+        left, found, converged = closest.closest_violation(
             mech, t, q, keep, budget, tol=VERDICT_TOL)
         if not converged:                # out of work: no verdict
             return None

@@ -27,9 +27,11 @@ def _model(model):
 
 def motion(model) -> str:
     """The run a picture of ``model`` over time shows: ``'dynamic'`` for a model whose
-    [analysis] type is dynamic (its free solids move under the loads), else
-    ``'kinematic'``."""
-    return "dynamic" if model.analysis.type == "dynamic" else "kinematic"
+    [analysis] integrates the motion (its free solids move under the loads; Catalan name
+    too), else ``'kinematic'``."""
+    from ..registry import analysis_type
+    kind = analysis_type(model.analysis.type)
+    return "dynamic" if kind is not None and kind.integrates else "kinematic"
 
 
 def configurations(model, t_end: float | None = None, steps: int | None = None,

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import pam2exu
-from pam2exu.analyses import checks, native
+from pam2exu.analyses import checks, closest, native
 from pam2exu.analyses import job as job_module
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -143,7 +143,7 @@ def test_a_solid_fixed_and_jointed_runs_with_minimum_norm_reactions():
 def test_the_diagnosis_of_a_failure_stops_when_its_work_is_done(monkeypatch):
     """The least-squares search behind "cannot be assembled" crawled for 24 s along the
     flat valley of a mechanism that cannot close (fuzz seeds 740, 944). Its work is
-    bounded (``native.DIAGNOSIS_WORK`` equations evaluated, not seconds, so that it says
+    bounded (``closest.DIAGNOSIS_WORK`` equations evaluated, not seconds, so that it says
     the same on a busy machine): with none left it stops at once and still gives its best
     configuration, and the diagnosis says the same thing."""
     model = pam2exu.load(EXAMPLES / "four_bar.toml")
@@ -156,7 +156,7 @@ def test_the_diagnosis_of_a_failure_stops_when_its_work_is_done(monkeypatch):
         calls.append(1)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(native, "DIAGNOSIS_WORK", 0)
+    monkeypatch.setattr(closest, "DIAGNOSIS_WORK", 0)
     monkeypatch.setattr(native, "equations", counted)
     with pytest.raises(pam2exu.SolverError, match=r"cannot be assembled .* the longest, "
                                                   r"ground.O4–ground.O2 0.4 m, is longer"):
