@@ -52,9 +52,11 @@ def extremes(res) -> list[Extreme]:
 
 
 def extremes_path(path: str | Path) -> Path:
-    """Where the extremes of the result CSV ``path`` go: ``run.csv`` -> ``run.extremes.csv``."""
+    """Where the extremes of the result file ``path`` go, as CSV: ``run.csv`` ->
+    ``run.extremes.csv`` (``run.xlsx`` and ``run.parquet`` too: before, a CSV was written
+    under the name ``run.extremes.xlsx``, fuzz seed 100072)."""
     path = Path(path)
-    return path.with_name(f"{path.stem}.extremes{path.suffix or '.csv'}")
+    return path.with_name(f"{path.stem}.extremes.csv")
 
 
 def write_extremes(res, path: str | Path) -> Path:

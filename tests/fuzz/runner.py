@@ -499,9 +499,10 @@ def run_case(seed: int, timeout: float | None = None, n_mutations: int | None = 
                 for flag in WRITES:
                     if flag in argv:
                         allowed.add(argv[argv.index(flag) + 1])
-                if "-o" in argv and argv[argv.index("-o") + 1].endswith(".csv"):
-                    # a clearance run's extremes, beside its CSV (shared/spec/clearance.md)
-                    allowed.add(argv[argv.index("-o") + 1][:-4] + ".extremes.csv")
+                if "-o" in argv and argv[0] == "run":
+                    # a clearance run's extremes, as CSV beside its result file
+                    allowed.add(os.path.splitext(argv[argv.index("-o") + 1])[0]
+                                + ".extremes.csv")
                 step = "pam2exu " + " ".join(argv)
                 outcome.successes += _cli(argv, scratch)
                 outcome.calls += 1

@@ -2,10 +2,13 @@
 natural backend, verify, export and plot), each failing before its fix; the seed of the
 campaign (``python -m tests.fuzz.runner --case SEED``) in each docstring."""
 import warnings
+from pathlib import Path
 
 import pytest
 
 import pam2exu
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 BACKENDS = ("exudyn", "natural")
 
@@ -88,3 +91,36 @@ def test_a_spring_between_pinned_points_ends_the_natural_dynamics():
         with pytest.raises(pam2exu.SolverError, match=r"points of spring 'k0' coincide"):
             pam2exu.run(m, analysis="dynamic", backend="natural", t_end=0.01, steps=2,
                         tolerance=1e-5)
+
+
+def test_two_points_of_a_solid_closer_than_round_off():
+    """Seed 107791: a point of a solid moved to within 5e-324 m of another: the natural
+    formulation took them as the solid's two base points and divided by |d|² = 0
+    (ZeroDivisionError); now it gives the solid a unit vector. The four-bar whose coupler's
+    B is moved onto A (the rocker then pinned to the crank's pin) assembles alike on both
+    backends."""
+    found = {}
+    for backend in BACKENDS:
+        model = pam2exu.load(EXAMPLES / "four_bar.toml")
+        model["coupler"].points["B"] = [0.0, 5e-324]        # A is at (0, 0)
+        res = pam2exu.run(model, analysis="assembly", backend=backend)
+        found[backend] = [float(res[f"{s}.fi"][0]) for s in ("crank", "coupler", "rocker")]
+    assert found["natural"] == pytest.approx(found["exudyn"], abs=1e-12)
+
+
+def test_verify_follows_one_branch_when_the_guess_lies_between_two():
+    """Seed 106649: the four-bar's coupler and rocker guesses moved far: Exudyn and the
+    natural backend assembled different branches and verify said DISAGREE on 6 angles,
+    which says nothing of the formulations. The second backend now starts from the first's
+    assembly, verify agrees and warns of the guess."""
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    for name, (x, y, fi) in {"coupler": (0.6934892387694876, -0.39594182695492774,
+                                         -0.05109058322711135),
+                             "rocker": (0.08348167902716186, -0.9589284421881887,
+                                        1.1727823118376355)}.items():
+        model[name].x, model[name].y, model[name].fi = x, y, fi
+    found = pam2exu.verify(model, analysis="kinematic", steps=20)
+    assert found.ok, found.verdict()
+    assert any("assembled different branches" in w for w in found.result.warnings)
+    # the reference is Exudyn's own run from the guess: its branch is the one followed
+    assert found.comparison["rocker.fi"].max_abs_error < 1e-9

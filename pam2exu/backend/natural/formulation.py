@@ -222,7 +222,10 @@ class Formulation:
         if len(own) >= 2:
             (s1, p1) = own[0]
             far = max(own[1:], key=lambda o: math.hypot(o[0][0] - s1[0], o[0][1] - s1[1]))
-            if math.hypot(far[0][0] - s1[0], far[0][1] - s1[1]) > 0:
+            size = max(1.0, *(abs(c) for loc, _ in own for c in loc))
+            # two basic points closer than round-off do not give the solid a direction
+            # (|d|² would underflow, fuzz seed 107791): its unit vector then
+            if math.hypot(far[0][0] - s1[0], far[0][1] - s1[1]) > 1e-9 * size:
                 d = (far[0][0] - s1[0], far[0][1] - s1[1])
                 return Frame(i, p1, far[1] - p1, s1, d)
         if own:
