@@ -16,7 +16,7 @@ from .mutants import KINDS, SOURCES, dumps, generate, mutant, source_doc
 #: the CI campaign: seeds CI_SEED … CI_SEED + CI_COUNT - 1 on 2 workers. Its verdict reads
 #: no clock: each case's work is bounded by the fast campaign's caps (mutants.py), and the
 #: runner's hang guard (runner.TIMEOUT, 600 s) only aborts a true hang
-CI_SEED, CI_COUNT = 0, 500
+CI_SEED, CI_COUNT = 0, 200
 LONG_COUNT = 10_000
 
 
