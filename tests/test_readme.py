@@ -62,9 +62,11 @@ def _workspace(tmp_path: Path) -> Path:
 
 
 #: the pages whose commands take longest (idle, 2 cores: performance.md's benchmarks 77 s,
-#: pictures.md's animations 63 s, clearance.md's runs 28 s, getting-started.md 25 s): run
+#: pictures.md's animations 63 s, clearance.md's runs 28 s, getting-started.md 25 s,
+#: compare.md 17 s, verify.md 13 s): run
 #: with --long, so that the test command stays within 8 minutes
-LONG_PAGES = ("performance.md", "pictures.md", "clearance.md", "getting-started.md")
+LONG_PAGES = ("performance.md", "pictures.md", "clearance.md", "getting-started.md",
+              "compare.md", "verify.md")
 SHELL_PAGES = [pytest.param(p, marks=pytest.mark.long) if p.name in LONG_PAGES else p
                for p in PAGES if _commands(p)]
 

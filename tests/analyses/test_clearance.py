@@ -280,6 +280,7 @@ def test_for_small_variations_the_clearance_is_its_first_order_estimate(request)
     assert 3.0 < gaps[1] / gaps[0] < 5.0                         # second order in Δ
 
 
+@pytest.mark.long          # 7 s idle on 2 cores
 def test_a_clearance_far_from_its_first_order_estimate_is_warned(request):
     """The contract's recommended warning: O2 moved by 20 % of the cranks' spacing, the
     clearance of A2 departs from its first-order estimate by more than half its maximum

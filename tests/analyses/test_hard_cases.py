@@ -693,7 +693,7 @@ LONG_RUN_PEAK = 256 * 2**20
 LONG_RUN_RSS = 512 * 2**20
 
 
-@pytest.mark.long(backends=("natural",))     # 24 s on natural, 8 s on Exudyn (2 cores)
+@pytest.mark.long      # 24 s on natural, 8 s on Exudyn (2 cores)
 def test_hundred_turns_in_100000_steps():
     """The example crank-rocker (a, b, c, d = 0.1, 0.35, 0.3, 0.4) turned 100 times at
     constant speed (θ = 200π t, 1 s) in 100,000 steps, kinematic. Required: crank.fi

@@ -73,7 +73,13 @@ def test_cp1252_mutant_is_not_utf8():
 
 # ------------------------------------------------------------------------- the runner
 
-@pytest.mark.parametrize("source", SOURCES)
+#: the clearance examples' unchanged runs take 5-6 s each (idle, 2 cores): with --long
+LONG_SOURCES = ("examples/clearance/locomotive.toml",
+                "examples/clearance/slider_guided_twice.toml")
+
+
+@pytest.mark.parametrize("source", [pytest.param(s, marks=pytest.mark.long)
+                                    if s in LONG_SOURCES else s for s in SOURCES])
 def test_unchanged_model_is_classified_success(source):
     outcome = runner.run_case(_seed_of(source), timeout=runner.TIMEOUT, n_mutations=0,
                               cli=True)
