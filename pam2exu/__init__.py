@@ -20,12 +20,13 @@ from .errors import (ConditionWarning, ConsistencyWarning, InputWarning, Redunda
                      VariationWarning)
 from .model import Law, Model, Solid, load, loads
 from .pictures import animate, draw
+from . import notebook  # noqa: F401  (registers the drawing of Model._repr_html_)
 from .results import CompareInputError, Comparison, Results, plot, read_csv
 from .results.compare import compare
 from .results.plot import PictureError
 from .verify import Verification, verify
+from .version import __version__
 
-__version__ = "0.1.0"
 
 
 def run(model, analysis=None, **settings):

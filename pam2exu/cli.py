@@ -15,11 +15,11 @@ import argparse
 import sys
 import warnings
 
-from . import __version__
 from .errors import ModelError, OutputError, Pam2ExuError, SolverError
 from .console import UsageError, Warnings, checked_model, run_outputs
 from .registry import ANALYSES, BACKENDS, DEFAULT_BACKEND
 from .verify import BACKENDS_COMPARED, verify
+from .version import __version__
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -213,7 +213,7 @@ def _analysis(model, analysis: str | None) -> str:
 
 def _header(mech, system, times, forces: bool, file: str) -> str:
     """Docstring, imports and the time grid."""
-    from . import __version__
+    from .version import __version__
     source = mech.model.source
     kind = ("masses, gravity, springs and loads included" if forces else
             "constraints only, as for kinematic positions")

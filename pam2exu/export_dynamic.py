@@ -225,10 +225,9 @@ def dynamic_script(model, t_end=None, steps=None, file: str = "script.py",
 
     Raises every error of ``run(model, analysis="dynamic")``.
     """
-    from .analyses.assembly import GUESS_STIFFNESS
     from .analyses.dynamic import motion, nearest_velocities, require_inertia
     from .analyses.job import check_mobility, prepare
-    from .analyses.positions import assemble
+    from .analyses.positions import GUESS_STIFFNESS, assemble
     from .backend.integrate import settings
     from .backend.script import ScriptSystem
 
@@ -254,7 +253,7 @@ def dynamic_script(model, t_end=None, steps=None, file: str = "script.py",
 
 
 def _header(mech, system, job, pieces: list, file: str) -> str:
-    from . import __version__
+    from .version import __version__
     from .backend.integrate import SPECTRAL_RADIUS
     source = str(mech.model.source or "")
     jumps = sum(1 for *_, at_break in pieces if at_break)

@@ -1,7 +1,9 @@
-"""How a ``Model`` shows itself in a Jupyter notebook: its solids and elements, and a drawing.
+"""How a ``Model`` shows itself in a Jupyter notebook: the drawing of its notebook view.
 
-``Model._repr_html_`` calls ``model_html`` through the registry's lazy ``resolve`` (the model
-package knows neither the analyses nor the pictures, which the drawing needs). A ``Results``
+The view itself (the head line, the solids, the elements) is the model's own
+(``pam2exu.model.describe.html``, which ``Model._repr_html_`` returns); the drawing needs the
+pictures and the analyses, above the model, so this module registers it there when the
+package is imported (``describe.register_drawing``): the import points down. A ``Results``
 table shows itself with ``results.writers.Exports._repr_html_``; an animation in a notebook
 is ``pictures.animate(model, html=True)``. docs/getting-started.md links the example
 notebook, examples/getting_started.ipynb.
@@ -13,6 +15,7 @@ import html
 import io
 
 from .errors import Pam2ExuError
+from .model import describe
 from .pictures import draw
 
 #: size of the drawing in a notebook [in] and its resolution [dots per inch]
@@ -27,27 +30,15 @@ def drawing_png(model) -> str:
     return base64.b64encode(out.getvalue()).decode("ascii")
 
 
-def model_html(model) -> str:
-    """The notebook view of a model: its head line, the solids, the elements (name, type,
-    anchors) and a drawing at t = 0, an <img> of base64 PNG; when the model cannot be drawn
-    (a problem in it, an assembly that fails), the message instead of the drawing."""
+def drawing_html(model) -> str:
+    """The drawing of a model's notebook view: an <img> of base64 PNG at t = 0, or, when the
+    model cannot be drawn (a problem in it, an assembly that fails), the message instead."""
     e = html.escape
-    a = model.analysis
-    head = (f"model '{e(model.name)}'" + (f" ({e(str(model.source))})" if model.source else "")
-            + f": {len(model.solids)} solids, {len(model.elements)} elements, gravity "
-              f"{model.gravity:g} m/s², {e(a.type)} analysis, t = 0 … {a.t_end:g} s in "
-              f"{a.steps} steps")
-    rows = ["<tr><th>name</th><th>type</th><th>anchors (a solid: its points)</th></tr>"]
-    for s in model.solids:
-        points = ", ".join(s.points)
-        rows.append(f"<tr><td>{e(s.name)}</td><td>solid</td><td>{e(points)}</td></tr>")
-    for el in model.elements:
-        anchors = ", ".join(str(getattr(el, f"anc{k + 1}")) for k in range(len(el.anchors)))
-        rows.append(f"<tr><td>{e(el.name)}</td><td>{e(el.type)}</td><td>{e(anchors)}</td></tr>")
     try:
-        picture = (f"<img alt='{e(model.name)} at t = 0' "
-                   f"src='data:image/png;base64,{drawing_png(model)}'/>")
+        return (f"<img alt='{e(model.name)} at t = 0' "
+                f"src='data:image/png;base64,{drawing_png(model)}'/>")
     except Pam2ExuError as exc:
-        picture = f"<p>no drawing: {e(str(exc))}</p>"
-    return (f"<div class='pam2exu-model'><p><b>{head}</b></p>"
-            f"<table>{''.join(rows)}</table>\n{picture}</div>")
+        return f"<p>no drawing: {e(str(exc))}</p>"
+
+
+describe.register_drawing(drawing_html)

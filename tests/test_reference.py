@@ -17,7 +17,7 @@ from pam2exu import reference
 from pam2exu.model.solid import SOLID_OUTPUTS
 from pam2exu.elements import ACCELERATION, ALIASES, CLEARANCE, ELEMENTS, FORCE, POSITION, VELOCITY
 from pam2exu.laws import LAW_ALIASES, LAWS
-from pam2exu.model.model import Analysis
+from pam2exu.model.analysis import Analysis
 from pam2exu.model.solid import Solid
 from pam2exu.registry import ANALYSES
 

@@ -2,10 +2,7 @@
 from __future__ import annotations
 
 from .job import Job, check_mobility, collect
-from .positions import positions
-
-#: stiffness tying each coordinate to its guess when degrees of freedom are free [N/m]
-GUESS_STIFFNESS = 1.0
+from .positions import GUESS_STIFFNESS, positions
 
 
 def assembly(job: Job):

@@ -20,12 +20,11 @@ import numpy as np
 from ..errors import MobilityError, ModelError, SolverError
 from ..kinematics import PER_SOLID, State
 from ..model.solid import LineRef
-from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect
 from .least_norm import (RANK, Applicability, Closure, Stop, applicability, follow,
                          lagrange_jacobian, split, time_rate)
 from .native import target_values
-from .positions import assemble
+from .positions import GUESS_STIFFNESS, assemble
 
 
 def clearance(job: Job):

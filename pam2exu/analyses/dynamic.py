@@ -30,10 +30,9 @@ import numpy as np
 from ..errors import InputWarning, ModelError, SolverError
 from ..kinematics import State, pose
 from . import force_pass, free, native
-from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect, warn
 from .kinetostatic import kinetostatic
-from .positions import assemble, check_residual
+from .positions import GUESS_STIFFNESS, assemble, check_residual
 
 #: the coarsest run takes at least this many steps over the interval
 FIRST_STEPS = 64

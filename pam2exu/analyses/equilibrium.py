@@ -21,9 +21,8 @@ from ..errors import ModelError
 from ..kinematics import State
 from ..registry import BACKENDS, resolve
 from . import force_pass, free
-from .assembly import GUESS_STIFFNESS
 from .job import Job, check_mobility, collect, warn
-from .positions import assemble, check_residual
+from .positions import GUESS_STIFFNESS, assemble, check_residual
 from .quasi_static import quasi_static
 
 #: an eigenvalue of the reduced stiffness at most this fraction of the largest stiffness

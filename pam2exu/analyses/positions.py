@@ -20,6 +20,10 @@ from .job import Job, warn_redundant
 #: each part costs a new Exudyn system, about 0.2 s, so parts are not made smaller)
 PART_STEPS = 50_000
 
+#: stiffness tying each coordinate to its guess when degrees of freedom are free, so that
+#: ``assemble`` finds the assembly nearest to the guess [N/m]
+GUESS_STIFFNESS = 1.0
+
 
 def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
               check: bool = True, partial: bool = False):

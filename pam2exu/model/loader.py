@@ -7,7 +7,8 @@ from pathlib import Path
 from ..elements import ALIASES, ELEMENTS, misplaced_clearance
 from ..errors import ModelError, Problem, closest, echo
 from ..limits import shown
-from .model import Analysis, Model
+from .analysis import Analysis
+from .model import Model
 from .solid import Solid
 from .variation import KEYS as _VARIATION_KEYS
 from .variation import Variation

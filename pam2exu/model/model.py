@@ -1,125 +1,24 @@
-"""The model: solids, elements and analysis settings, built in Python or loaded from TOML.
+"""The model: the container of solids, elements, variations and analysis settings, built in
+Python or loaded from TOML.
 
-``Model.problems()`` collects every problem before any numerics; ``Model.mechanism()``
-returns the validated, resolved form the translation and the analyses work on.
+``Model.problems()`` collects every problem before any numerics (``problems.py``);
+``Model.mechanism()`` returns the validated, resolved form the translation and the analyses
+work on (``mechanism.py``); the settings are ``analysis.py``'s ``Analysis``, and how a model
+shows itself is ``describe.py``.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import fields
 
-from .. import limits, registry
 from ..elements import ALIASES, ELEMENTS, Element, misplaced_clearance
-from ..errors import ModelError, Problem, VariationWarning, closest, echo, warn_outside
-from ..limits import is_number as _number
-from .angles import angles_problem
+from ..errors import ModelError, Problem, VariationWarning, closest, warn_outside
+from . import describe
+from .analysis import Analysis
 from .mechanism import Mechanism
-from .solid import Scope, Solid, solid_problems
+from .problems import model_problems, model_warnings
+from .solid import Solid
 from .variation import KEYS as VARIATION_KEYS
-from .variation import Variation, variation_problems
-
-#: the loosest integration tolerance of the dynamic analysis (its error per unit of value)
-MAX_TOLERANCE = 1e-2
-
-
-@dataclass
-class Analysis:
-    """What to run: ``type``, the interval [0, ``t_end``] in ``steps`` intervals, ``outputs``.
-
-    The ``[analysis]`` table of a model file, ``Model.analysis`` in Python: the defaults of
-    ``run``, whose arguments override them for one run. Values are checked by
-    ``problems`` (called by ``Model.problems`` and by ``run``), not here.
-
-    Parameters
-    ----------
-    type : str
-        ``'assembly'``, ``'quasi_static'``, ``'kinematic'`` or ``'kinetostatic'``
-        (``pam2exu.registry.ANALYSES``); PAM's Catalan names (``'ensamblatge'``,
-        ``'quasi_estatica'``, ``'cinematica'``, ``'cinetostatica'``) are read as these.
-    t_end : float
-        End of the interval [0, t_end] [s], > 0 (not used by an assembly, which solves
-        t = 0 only).
-    steps : int
-        Number of intervals, ≥ 1: results have steps + 1 rows at t_k = k t_end / steps.
-    outputs : list of str, optional
-        Names or patterns of the columns to compute and keep (``crank.fi``, ``crank.*``,
-        ``*.Fx`` or a bare ``Fx``); None keeps every column of the analysis.
-    backend : str
-        What solves the positions: ``'exudyn'`` (the default; ``pam2exu.registry.BACKENDS``
-        lists the backends).
-    tolerance : float
-        Accuracy required of the ``dynamic`` analysis's time integration: its error at
-        most tolerance · (1 + |value|) on every coordinate and rate, SI units;
-        0 < tolerance ≤ 1e-2 [-]. Other analyses ignore it.
-
-    Examples
-    --------
-    >>> Analysis("kinematic", t_end=0.0, steps=10).problems()
-    ['t_end must be a positive number of seconds, got 0.0']
-    """
-
-    type: str = "kinematic"
-    t_end: float = 1.0
-    steps: int = 100
-    outputs: list[str] | None = None
-    backend: str = registry.DEFAULT_BACKEND
-    tolerance: float = 1e-8
-
-    #: keys beyond the contract's [analysis] table (docs/model-format.md says so)
-    EXTENSIONS = ("backend", "tolerance")
-
-    def __post_init__(self):
-        self._canonical_type()
-
-    def _canonical_type(self) -> None:
-        """A Catalan analysis name becomes the contract's."""
-        kind = registry.analysis_type(self.type) if isinstance(self.type, str) else None
-        if kind is not None:
-            self.type = kind.name
-
-    def problems(self) -> list[str]:
-        """What is wrong with these settings, one message each (empty when they are sound).
-
-        Returns
-        -------
-        list of str
-            Messages without a place (``Model.problems`` puts them under
-            ``"[analysis]"``).
-        """
-        out = []
-        self._canonical_type()
-        if not isinstance(self.type, str) or self.type not in registry.ANALYSES:
-            names = list(registry.ANALYSES)
-            aliases = [a.alias for a in registry.ANALYSES.values()]
-            out.append(f"unknown analysis type {echo(self.type)}"
-                       f"{closest(str(self.type), names + aliases)}; known types: "
-                       f"{', '.join(names)} (Catalan: {', '.join(aliases)})")
-        if not isinstance(self.backend, str) or self.backend not in registry.BACKENDS:
-            names = list(registry.BACKENDS)
-            out.append(f"unknown backend {echo(self.backend)}{closest(str(self.backend), names)}; "
-                       f"known backends: {', '.join(names)}")
-        low, high = limits.T_END
-        if not _number(self.t_end) or self.t_end <= 0:
-            out.append(f"t_end must be a positive number of seconds, got {echo(self.t_end)}")
-        elif not low <= self.t_end <= high:
-            out.append(f"t_end = {self.t_end:g} s is out of range: it must lie between "
-                       f"{low:g} s and {high:g} s")
-        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
-            out.append(f"steps must be a positive whole number, got {echo(self.steps)}")
-        elif self.steps > limits.SOLVE_STEPS:
-            out.append(f"steps = {self.steps} is more than pam2exu runs: one run solves the "
-                       f"positions at most {limits.SOLVE_STEPS:,} times, once a step at least. "
-                       "Use fewer steps (every row is exact, whatever the step), or split "
-                       "the interval into several runs, each over a shorter t_end")
-        if self.outputs is not None and (
-                not isinstance(self.outputs, (list, tuple))
-                or not all(isinstance(o, str) for o in self.outputs)):
-
-            out.append("outputs must be a list of names or patterns, e.g. [\"crank.*\", \"Fx\"]")
-        if not _number(self.tolerance) or not 0 < self.tolerance <= MAX_TOLERANCE:
-            out.append(f"tolerance must be a number in (0, {MAX_TOLERANCE:g}], the error "
-                       f"allowed per unit of a coordinate or rate, got {echo(self.tolerance)}")
-        return out
-
+from .variation import Variation
 
 class Model:
     """A PAM model: solids, elements and the analysis to run.
@@ -362,10 +261,10 @@ class Model:
         return variation
 
     def __repr__(self) -> str:       # one line: name, file, counts, analysis (describe.py)
-        return registry.resolve("pam2exu.model.describe:one_line")(self)
+        return describe.one_line(self)
 
-    def _repr_html_(self) -> str:    # in a notebook (pam2exu.notebook: needs the analyses)
-        return registry.resolve("pam2exu.notebook:model_html")(self)
+    def _repr_html_(self) -> str:    # IPython's HTML form: solids, elements, drawing (describe.py)
+        return describe.html(self)
 
     def __getitem__(self, name: str) -> Solid | Element:
         """The solid or element named ``name``; KeyError (suggesting the nearest) if none."""
@@ -400,36 +299,7 @@ class Model:
         [model]: gravity is the magnitude along −y, a number ≥ 0; got -9.81
         [[solid]] #1 'crank': mass is negative (-1.0): it must be ≥ 0
         """
-        out: list[Problem] = []
-        if not _number(self.gravity) or self.gravity < 0:
-            out.append(Problem("[model]", f"gravity is the magnitude along −y, a number ≥ 0; "
-                                          f"got {echo(self.gravity)}"))
-        elif self.gravity > limits.VALUE:
-            out.append(Problem("[model]", f"gravity = {self.gravity:g} m/s² is out of range "
-                                          f"(at most {limits.VALUE:g})"))
-        if angles_problem(self.angles):
-            out.append(Problem("[model]", angles_problem(self.angles)))
-        if not isinstance(self.name, str):
-            out.append(Problem("[model]", f"name must be a string, got {echo(self.name)}"))
-        elif len(self.name) > limits.MODEL_NAME:
-            out.append(Problem("[model]", f"name is {len(self.name)} characters long: at most "
-                                          f"{limits.MODEL_NAME} are allowed"))
-        seen: dict[str, str] = {}
-        for solid in self.solids:
-            out += [Problem(solid.where, m)
-                    for m in solid_problems(solid, degrees=self.angles == "deg")]
-            _unique(solid.name, solid.where, seen, out)
-        scope = Scope(self.solids)
-        scope.elements = self.elements
-        for el in self.elements:
-            _unique(el.name, el.where, seen, out)
-            out += [Problem(el.where, m) for m in el.problems(scope)]
-        out += [Problem(*p) for p in variation_problems(self.variations, scope,
-                                                         self.elements)[0]]
-        out += [Problem("[analysis]", m) for m in self.analysis.problems()]
-        if not self.solids:
-            out.append(Problem("model", "there are no solids: add at least one [[solid]]"))
-        return out
+        return model_problems(self)
 
     def validate(self) -> None:
         """Raise ModelError listing every problem, if there is any; else issue ``warnings()``.
@@ -458,9 +328,7 @@ class Model:
             Each with ``where`` (``"[[variation]] #1 (anchor 'ground.O2')"``) and
             ``message``; ``validate`` issues them as ``VariationWarning``.
         """
-        scope = Scope(self.solids)
-        return [Problem(*p) for p in variation_problems(self.variations, scope,
-                                                         self.elements)[1]]
+        return model_warnings(self)
 
     def issue_warnings(self) -> None:
         """Issue each of ``warnings()`` not issued yet for this model (VariationWarning)."""
@@ -486,15 +354,3 @@ class Model:
         self.validate()
         return Mechanism(self)
 
-
-def _unique(name, where, seen, out):
-    problem = limits.name_problem(name)
-    if problem:
-        out.append(Problem(where, problem))
-        if not isinstance(name, str) or len(name) > limits.NAME:
-            return
-    if name in seen:
-        out.append(Problem(where, f"name '{name}' is already used by {seen[name]}: "
-                                  "solids and elements share one namespace, rename one of them"))
-    else:
-        seen[name] = where
