@@ -52,27 +52,73 @@ def _target(module: str, node: ast.ImportFrom | ast.Import, is_package: bool) ->
     return sorted(out - {module} - ancestors)
 
 
-def _imports(module: str) -> tuple[set[str], set[str]]:
-    """(module-level, function-level) pam2exu imports of a module; ``if TYPE_CHECKING:``
-    blocks (annotations only, never run) are left out."""
+def _imports(module: str) -> tuple[set[str], set[str], set[str]]:
+    """(module-level, lazy, annotation) pam2exu dependencies of a module: its imports at
+    module level; its imports inside functions and the modules its ``'pam2exu.module:name'``
+    strings name (the registry's declarations, ``registry.resolve``: imported when first
+    used); and its ``if TYPE_CHECKING:`` imports (never run, but documented dependencies)."""
     path = MODULES[module]
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    top, inner = set(), set()
+    top, inner, typing = set(), set(), set()
 
-    def visit(node, in_function):
+    def visit(node, in_function, in_typing):
         if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-            return
+            in_typing = True
         if isinstance(node, (ast.Import, ast.ImportFrom)):
-            (inner if in_function else top).update(
+            (typing if in_typing else inner if in_function else top).update(
                 _target(module, node, path.name == "__init__.py"))
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            inner.update(_named_module(node.value))
         for child in ast.iter_child_nodes(node):
             visit(child, in_function or isinstance(node, (ast.FunctionDef,
-                                                          ast.AsyncFunctionDef, ast.Lambda)))
-    visit(tree, False)
-    return top, inner
+                                                          ast.AsyncFunctionDef, ast.Lambda)),
+                  in_typing)
+    visit(tree, False, False)
+    return top, inner, typing
+
+
+def _named_module(text: str) -> set[str]:
+    """The module a ``'pam2exu.module:attribute'`` string names (``registry.resolve``)."""
+    found = re.fullmatch(r"(pam2exu(?:\.\w+)*):\w+", text)
+    return {found.group(1)} if found else set()
+
+
+def _face_imports(module: str) -> list[str]:
+    """The names a module imports from the package face ``pam2exu`` (its ``__init__``)
+    that are no submodule: ``from pam2exu import run``, ``from . import __version__``."""
+    path = MODULES[module]
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            base = module if path.name == "__init__.py" else module.rpartition(".")[0]
+            for _ in range(node.level - 1):
+                base = base.rpartition(".")[0]
+            source = ((f"{base}.{node.module}" if node.module else base) if node.level
+                      else node.module)
+            out += [a.name for a in node.names
+                    if source == "pam2exu" and f"pam2exu.{a.name}" not in MODULES]
+    return out
 
 
 GRAPH = {m: _imports(m) for m in MODULES}
+
+#: the registry's doors: its declarations name the analyses' functions and the backends'
+#: classes as strings (imported when first used), while the model and the analyses read its
+#: tables; these edges, and only these, may close a loop
+PLUG_INS = ("pam2exu.analyses.", "pam2exu.backend.")
+REGISTRY = "pam2exu.registry"
+
+#: what the model layer must not know (docs/architecture.md: nothing imports upwards)
+ABOVE_THE_MODEL = ("pam2exu.analyses", "pam2exu.backend", "pam2exu.results",
+                   "pam2exu.pictures", "pam2exu.notebook", "pam2exu.cli", "pam2exu.console",
+                   "pam2exu.export", "pam2exu.export_dynamic", "pam2exu.verify")
+
+
+def _lazy_graph(graph) -> dict[str, set[str]]:
+    """Every dependency (module level, lazy, annotations) but the registry's plug-in doors."""
+    return {m: top | inner | typing if m != REGISTRY else
+            top | typing | {n for n in inner if not n.startswith(PLUG_INS)}
+            for m, (top, inner, typing) in graph.items()}
 
 
 def _cycle(edges: dict[str, set[str]]) -> list[str] | None:
@@ -103,22 +149,71 @@ def _cycle(edges: dict[str, set[str]]) -> list[str] | None:
 
 def test_the_walker_finds_imports_and_cycles():
     """The walker itself: the package's own imports are seen, and a cycle is found."""
-    top, _ = GRAPH["pam2exu.analyses.job"]
+    top, _, _ = GRAPH["pam2exu.analyses.job"]
     assert {"pam2exu.registry", "pam2exu.backend", "pam2exu.model", "pam2exu.model.solid",
-            "pam2exu.analyses.checks"} <= top
+            "pam2exu.analyses.grid"} <= top
     assert _cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert _cycle({"a": {"b"}, "b": {"c"}}) is None
 
 
+def test_the_walker_sees_annotations_and_the_registry_strings():
+    """``if TYPE_CHECKING:`` imports and ``'pam2exu.module:name'`` strings are edges: the
+    registry's into the analyses and the backends, the analyses' annotations of the Job."""
+    _, inner, _ = GRAPH[REGISTRY]
+    assert {"pam2exu.analyses.kinematic", "pam2exu.analyses.dynamic",
+            "pam2exu.backend.natural"} <= inner
+    tree = ast.parse("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
+                     "    from pam2exu.analyses.job import Job\n"
+                     "F = 'pam2exu.notebook:drawing_html'")
+    typing = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module.startswith("pam2exu"):
+            typing |= set(_target("pam2exu.model.model", node, False))
+    assert "pam2exu.analyses.job" in typing
+    assert _named_module("pam2exu.notebook:drawing_html") == {"pam2exu.notebook"}
+
+
 def test_the_import_graph_has_no_cycle():
     """Module-level imports, with every package's __init__, form no cycle."""
-    assert _cycle({m: top for m, (top, _) in GRAPH.items()}) is None
+    assert _cycle({m: top for m, (top, _, _) in GRAPH.items()}) is None
+
+
+def test_the_annotations_form_no_cycle():
+    """``if TYPE_CHECKING:`` imports (annotations only) are dependencies too: with the
+    module-level imports they form no cycle."""
+    assert _cycle({m: top | typing for m, (top, _, typing) in GRAPH.items()}) is None
 
 
 def test_no_import_inside_a_function_dodges_a_cycle():
     """Imports of pam2exu modules inside functions (kept lazy so that ``import pam2exu``
-    loads neither Exudyn nor matplotlib) would form no cycle at module level either."""
-    assert _cycle({m: top | inner for m, (top, inner) in GRAPH.items()}) is None
+    loads neither Exudyn nor matplotlib) and ``'module:name'`` strings would form no cycle
+    at module level either: only the registry's doors into its plug-ins may close a loop."""
+    assert _cycle(_lazy_graph(GRAPH)) is None
+
+
+def test_the_registry_strings_point_only_into_its_plug_ins():
+    """The registry's ``'module:name'`` strings name existing modules of the analyses and
+    the backends, nothing above them (the command, the pictures, the notebook)."""
+    text = MODULES[REGISTRY].read_text(encoding="utf-8")
+    named = set(re.findall(r"[\"'](pam2exu(?:\.\w+)+):\w+[\"']", text))
+    assert named and sorted(named - set(MODULES)) == []
+    assert sorted(n for n in named if not n.startswith(PLUG_INS)) == []
+
+
+def test_the_model_layer_knows_nothing_above_it():
+    """No module of ``pam2exu.model`` depends, in any way (imports at module level, in
+    functions, annotations, ``'module:name'`` strings), on the analyses, the backends, the
+    results, the pictures, the notebook or the commands."""
+    up = {m: sorted(n for n in top | inner | typing if n.startswith(ABOVE_THE_MODEL))
+          for m, (top, inner, typing) in GRAPH.items() if m.startswith("pam2exu.model")}
+    assert {m: n for m, n in up.items() if n} == {}
+
+
+def test_no_module_imports_from_the_package_face():
+    """The package face (``pam2exu/__init__.py``) only re-exports: no module of the package
+    imports a name from it (``__version__`` is ``pam2exu.version``'s)."""
+    found = {m: names for m in MODULES if m != "pam2exu" and (names := _face_imports(m))}
+    assert found == {}
 
 
 def test_no_module_is_longer_than_500_lines():

@@ -1,18 +1,14 @@
-"""The self-checks after the numerics: pam2exu's constraints hold at the backend's
-positions, and no result is NaN or infinite."""
+"""The self-check after the numerics: pam2exu's constraints hold at the backend's positions
+(that no result is NaN or infinite is the last guard of the table, ``job.check_finite``)."""
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..backend import Positions
-from ..errors import SolverError, TranslationError
+from ..errors import TranslationError
 from . import native
 from .failure import position_failure
-
-if TYPE_CHECKING:                 # annotations only: job.py imports this module
-    from .job import Job
+from .job import Job
 
 
 #: constraint residual above this (× the length scale) means a wrong translation
@@ -56,21 +52,3 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
             f"equations of element {name} by {value:.3g} (tolerance {tol:.1g}): the translation "
             f"of this element for {label} is wrong. Please report it with the model file.")
 
-
-def check_finite(job: Job, t: np.ndarray, values: dict[str, np.ndarray]) -> None:
-    """SolverError when a column has a value that is not finite (NaN, ±inf)."""
-    bad = {name: np.nonzero(~np.isfinite(v))[0] for name, v in values.items()}
-    bad = {name: rows for name, rows in bad.items() if rows.size}
-    if not bad:
-        return
-    k = min(int(rows[0]) for rows in bad.values())
-    names = [name for name, rows in bad.items() if rows[0] == k]
-    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
-    raise SolverError(
-        f"the {job.analysis} analysis gave values that are not numbers (NaN or infinite) "
-        f"first at t = {t[k]:.6g} s (row {k}), in {shown}"
-        + (f"; {len(bad)} columns in all" if len(bad) > len(names) else "")
-        + ". The mechanism is at or near a position where these are not defined (a "
-          "singular position, two points of an element that coincide): end the interval "
-          "before this time, or change the model so it avoids that position.",
-        time=float(t[k]), step=k)

@@ -2,15 +2,11 @@
 the constraints that contradict each other, the dead point, or Newton's divergence."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from .. import registry
 from ..backend import Positions
 from ..errors import SolverError
 from . import closest, loops, native
-
-if TYPE_CHECKING:                 # annotations only: job.py imports the checks, which import this
-    from .job import Job
+from .job import Job
 
 
 def position_failure(job: Job, found: Positions) -> SolverError:

@@ -10,7 +10,8 @@ import numpy as np
 from .. import points, registry
 from ..backend import Backend
 from ..elements import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY, Var
-from ..errors import InputWarning, ModelError, Problem, RedundancyWarning, warn_outside
+from ..errors import (InputWarning, ModelError, Problem, RedundancyWarning, SolverError,
+                      warn_outside)
 from ..kinematics import State, column
 from ..model import Model, load
 from ..model.mistakes import input_warnings
@@ -19,7 +20,6 @@ from ..model.variation import pace_problems
 from ..results import Results, select_columns
 from ..results.info import RunInfo
 from . import grid, native
-from .checks import check_finite
 
 
 @dataclass
@@ -219,3 +219,22 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
         check_finite(job, t, {k: v for k, v in values.items()
                               if k.rpartition(".")[2] not in ("ICx", "ICy")})
     return res
+
+
+def check_finite(job: Job, t: np.ndarray, values: dict[str, np.ndarray]) -> None:
+    """SolverError when a column has a value that is not finite (NaN, ±inf)."""
+    bad = {name: np.nonzero(~np.isfinite(v))[0] for name, v in values.items()}
+    bad = {name: rows for name, rows in bad.items() if rows.size}
+    if not bad:
+        return
+    k = min(int(rows[0]) for rows in bad.values())
+    names = [name for name, rows in bad.items() if rows[0] == k]
+    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    raise SolverError(
+        f"the {job.analysis} analysis gave values that are not numbers (NaN or infinite) "
+        f"first at t = {t[k]:.6g} s (row {k}), in {shown}"
+        + (f"; {len(bad)} columns in all" if len(bad) > len(names) else "")
+        + ". The mechanism is at or near a position where these are not defined (a "
+          "singular position, two points of an element that coincide): end the interval "
+          "before this time, or change the model so it avoids that position.",
+        time=float(t[k]), step=k)

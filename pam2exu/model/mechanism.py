@@ -3,8 +3,7 @@ analyses work on (``Model.mechanism()`` makes it)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from ..elements import Element
 from ..kinematics import PER_SOLID
@@ -12,8 +11,18 @@ from .angles import si_inputs
 from .solid import Scope, Solid
 from .variation import Variation
 
-if TYPE_CHECKING:                      # the annotation only: model.py imports this module
-    from .model import Model
+
+class ModelLike(Protocol):
+    """What a mechanism reads of the model it is made from: a ``Model``, which makes
+    mechanisms (``Model.mechanism``), so this module does not import it."""
+
+    name: str
+    gravity: float
+    source: str | None
+    angles: str
+    solids: list[Solid]
+    elements: list[Element]
+    variations: list[Variation]
 
 
 @dataclass
@@ -51,7 +60,7 @@ class Mechanism:
         ``nominal``, ``offsets(t)``); read by the clearance analysis only.
     """
 
-    model: Model
+    model: ModelLike
     solids: list[Solid] = field(init=False)
     elements: list[Element] = field(init=False)
 

@@ -39,7 +39,7 @@ def test_a_spring_whose_points_coincide_is_a_solver_error_naming_it_and_the_time
 
 
 def test_a_non_finite_value_is_never_a_result(monkeypatch):
-    """The last guard (checks.check_finite): whatever produced it, a NaN in a column is a
+    """The last guard (job.check_finite): whatever produced it, a NaN in a column is a
     SolverError naming the column and the first time, not a result."""
     from pam2exu.elements import Spring
 
@@ -65,8 +65,8 @@ def test_check_finite_names_every_column_of_the_first_bad_row():
               "c.z": np.array([0, 1, 2, np.nan, 4.0]), "d.w": np.arange(5.0)}
     with pytest.raises(pam2exu.SolverError, match=r"first at t = 0.5 s \(row 2\), in a.x, b.y; "
                                                   r"3 columns in all"):
-        checks.check_finite(job, t, values)
-    checks.check_finite(job, t, {"d.w": np.arange(5.0)})        # nothing to say
+        job_module.check_finite(job, t, values)
+    job_module.check_finite(job, t, {"d.w": np.arange(5.0)})        # nothing to say
 
 
 def test_a_foreign_exception_becomes_a_solver_error_saying_what_was_done(monkeypatch):
