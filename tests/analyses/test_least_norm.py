@@ -190,3 +190,18 @@ def test_follow_bounds_its_work_per_output_step():
     assert stop.cause == ln.Stop.WORK and stop.steps == 50
     assert 0.0 < stop.time < times[1]
     assert ok.tolist() == [True] + [False] * 10
+
+
+@pytest.mark.parametrize("ratio, holds", [(2e-9, True), (1e-6, True), (5e-10, False)])
+def test_a_condition_fails_at_the_contracts_rank_ratio_1e_9(ratio, holds):
+    """The contract (docs/clearance.md, 'conditions of applicability'): (ii) fails when
+    σ_min/σ_max of F_q is ≤ 1e-9, and not above. F_q = diag(1, ratio) has exactly that
+    ratio; F_j = (0, 1)ᵀ and W = I keep (i) (σ 1 and √(1 + ratio²)) and the reduced
+    Hessian (1) away from it: (ii) decides alone."""
+    c = ln.Closure(np.zeros(2), np.diag([1.0, ratio]), np.array([[0.0], [1.0]]), np.eye(2))
+    found = ln.applicability(c)
+    assert found.ratio_ii == pytest.approx(ratio, rel=1e-12)
+    assert found.ratio_i == pytest.approx(1.0, abs=1e-12)
+    assert found.hessian == pytest.approx(1.0, abs=1e-12)
+    assert bool(found.holds) is holds
+    assert found.free.shape[1] == (0 if holds else 1)
