@@ -255,3 +255,26 @@ def test_a_fixed_solid_is_reported_exactly_where_it_is_held(where):
             for rate in ("D", "DD"):
                 assert np.all(res[f"ground.{rate}{k}"] == 0.0), (backend, rate + k)
         assert abs(res["crank.fi"][-1] - res["crank.fi"][0]) > 1e-3
+
+
+def test_a_slider_already_moving_at_t0_carries_the_pendulum_as_a_free_one():
+    """The pendulum on a slider driven at a constant 0.8 m/s from t = 0 (x = 0.5 + 0.8 t),
+    given no initial rates. The nearest velocities that satisfy C_q q̇ = −C_t (C_t = −0.8
+    on the slider's row) are, in closed form, the slider's and the lever's Dx = 0.8 m/s,
+    everything else 0. In the frame moving with the slider (no acceleration: Galilean) the
+    lever swings as the free pendulum from θ0 = −1.2 at rest: ``reference`` without a
+    slider acceleration. With −C_t the run started at Dx = −0.8. (The nearest velocities
+    are the analysis's, not the backend's: Exudyn's run, 0.45 s, covers both.)"""
+    law = Law("polynomial", [0.5, 0.8, 0.0])
+    model = pam2exu.loads(slider_toml("polynomial", law.C))
+    model["slider"].x = model["lever"].x = 0.5         # the guesses (slider_toml's: C[2])
+    res = _run(model, t_end=0.4, steps=8)
+    for name in ("slider", "lever"):
+        assert res[f"{name}.Dx"][0] == pytest.approx(0.8, abs=1e-12), name
+        assert res[f"{name}.Dy"][0] == pytest.approx(0.0, abs=1e-12), name
+    assert res["lever.Dfi"][0] == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(res["slider.x"], law(res.t)[0], atol=1e-12)
+    np.testing.assert_allclose(res["lever.x"], res["slider.x"], atol=1e-12)
+    ref = reference(res.t, (-1.2, 0.0))
+    assert np.max(np.abs(res["lever.fi"] - ref[0]) / (1 + np.abs(ref[0]))) <= 1e-8
+    assert np.max(np.abs(res["lever.Dfi"] - ref[1]) / (1 + np.abs(ref[1]))) <= 1e-8

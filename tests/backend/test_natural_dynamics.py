@@ -176,3 +176,16 @@ def test_cli_verify_dynamic_exits_0(capsys):
     assert code == 0, out
     assert "two time integrations, each within T = 1e-08" in out
     assert "AGREE: natural and exudyn agree" in out
+
+
+def test_the_error_estimate_bounds_the_error_of_the_rows():
+    """The estimate (the largest |coarser − finer| / (1 + |finer|) of the last two runs,
+    the finer returned) bounds the returned rows' error against DOP853 at rtol 1e-13 on the
+    one-DOF equation, in the same measure (measured: 7.2e-7 ≤ 2.9e-5 ≤ 1e-4). Scaled by
+    1 + 10³ |value| instead, it was 1.1e-7: below the error it claims to bound."""
+    tolerance = 1e-4
+    res = _run(pendulum(0.3), t_end=1.0, steps=10, tolerance=tolerance)
+    ref = reference(res.t, (0.3, 0.0))
+    error = max(float(np.max(np.abs(res[c] - r) / (1 + np.abs(r))))
+                for c, r in (("lever.fi", ref[0]), ("lever.Dfi", ref[1])))
+    assert 0 < error <= res.info["integration_error"] <= tolerance
