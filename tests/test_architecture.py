@@ -58,7 +58,12 @@ def _imports(module: str) -> tuple[set[str], set[str], set[str]]:
     strings name (the registry's declarations, ``registry.resolve``: imported when first
     used); and its ``if TYPE_CHECKING:`` imports (never run, but documented dependencies)."""
     path = MODULES[module]
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return _dependencies(module, path.read_text(encoding="utf-8"), path.name == "__init__.py")
+
+
+def _dependencies(module: str, source: str, is_package: bool):
+    """``_imports`` of a module whose text is ``source``."""
+    tree = ast.parse(source)
     top, inner, typing = set(), set(), set()
 
     def visit(node, in_function, in_typing):
@@ -66,7 +71,7 @@ def _imports(module: str) -> tuple[set[str], set[str], set[str]]:
             in_typing = True
         if isinstance(node, (ast.Import, ast.ImportFrom)):
             (typing if in_typing else inner if in_function else top).update(
-                _target(module, node, path.name == "__init__.py"))
+                _target(module, node, is_package))
         if isinstance(node, ast.Constant) and isinstance(node.value, str):
             inner.update(_named_module(node.value))
         for child in ast.iter_child_nodes(node):
@@ -158,19 +163,18 @@ def test_the_walker_finds_imports_and_cycles():
 
 def test_the_walker_sees_annotations_and_the_registry_strings():
     """``if TYPE_CHECKING:`` imports and ``'pam2exu.module:name'`` strings are edges: the
-    registry's into the analyses and the backends, the analyses' annotations of the Job."""
+    registry's into the analyses and the backends; in a module of the model, an annotation
+    of the Job and a string naming the notebook (as ``Model._repr_html_`` had)."""
     _, inner, _ = GRAPH[REGISTRY]
     assert {"pam2exu.analyses.kinematic", "pam2exu.analyses.dynamic",
             "pam2exu.backend.natural"} <= inner
-    tree = ast.parse("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
-                     "    from pam2exu.analyses.job import Job\n"
-                     "F = 'pam2exu.notebook:drawing_html'")
-    typing = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.module.startswith("pam2exu"):
-            typing |= set(_target("pam2exu.model.model", node, False))
-    assert "pam2exu.analyses.job" in typing
-    assert _named_module("pam2exu.notebook:drawing_html") == {"pam2exu.notebook"}
+    source = ("from typing import TYPE_CHECKING\n"
+              "if TYPE_CHECKING:\n    from ..analyses.job import Job\n"
+              "def view(model):\n"
+              "    return registry.resolve('pam2exu.notebook:model_html')(model)\n")
+    top, inner, typing = _dependencies("pam2exu.model.model", source, False)
+    assert (top, inner, typing) == (set(), {"pam2exu.notebook"}, {"pam2exu.analyses",
+                                                                  "pam2exu.analyses.job"})
 
 
 def test_the_import_graph_has_no_cycle():
