@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from pam2exu.analyses.native import SPARSE_FROM
-from pam2exu.backend.system import DENSE_UP_TO
+from pam2exu.backend.exudyn.system import DENSE_UP_TO
 
 from .cases import CHAIN, CHAIN_LAW, TWO_PI
 from .measure import DEFAULT_TOLERANCE, KINDS, fit_exponent, warning_summary
@@ -342,7 +342,7 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
             f"{largest['steps']:,} steps): the plain script evaluates its driver at Exudyn's "
             "load-step time t − dt, and that time accumulates round-off step by step. pam2exu "
             "rounds the load-step time to its grid (`grid_time` in "
-            "`pam2exu/backend/symbolic.py`), and its largest relative position error at "
+            "`pam2exu/backend/exudyn/symbolic.py`), and its largest relative position error at "
             f"{largest['steps']:,} steps is {pam_err:.0e} (section 1).")
         add("")
     add("Newton iterations and solve time of the plain (symbolic) script over the grid, with "

@@ -125,7 +125,7 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
 #: the backends; the first is the default
 BACKENDS: dict[str, BackendType] = {b.name: b for b in (
     BackendType("exudyn", "Exudyn's static solver on the translated model",
-                "pam2exu.backend.exudyn_backend:Exudyn"),
+                "pam2exu.backend.exudyn:Exudyn"),
     BackendType("natural", "natural coordinates (basic points, unit vectors, angles) solved "
                 "by pam2exu's vectorised Newton method: a second, independent formulation",
                 "pam2exu.backend.natural:Natural"),

@@ -2,7 +2,7 @@
 
 The degrees of freedom no actuator drives move under gravity, the torsors, the springs and
 dampers and the inertia of every solid; the driven ones follow their laws. Exudyn's
-``SolveDynamic`` integrates the translated model (``backend.integrate``). Its generalized-α
+``SolveDynamic`` integrates the translated model (``backend.exudyn.integrate``). Its generalized-α
 rule is of order 2, so two runs at h and h/2 extrapolate (Richardson) to order 3 at least
 (measured 3.3 on the pendulum of the tests), and three runs give two such values whose
 difference bounds the error of the better one (Romberg). The step is halved until that

@@ -17,7 +17,7 @@ import numpy as np
 
 import exudyn as exu
 
-from ..kinematics import pose
+from ...kinematics import pose
 from .symbolic import SymbolicNamespace
 from .system import ExudynSystem
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Positions
+from ..base import Positions
 from .system import ExudynSystem, SolveSettings
 
 
@@ -43,7 +43,7 @@ class Exudyn:
                                     anchor_stiffness=anchor_stiffness)
 
     def integrate(self, mech, times, q0, qd0, substeps, verbose=0):
-        """``backend.integrate.integrate``: Exudyn's trapezoidal rule (``SolveDynamic``)
+        """``backend.exudyn.integrate.integrate``: Exudyn's trapezoidal rule (``SolveDynamic``)
         from (q0, q̇0) through ``times``, ``substeps`` steps per interval."""
         from .integrate import integrate
         return integrate(mech, times, q0, qd0, substeps, verbose=verbose)
