@@ -120,7 +120,7 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         "solver=SolveSettings(tolerance=...))` (a loaded `Model`, so without parsing the "
         "TOML) divided by the number of steps: building the Exudyn system, Exudyn's static "
         "solve, the native pass (velocities, accelerations, forces), the checks after the run "
-        "and the result table. *Exudyn* is `res.info['exudyn_seconds']` (building, solving "
+        "and the result table. *Exudyn* is `res.info['backend_seconds']` (building, solving "
         "and reading the Exudyn system); *native* is the rest.")
     add("")
 

@@ -133,6 +133,13 @@ BACKENDS: dict[str, BackendType] = {b.name: b for b in (
 DEFAULT_BACKEND = "exudyn"
 
 
+def backends_that(can: Callable[[type], bool]) -> list[str]:
+    """The names of the backends whose class ``can`` accepts (what a backend declares it
+    can do: ``Backend.moves_free_solids``, ``integrator``), for messages that say where
+    to run instead; imports every backend."""
+    return [name for name, b in BACKENDS.items() if can(resolve(b.implementation))]
+
+
 def analysis_type(name: str) -> AnalysisType | None:
     """The analysis called ``name`` or whose Catalan alias is ``name``; None if there is none."""
     if name in ANALYSES:

@@ -8,9 +8,10 @@ imported, with exudyn, on first use.
 """
 from importlib import import_module
 
-from .base import Backend, Positions
+from .base import Backend, Integrator, Positions, Trajectory
 
-__all__ = ["Backend", "Positions", "Exudyn", "ExudynSystem", "SolveSettings"]
+__all__ = ["Backend", "Integrator", "Positions", "Trajectory", "Exudyn", "ExudynSystem",
+           "SolveSettings"]
 
 #: the Exudyn backend's names offered here, and the module each comes from
 _EXUDYN_NAMES = {"Exudyn": "pam2exu.backend.exudyn",
