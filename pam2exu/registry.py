@@ -6,8 +6,8 @@ analysis computes, whether it needs every degree of freedom driven, which functi
 it), the CLI and the generated reference pages.
 
 Adding an analysis is one module with its function ``f(job) -> Results`` and one entry in
-``ANALYSES``; adding a backend is one module with a class implementing
-``pam2exu.backend.Backend`` and one entry in ``BACKENDS``.
+``ANALYSES``; adding a backend is one module (or package) with a subclass of
+``pam2exu.backend.Backend`` (its contract) and one entry in ``BACKENDS``.
 
 A declaration names what implements it as ``'module:attribute'``, imported when first
 used (a callable may be given instead): so reading and validating a model loads neither

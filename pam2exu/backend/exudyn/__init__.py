@@ -1,5 +1,11 @@
 """The Exudyn backend: each solve translates the mechanism (``ExudynSystem``) and runs
-Exudyn's static solver, one load step per time."""
+Exudyn's static solver, one load step per time.
+
+The package is the only code that imports exudyn: the translation (``system``), the time
+laws compiled to Exudyn symbolic functions (``symbolic``), the standalone script writer
+(``script``, ``pam2exu export``) and the time integration of the dynamic analysis
+(``integrate``).
+"""
 from __future__ import annotations
 
 import numpy as np
