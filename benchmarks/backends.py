@@ -114,7 +114,7 @@ def _first(config, backend, kin, forces, L, w):
     errors = error_summary(res, kin, forces if config.analysis == "kinetostatic" else None,
                            L, w)
     return Run(config.case, config.analysis, config.steps, default_tolerance(backend), seconds,
-               res.info["exudyn_seconds"] or 0.0, errors, "", list(res.warnings))
+               res.info["backend_seconds"] or 0.0, errors, "", list(res.warnings))
 
 
 def chain_repeats(plan, N):
@@ -168,7 +168,7 @@ def side_by_side(plan):
                         f"{type(exc).__name__}: {exc}")
                     continue
                 if seconds < r.seconds:
-                    r.seconds, r.exudyn_seconds = seconds, res.info["exudyn_seconds"] or 0.0
+                    r.seconds, r.exudyn_seconds = seconds, res.info["backend_seconds"] or 0.0
         log(f"  repeat {k + 1} done")
     for c in configs:
         log(f"  {c.case:12s} {c.analysis:12s} best: " + compare_line(c))

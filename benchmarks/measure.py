@@ -102,7 +102,7 @@ class Run:
     steps: int
     tolerance: float
     seconds: float                          # best total wall time
-    exudyn_seconds: float                   # its res.info['exudyn_seconds']
+    exudyn_seconds: float                   # its res.info['backend_seconds']
     errors: dict = field(default_factory=dict)   # kind -> (max relative error, column)
     note: str = ""
     warnings: list = field(default_factory=list)  # res.warnings (texts)
@@ -144,7 +144,7 @@ def measure(case, model, analysis, steps, t_end, tolerance, repeats, kin, forces
     as ``run.res`` if ``keep``)."""
     seconds, res, note = run_pam(model, analysis, steps, t_end, tolerance, repeats, dense)
     errors = error_summary(res, kin, forces if analysis == "kinetostatic" else None, L, w)
-    run = Run(case, analysis, steps, tolerance, seconds, res.info["exudyn_seconds"], errors,
+    run = Run(case, analysis, steps, tolerance, seconds, res.info["backend_seconds"], errors,
               note, list(res.warnings))
     if keep:
         run.res = res

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pam2exu.backend.system import DENSE_UP_TO
+from pam2exu.backend.exudyn.system import DENSE_UP_TO
 
 from .backends import Failure
 from .backends import label as backend_label

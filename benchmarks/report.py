@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from pam2exu.analyses.native import SPARSE_FROM
-from pam2exu.backend.system import DENSE_UP_TO
+from pam2exu.backend.exudyn.system import DENSE_UP_TO
 
 from .cases import CHAIN, CHAIN_LAW, TWO_PI
 from .measure import DEFAULT_TOLERANCE, KINDS, fit_exponent, warning_summary
@@ -120,7 +120,7 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         "solver=SolveSettings(tolerance=...))` (a loaded `Model`, so without parsing the "
         "TOML) divided by the number of steps: building the Exudyn system, Exudyn's static "
         "solve, the native pass (velocities, accelerations, forces), the checks after the run "
-        "and the result table. *Exudyn* is `res.info['exudyn_seconds']` (building, solving "
+        "and the result table. *Exudyn* is `res.info['backend_seconds']` (building, solving "
         "and reading the Exudyn system); *native* is the rest.")
     add("")
 
@@ -342,7 +342,7 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
             f"{largest['steps']:,} steps): the plain script evaluates its driver at Exudyn's "
             "load-step time t − dt, and that time accumulates round-off step by step. pam2exu "
             "rounds the load-step time to its grid (`grid_time` in "
-            "`pam2exu/backend/symbolic.py`), and its largest relative position error at "
+            "`pam2exu/backend/exudyn/symbolic.py`), and its largest relative position error at "
             f"{largest['steps']:,} steps is {pam_err:.0e} (section 1).")
         add("")
     add("Newton iterations and solve time of the plain (symbolic) script over the grid, with "

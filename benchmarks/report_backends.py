@@ -169,7 +169,7 @@ def backends_section(plan, quick, side, memory):
         "timed in alternation, their order swapped every repeat, round the whole grid of "
         f"this section: best of {plan.backend_repeats} repeats (chain: "
         f"{chain_repeats(plan, 1)} up to N = 8, {chain_repeats(plan, 16)} above), so every "
-        "ratio below comes from runs of this benchmark run a few seconds apart. *Positions solve* is `res.info['exudyn_seconds']`, the time in the backend's "
+        "ratio below comes from runs of this benchmark run a few seconds apart. *Positions solve* is `res.info['backend_seconds']`, the time in the backend's "
         "`solve_positions` (for the natural backend: its Newton solve, and its own "
         "velocities and accelerations, which the analyses then use); *native* is the rest. "
         "Errors as in section 1, against the closed forms and the Newton–Euler references, "

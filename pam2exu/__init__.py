@@ -91,7 +91,7 @@ def run(model, analysis=None, **settings):
         quasi_static, kinematic, kinetostatic: some degree of freedom is not driven by an
         actuator (the message names the solids that can move).
     SolverError
-        Exudyn's solver did not converge, the mechanism reaches a singular (dead-point)
+        The backend's solver did not converge, the mechanism reaches a singular (dead-point)
         position it cannot pass, or redundant constraints contradict each other (two
         drives of one coordinate that disagree); ``time`` [s], ``step`` and ``elements``
         say where and which.

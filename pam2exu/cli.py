@@ -64,7 +64,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--partial", action="store_true",
                      help="if the run fails, write the rows computed before the failure to "
                           "-o (the clearance analysis keeps them); the exit status stays 1")
-    run.add_argument("--verbose", action="store_true", help="show Exudyn's solver output")
+    run.add_argument("--verbose", action="store_true", help="show the backend's solver output")
     run.add_argument("--plot", nargs="+", metavar="VAR",
                      help="plot these variables against t (names or patterns, as --outputs)")
     run.add_argument("--plot-file", metavar="FIG.png",

@@ -204,11 +204,12 @@ class SolverError(Pam2ExuError):
 
 
 class TranslationError(Pam2ExuError):
-    """Exudyn's configuration does not satisfy pam2exu's own constraint equations.
+    """The backend's configuration does not satisfy pam2exu's own constraint equations.
 
     This is a bug in the translation of the named element, not a user error. Raised by the
-    self-checks after an analysis: the constraint residual at Exudyn's configuration, and
-    (quasi_static) Exudyn's multipliers against the native equilibrium. CLI exit code 1.
+    self-checks after an analysis: the constraint residual at the backend's configuration,
+    and (quasi_static) the backend's multipliers against the native equilibrium. CLI exit
+    code 1.
 
     Parameters
     ----------

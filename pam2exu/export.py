@@ -1,6 +1,6 @@
 """Export a model as a standalone Exudyn script (imports exudyn and numpy only).
 
-The script builds the system of the translation (``backend.script.ScriptSystem`` records
+The script builds the system of the translation (``backend.exudyn.script.ScriptSystem`` records
 ``ExudynSystem``'s construction and every element's ``build`` as code: one commented block
 per solid and element), writes the actuators' laws as plain Python functions of t, solves
 the positions over the analysis interval with Exudyn's static solver, one load step per time
@@ -173,8 +173,8 @@ def script(model, t_end: float | None = None, steps: int | None = None,
     (True, True)
     """
     from .analyses.job import check_mobility, prepare
-    from .backend.script import ScriptSystem, code
-    from .backend.system import SolveSettings, solver_options
+    from .backend.exudyn.script import ScriptSystem, code
+    from .backend.exudyn.system import SolveSettings, solver_options
 
     if _analysis(model, analysis) == "dynamic":
         from .export_dynamic import dynamic_script
@@ -240,7 +240,7 @@ def _laws(system) -> str:
 
 def _pre_step(system) -> str:
     """The pre-step function that sets each actuator's parameter to its law at t_k."""
-    from .backend.script import code
+    from .backend.exudyn.script import code
     if not system.drivers:
         return ""
     body = ""
@@ -258,7 +258,7 @@ def _pre_step(system) -> str:
 
 def _results(mech, system) -> str:
     """Reading the sensors and writing the CSV."""
-    from .backend.script import code
+    from .backend.exudyn.script import code
     solids = mech.solids
     fixed = [f"{solids[i].name!r}: {code([solids[i].x, solids[i].y, solids[i].fi])}"
              for i in sorted(system.grounded)]

@@ -1,8 +1,8 @@
 """Export a model whose analysis is ``dynamic`` as a standalone Exudyn script of its motion.
 
 The script (imports exudyn, numpy, csv and sys only) builds the system of the dynamic analysis
-(``backend.integrate``: masses, gravity, springs, dampers and loads, fixed solids as ground)
-as commented blocks (``backend.script.ScriptSystem``), starts it from the state the analysis
+(``backend.exudyn.integrate``: masses, gravity, springs, dampers and loads, fixed solids as ground)
+as commented blocks (``backend.exudyn.script.ScriptSystem``), starts it from the state the analysis
 starts from (the assembly at t = 0 and the nearest consistent velocities, written as
 numbers), drives the actuators at the integrator's time as the analysis does, integrates
 with ``SolveDynamic`` (generalized-α, the analysis's settings) piece by piece as the
@@ -228,8 +228,8 @@ def dynamic_script(model, t_end=None, steps=None, file: str = "script.py",
     from .analyses.dynamic import motion, nearest_velocities, require_inertia
     from .analyses.job import check_mobility, prepare
     from .analyses.positions import GUESS_STIFFNESS, assemble
-    from .backend.integrate import settings
-    from .backend.script import ScriptSystem
+    from .backend.exudyn.integrate import settings
+    from .backend.exudyn.script import ScriptSystem
 
     # the script is Exudyn's generalized-alpha: its pieces and steps from the Exudyn backend
     job = prepare(model, "dynamic", t_end, steps, POSITIONS, backend="exudyn",
@@ -254,7 +254,7 @@ def dynamic_script(model, t_end=None, steps=None, file: str = "script.py",
 
 def _header(mech, system, job, pieces: list, file: str) -> str:
     from .version import __version__
-    from .backend.integrate import SPECTRAL_RADIUS
+    from .backend.exudyn.integrate import SPECTRAL_RADIUS
     source = str(mech.model.source or "")
     jumps = sum(1 for *_, at_break in pieces if at_break)
     about = textwrap.fill(
@@ -318,7 +318,7 @@ def _comment(text: str) -> str:
 
 def _pieces_code(pieces: list) -> str:
     """The pieces as a list literal, one per line: (start, end, rows, steps, jump)."""
-    from .backend.script import code
+    from .backend.exudyn.script import code
     lines = []
     for times, rows, steps, at_break in pieces:
         if rows and rows != list(range(rows[0], rows[-1] + 1)):
@@ -336,7 +336,7 @@ def _laws(system) -> str:
 
 def _drive(system) -> str:
     """Offsets by user functions of t, distances by a pre-step function."""
-    from .backend.script import code, identifier
+    from .backend.exudyn.script import code, identifier
     if not system.drivers:
         return ""
     body, stepped = "", ""
@@ -363,7 +363,7 @@ def _drive(system) -> str:
 
 
 def _solve(system, options: dict, pieces: list) -> str:
-    from .backend.script import code
+    from .backend.exudyn.script import code
     lines = []
     for path, value in options.items():
         if path.split(".")[-1] in ("numberOfSteps", "startTime", "endTime"):
@@ -380,7 +380,7 @@ def _solve(system, options: dict, pieces: list) -> str:
 
 def _impulse(system) -> str:
     """The rates of the laws and ``velocities_after`` (a model with law breakpoints)."""
-    from .backend.script import code
+    from .backend.exudyn.script import code
     laws = sorted({law.name for _, _, law, _ in system.drivers}, key=list(RATE_CODE).index)
     rates = [f"({obj}, lambda t: {law.name}_rate(t, {', '.join(code(c) for c in law.C)})),"
              for obj, _, law, _ in system.drivers]
@@ -390,7 +390,7 @@ def _impulse(system) -> str:
 
 
 def _results(mech, system, q0) -> str:
-    from .backend.script import code
+    from .backend.exudyn.script import code
     from .kinematics import pose
     solids = mech.solids
     fixed = [f"{solids[i].name!r}: {code(np.asarray(q0)[pose(i)])}"

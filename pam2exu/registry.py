@@ -6,8 +6,8 @@ analysis computes, whether it needs every degree of freedom driven, which functi
 it), the CLI and the generated reference pages.
 
 Adding an analysis is one module with its function ``f(job) -> Results`` and one entry in
-``ANALYSES``; adding a backend is one module with a class implementing
-``pam2exu.backend.Backend`` and one entry in ``BACKENDS``.
+``ANALYSES``; adding a backend is one module (or package) with a subclass of
+``pam2exu.backend.Backend`` (its contract) and one entry in ``BACKENDS``.
 
 A declaration names what implements it as ``'module:attribute'``, imported when first
 used (a callable may be given instead): so reading and validating a model loads neither
@@ -125,12 +125,19 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
 #: the backends; the first is the default
 BACKENDS: dict[str, BackendType] = {b.name: b for b in (
     BackendType("exudyn", "Exudyn's static solver on the translated model",
-                "pam2exu.backend.exudyn_backend:Exudyn"),
+                "pam2exu.backend.exudyn:Exudyn"),
     BackendType("natural", "natural coordinates (basic points, unit vectors, angles) solved "
                 "by pam2exu's vectorised Newton method: a second, independent formulation",
                 "pam2exu.backend.natural:Natural"),
 )}
 DEFAULT_BACKEND = "exudyn"
+
+
+def backends_that(can: Callable[[type], bool]) -> list[str]:
+    """The names of the backends whose class ``can`` accepts (what a backend declares it
+    can do: ``Backend.moves_free_solids``, ``integrator``), for messages that say where
+    to run instead; imports every backend."""
+    return [name for name, b in BACKENDS.items() if can(resolve(b.implementation))]
 
 
 def analysis_type(name: str) -> AnalysisType | None:

@@ -61,7 +61,7 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
     MobilityError
         A degree of freedom is not driven (all analyses but assembly).
     SolverError
-        Exudyn's solver did not converge, a singular position was reached, or redundant
+        The backend's solver did not converge, a singular position was reached, or redundant
         constraints contradict each other.
     TranslationError
         A self-check failed (a bug of pam2exu).

@@ -1,4 +1,4 @@
-"""Assembly: the constraints solved at t = 0 by the backend (Exudyn); one row of x, y, fi per solid."""
+"""Assembly: the constraints solved at t = 0 by the backend; one row of x, y, fi per solid."""
 from __future__ import annotations
 
 from .job import Job, check_mobility, collect
@@ -9,7 +9,7 @@ def assembly(job: Job):
     """Solve C(q, 0) = 0 from the initial guess.
 
     With free degrees of freedom, each coordinate is tied to its initial value by a soft
-    spring, so Exudyn finds the assembled configuration nearest to the guess (the spring
+    spring, so the backend finds the assembled configuration nearest to the guess (the spring
     forces only select among solutions; the constraints are met exactly).
     """
     q0 = job.mech.initial_q()

@@ -1,15 +1,15 @@
 """Following one branch of the motion through singular and nearly singular positions.
 
-Exudyn's static solver starts each step's Newton iteration from the previous step's
+The backend's solver starts each step's Newton iteration from the previous step's
 configuration. Near a change point (a parallelogram whose links become collinear, a
 four-bar passing close to one) that start can be nearer to another assembly branch, and
 Newton converges there: the positions still close, but the mechanism has switched branch.
 The velocities tell: on a smooth motion they change by O(dt³) more than the accelerations
 predict between two steps (``native.continuity_defect``); a branch switch makes them jump.
 
-Where they jump, the step is solved again by Exudyn, its Newton iteration now started from
+Where they jump, the step is solved again by the backend, its Newton iteration now started from
 the Taylor predictor q + h q̇ + h²/2 q̈ of the last good step, which lies on the branch
-followed. If Exudyn lands on the same configuration as before, there was no switch (a
+followed. If the backend lands on the same configuration as before, there was no switch (a
 coarse grid); otherwise the rest of the run is replaced by the re-solved one.
 
 At a step that lies exactly on a singular position, Cq q̇ = −C_t does not fix the rates.
@@ -48,7 +48,7 @@ CONDITION_WARNING = 100.0
 CONDITION_SAMPLES = 400
 #: a step next to a velocity jump whose condition number is above this is taken as lying
 #: on the singular position itself: Newton converges there only to ~√(tolerance), so the
-#: condition number of Exudyn's configuration is ~1e6, not 1e16
+#: condition number of the backend's configuration is ~1e6, not 1e16
 SINGULAR = 1e4
 
 

@@ -1,14 +1,15 @@
 """Forward dynamics (shared/spec/dynamics.md, ``dynamic``): let go of the mechanism.
 
 The degrees of freedom no actuator drives move under gravity, the torsors, the springs and
-dampers and the inertia of every solid; the driven ones follow their laws. Exudyn's
-``SolveDynamic`` integrates the translated model (``backend.integrate``). Its generalized-α
-rule is of order 2, so two runs at h and h/2 extrapolate (Richardson) to order 3 at least
-(measured 3.3 on the pendulum of the tests), and three runs give two such values whose
-difference bounds the error of the better one (Romberg). The step is halved until that
-estimate meets ``tolerance`` · (1 + |value|) on every coordinate and rate.
+dampers and the inertia of every solid; the driven ones follow their laws. A backend
+with a fixed-step integrator (``Backend.integrate``; the Exudyn backend's: ``SolveDynamic``
+on the translated model, ``backend.exudyn.integrate``) integrates with a given step: its
+generalized-α rule is of order 2, so two runs at h and h/2 extrapolate (Richardson) to
+order 3 at least (measured 3.3 on the pendulum of the tests), and three runs give two such
+values whose difference bounds the error of the better one (Romberg). The step is halved
+until that estimate meets ``tolerance`` · (1 + |value|) on every coordinate and rate.
 
-The native pass then does what Exudyn does not: the extrapolated state is projected back
+The native pass then does what the integrator does not: the extrapolated state is projected back
 onto the constraints (positions and velocities, a correction of the integration error's
 size), the accelerations and multipliers come from the equations of motion
 
@@ -18,8 +19,9 @@ size), the accelerations and multipliers come from the equations of motion
 and the reactions from the same formulas as ``kinetostatic`` (``force_pass.over_time``),
 so every row satisfies every solid's Newton–Euler equations.
 
-A backend with its own adaptive integrator (``Backend.motion``: the natural backend's, in
-natural coordinates) replaces the Romberg sequence; the rest is the same.
+A backend with its own adaptive integrator (``Integrator.ADAPTIVE``, ``Backend.motion``:
+the natural backend's, in natural coordinates) replaces the Romberg sequence; the rest is
+the same.
 """
 from __future__ import annotations
 
@@ -27,8 +29,10 @@ import math
 
 import numpy as np
 
+from ..backend import Integrator
 from ..errors import InputWarning, ModelError, SolverError
 from ..kinematics import State, pose
+from ..registry import backends_that
 from . import force_pass, free, native
 from .job import Job, check_mobility, collect, warn
 from .kinetostatic import kinetostatic
@@ -62,11 +66,12 @@ def dynamic(job: Job):
     mob = check_mobility(job, mech.initial_q(), need_driven=False)
     if mob.dof == 0:
         return kinetostatic(job)
-    if not getattr(job.backend, "integrates", False):
+    if job.backend.integrator is Integrator.NONE:
+        able = backends_that(lambda b: b.integrator is not Integrator.NONE)
         raise ModelError(
             f"the {job.backend.name} backend cannot integrate the motion of free solids "
             f"({', '.join(repr(n) for n in mob.free_solids)}): run the dynamic analysis on "
-            "the exudyn backend (backend = \"exudyn\", --backend exudyn)")
+            f"the {' or '.join(able)} backend (backend = \"{able[0]}\", --backend {able[0]})")
     redundant = mob.redundant > 0
     q0 = assemble(job, redundant, GUESS_STIFFNESS)
     require_inertia(mech, float(t[0]), q0)
@@ -86,13 +91,13 @@ def dynamic(job: Job):
     return collect(job, q, qd, qdd, extra=out)
 
 
-# ---- the motion, by Exudyn, to the tolerance ---------------------------------------------
+# ---- the motion, by the backend, to the tolerance ---------------------------------------------
 
 def motion(job: Job, q0: np.ndarray, qd0: np.ndarray, pieces: list | None = None):
     """(q, q̇) at every time of the job, segment by segment between the laws' breakpoints
     (where the velocities jump: ``impulse``), each one to the tolerance (``romberg``).
     ``pieces``: a list that receives every run's (times, rows it fills, steps of its finest
-    Exudyn run, whether it ends at a breakpoint), in order (``export_dynamic`` repeats them)."""
+    run, whether it ends at a breakpoint), in order (``export_dynamic`` repeats them)."""
     mech, t = job.mech, job.times
     dt = float(t[1] - t[0])
     # a breakpoint within round-off of a row is that row's time
@@ -127,12 +132,20 @@ def motion(job: Job, q0: np.ndarray, qd0: np.ndarray, pieces: list | None = None
                   f"of value, not the tolerance {job.tolerance:g}: "
                   + (f"{job.backend.label} cannot integrate more accurately here. Ask for "
                      "a looser tolerance, or a shorter interval"
-                     if hasattr(job.backend, "motion") else "Exudyn's generalized-α stops "
-                     f"improving here, or would need more than {MOST_STEPS:,} steps. Ask for "
-                     "a looser tolerance, or run on the natural backend (backend = "
-                     "\"natural\": an adaptive high-order integrator, docs/analyses.md)"),
+                     if job.backend.integrator is Integrator.ADAPTIVE
+                     else _finer_steps_advice(job)),
              AccuracyWarning)
     return q, qd
+
+
+def _finer_steps_advice(job: Job) -> str:
+    """Why a fixed-step integrator stopped short of the tolerance, and what to do."""
+    adaptive = backends_that(lambda b: b.integrator is Integrator.ADAPTIVE)
+    return (f"{job.backend.integrator_name} stops improving here, or would need more than "
+            f"{MOST_STEPS:,} steps. Ask for a looser tolerance"
+            + (f", or run on the {' or '.join(adaptive)} backend (backend = "
+               f"\"{adaptive[0]}\": an adaptive high-order integrator, docs/analyses.md)"
+               if adaptive else ""))
 
 
 def _pieces(t: np.ndarray, inside: np.ndarray, start: float, end: float):
@@ -161,12 +174,13 @@ def romberg(job: Job, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray,
     the earlier one to first order, so it bounds the error of the later one, which is
     kept, as long as the extrapolations converge (the error falls as h³ or faster: by
     8 or more per halving; measured 10 on the pendulum). Dividing it by 7, as the order
-    would allow, let the pendulum's error exceed the estimate by 1.3 ×. A run Exudyn cannot finish
-    (a step too long for its Newton iteration) starts the sequence again from twice its
-    steps. A backend with its own adaptive integrator (``Backend.motion``) meets the
-    tolerance itself. ``at_break``: the last time is a law breakpoint, where the velocity
-    equations change: that row is left as integrated (the state before the jump)."""
-    if hasattr(job.backend, "motion"):
+    would allow, let the pendulum's error exceed the estimate by 1.3 ×. A run the
+    integrator cannot finish (a step too long for its Newton iteration) starts the
+    sequence again from twice its steps. A backend with its own adaptive integrator
+    (``Integrator.ADAPTIVE``: ``Backend.motion``) meets the tolerance itself.
+    ``at_break``: the last time is a law breakpoint, where the velocity equations change:
+    that row is left as integrated (the state before the jump)."""
+    if job.backend.integrator is Integrator.ADAPTIVE:
         q, qd, estimate, steps = job.backend.motion(job.mech, times, q0, qd0, job.tolerance,
                                                     verbose=job.solver.verbose)
         return (q, qd), estimate, steps
@@ -202,8 +216,8 @@ def romberg(job: Job, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray,
 
 
 def _run(job: Job, times, q0, qd0, substeps: int, last: bool):
-    """(q, q̇) of one Exudyn run, None if it failed; on the ``last`` run allowed, a
-    SolverError naming the time where it stopped."""
+    """(q, q̇) of one run of the backend's fixed-step integrator, None if it failed; on
+    the ``last`` run allowed, a SolverError naming the time where it stopped."""
     found = job.backend.integrate(job.mech, times, q0, qd0, substeps,
                                   verbose=job.solver.verbose)
     if found.error is None:
@@ -213,7 +227,7 @@ def _run(job: Job, times, q0, qd0, substeps: int, last: bool):
     rows = ~np.isfinite(found.q).all(axis=1)
     at = float(times[int(np.argmax(rows))]) if rows.any() else float(times[-1])
     raise SolverError(
-        f"t={at:g}: Exudyn's dynamic solver failed ({found.error}) even with "
+        f"t={at:g}: {job.backend.label}'s dynamic solver failed ({found.error}) even with "
         f"{substeps} steps per interval of {times[1] - times[0]:g} s. The motion may reach "
         "a singular position where the mechanism locks or branches: check the model "
         "there (pam2exu draw MODEL --t T), or end the interval before it", time=at)

@@ -102,7 +102,7 @@ def account(model, res: Results) -> Results:
                           + columns["dissipated"])
     return Results(res.t, {f"energy.{k}": v for k, v in columns.items()},
                    {f"energy.{k}": "J" for k in columns}, res.analysis, res.model,
-                   res.warnings, res.info)
+                   res.warnings, res.info, res.backend)
 
 
 def require_rates(kind: str, source) -> None:

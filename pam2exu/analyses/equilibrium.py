@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kinematics import State
-from ..registry import BACKENDS, resolve
+from ..registry import backends_that
 from . import force_pass, free
 from .job import Job, check_mobility, collect, warn
 from .positions import GUESS_STIFFNESS, assemble, check_residual
@@ -80,7 +80,7 @@ def equilibrium(job: Job):
     if mob.dof == 0:
         return quasi_static(job)
     if not job.backend.moves_free_solids:
-        able = [name for name, b in BACKENDS.items() if resolve(b.implementation).moves_free_solids]
+        able = backends_that(lambda b: b.moves_free_solids)
         raise ModelError(
             f"the {job.backend.name} backend cannot solve a static equilibrium with free "
             f"degrees of freedom (the solids {', '.join(repr(n) for n in mob.free_solids)} "

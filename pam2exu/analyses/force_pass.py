@@ -6,7 +6,8 @@ With q = (x, y, fi) per solid, the equations of motion of the constrained solids
 
 so the constraint forces Cqᵀ λ follow from one linear solve per step once q, qd, qdd are
 known (inverse dynamics; quasi-statics is the same with Q_inertia = 0). These λ are the
-static solver's multipliers of Exudyn (f + Cqᵀ λ = 0), so both can be compared directly.
+backend's static multipliers (f + Cqᵀ λ = 0, ``Backend.solve_positions(forces=True)``),
+so both can be compared directly.
 
 An element's reaction is the part of Cqᵀ λ that its own rows give to its receiving solid
 (a wrench about that solid's origin), moved to the element's reporting point and turned

@@ -210,7 +210,7 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
         job.info["undefined"] = "; ".join(notes)
     values.update(extra)
     res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
-                  mech.name, job.warnings, job.info)
+                  mech.name, job.warnings, job.info, job.backend.label)
     table = res.to_numpy()[:, 1:]        # a view of the table's storage: no copies
     np.add(table, 0.0, out=table)        # no negative zeros in tables
     if not (np.isfinite(table).all()

@@ -1,4 +1,4 @@
-"""Kinematic analysis: positions by the backend (Exudyn), velocities and accelerations natively."""
+"""Kinematic analysis: positions by the backend, velocities and accelerations natively."""
 from __future__ import annotations
 
 from ..elements import ACCELERATION, VELOCITY
@@ -10,8 +10,8 @@ from .positions import positions
 def kinematic(job: Job):
     """x … DDfi of every solid, f(t), Df(t), ro, Dro, fi_rel, Dfi_rel over the interval.
 
-    Contract: every degree of freedom driven (else MobilityError); positions from Exudyn's
-    static solver at each time; Cq qd = −C_t and Cq qdd = γ solved natively for all steps;
+    Contract: every degree of freedom driven (else MobilityError); positions from the
+    backend's solver at each time; Cq qd = −C_t and Cq qdd = γ solved natively for all steps;
     the motion stays on the branch it starts on (``branch.motion``).
     """
     mob = check_mobility(job, job.mech.initial_q())

@@ -14,7 +14,7 @@ from .job import Job, check_mobility, collect, warn
 def kinetostatic(job: Job):
     """Everything of kinematic, plus every reaction, spring force and actuator force.
 
-    Contract: positions from Exudyn's static solver, qd and qdd natively (as kinematic);
+    Contract: positions from the backend's solver, qd and qdd natively (as kinematic);
     then at every step Cqᵀ λ = Q_inertia − Q_applied is solved natively (inertia from the
     mass at G and the inertia about G; gravity, torsors, springs and dampers applied), and
     the reactions are read from λ (``force_pass.reactions``). The power balance is checked.

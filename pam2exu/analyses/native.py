@@ -2,7 +2,7 @@
 
 Everything here is NumPy on all time steps at once (in chunks that bound memory):
 
-    C(q, t) = 0                 positions (solved by Exudyn, checked here)
+    C(q, t) = 0                 positions (solved by the backend, checked here)
     Cq qd = −C_t                velocities
     Cq qdd = γ                  accelerations, γ = f'' − conv (see kinematics)
 """

@@ -17,7 +17,7 @@ from .job import Job, warn_redundant
 
 #: steps solved by one call of the backend: a longer run is solved in parts, one tick of its
 #: progress bar each (a part takes a few seconds: 5 s for the four-bar on a slow machine;
-#: each part costs a new Exudyn system, about 0.2 s, so parts are not made smaller)
+#: each part costs the Exudyn backend a new system, about 0.2 s, so parts are not made smaller)
 PART_STEPS = 50_000
 
 #: stiffness tying each coordinate to its guess when degrees of freedom are free, so that
@@ -45,7 +45,7 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
         found = solve_in_parts(job, start, redundant, VELOCITY in job.levels)
         if found.solved:         # step 0 is the assembly (Newton moved it by round-off)
             found.q[0] = start
-    job.info["exudyn_seconds"] = _time.perf_counter() - clock
+    job.info["backend_seconds"] = _time.perf_counter() - clock
 
     if found.solved < len(job.times) and not (partial and found.solved > 0):
         raise position_failure(job, found)

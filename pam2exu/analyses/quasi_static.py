@@ -11,9 +11,9 @@ from . import force_pass, native
 from .job import Job, check_mobility, collect
 from .positions import positions, velocities
 
-#: Exudyn's multipliers must satisfy the native equilibrium to this, relative to the forces
+#: the backend's multipliers must satisfy the native equilibrium to this, relative to the forces
 EQUILIBRIUM_TOLERANCE = 1e-9
-#: the steps at which Exudyn's static solver, with the forces, checks the native reactions
+#: the steps at which the backend's static solver, with the forces, checks the native reactions
 CHECKED_STEPS = 3
 
 
@@ -23,12 +23,12 @@ def quasi_static(job: Job):
     Contract: every degree of freedom is driven, so the configurations do not depend on the
     forces: they come from the backend's solver on the constraints (as kinematic), and
     the reactions from the native equilibrium Cqᵀ λ = −Q_applied at every step (gravity,
-    torsors and springs, no damper terms; ``force_pass.over_time``). Exudyn's static solver
-    with the masses and force elements in the model checks them at ``CHECKED_STEPS`` steps
-    (its multipliers λ, f + Cqᵀ λ = 0, must satisfy the native equilibrium). With
-    redundant constraints λ is not unique: the reactions are the minimum-norm solution and
-    are not checked against Exudyn's. A singular (dead-point) position, where the reactions
-    are not defined, is an error.
+    torsors and springs, no damper terms; ``force_pass.over_time``). The backend's static
+    solver with the masses and force elements in the model checks them at
+    ``CHECKED_STEPS`` steps (its multipliers λ, f + Cqᵀ λ = 0, must satisfy the native
+    equilibrium). With redundant constraints λ is not unique: the reactions are the
+    minimum-norm solution and are not checked against the backend's. A singular
+    (dead-point) position, where the reactions are not defined, is an error.
     """
     mob = check_mobility(job, job.mech.initial_q())
     redundant = mob.redundant > 0
@@ -44,7 +44,7 @@ def quasi_static(job: Job):
         rows = checked_steps(len(job.times))
         label = job.backend.label
         job.stage = f"checking the reactions with {job.backend.solver_name}"
-        worst = exudyn_equilibrium_error(job, q, rows)
+        worst = backend_equilibrium_error(job, q, rows)
         job.info["reactions_from"] = (f"native solve, {label}'s multipliers agree at "
                                       f"{len(rows)} steps")
         job.info["equilibrium_error"] = worst
@@ -58,11 +58,12 @@ def quasi_static(job: Job):
 
 
 def checked_steps(n: int) -> list[int]:
-    """The steps Exudyn's multipliers are checked at: the first, the last and evenly between."""
+    """The steps the backend's multipliers are checked at: the first, the last and evenly
+    between."""
     return sorted({int(k) for k in np.linspace(0, n - 1, min(n, CHECKED_STEPS)).round()})
 
 
-def exudyn_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float:
+def backend_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float:
     """Largest ``equilibrium_error`` of the backend's multipliers at the given steps.
 
     At each step, the backend's static solver with the masses and force elements (no

@@ -1,15 +1,19 @@
-"""What the analyses ask of a backend: configurations over a time grid.
+"""What the analyses ask of a backend, and what it declares it can do (``Backend``).
 
 A backend is one formulation of the mechanism's constraints with a solver for them
-(``registry.BACKENDS`` lists them; ``Exudyn`` is the default). The analyses and the branch
-following talk to it only through ``Backend.solve_positions``; velocities, accelerations
-and forces are pam2exu's native pass on the coordinates it returns, which are always
-x, y, fi of every solid (``kinematics.pose``), whatever the backend solves internally.
+(``registry.BACKENDS`` lists them; ``Exudyn`` is the default). The analyses, the branch
+following and the checks talk to it only through the methods of ``Backend``; velocities,
+accelerations and forces are pam2exu's native pass on the coordinates it returns, which
+are always x, y, fi of every solid (``kinematics.pose``), whatever the backend solves
+internally. What a backend can do beyond the positions it declares by class attributes of
+``Backend``; the analyses read those declarations and never probe the object.
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import ClassVar, Protocol
+from enum import Enum
+from typing import ClassVar
 
 import numpy as np
 
@@ -51,50 +55,148 @@ class Positions:
     qdd: np.ndarray | None = None
 
 
-class Backend(Protocol):
-    """A formulation with a position solver.
+@dataclass
+class Trajectory:
+    """A fixed-step integrator's answer to ``Backend.integrate``.
+
+    Attributes
+    ----------
+    q, qd : numpy.ndarray
+        (len(times), nq): x, y, fi of every solid and their rates at the output times (the
+        first row the start); NaN from where the integration failed.
+    steps : int
+        The steps taken over the whole run.
+    error : str or None
+        The integrator's own words when it failed (quoted in messages); None on success.
+    """
+
+    q: np.ndarray
+    qd: np.ndarray
+    steps: int
+    error: str | None = None
+
+
+class Integrator(Enum):
+    """How a backend integrates the equations of motion (``Backend.integrator``)."""
+
+    #: it does not: the dynamic analysis refuses free solids on it
+    NONE = "none"
+    #: ``Backend.integrate`` with a given number of equal steps; the analysis refines the
+    #: step (Richardson, Romberg) until the error estimate meets the tolerance
+    FIXED_STEP = "fixed step"
+    #: ``Backend.motion`` meets the tolerance itself; the analysis takes its answer
+    ADAPTIVE = "adaptive"
+
+
+class Backend(ABC):
+    """Base class of the backends: a formulation of the constraints with its solvers.
+
+    To implement a new backend, follow these rules:
+
+        1. Subclass ``Backend`` in a module or package of ``pam2exu/backend/`` and add one
+           ``registry.BackendType`` naming it (``'pam2exu.backend.<module>:<Class>'``) to
+           ``registry.BACKENDS``; ``BackendType.create`` calls the class with no argument,
+           once per run (an instance may keep what it built for a mechanism).
+        2. Set the identity attributes ``name``, ``label``, ``solver_name`` and
+           ``Settings`` (see Attributes); the class refuses to be defined without them.
+        3. Implement ``solve_positions``, the one method every analysis calls. It returns
+           x, y, fi of every solid (``kinematics.pose``)
+           in a ``Positions``, whatever the backend's own coordinates are. A solve that
+           does not converge is no exception: return the rows solved (``solved``), the
+           solver's own words (``error``) and where it stopped (``last``); the analyses
+           write the message (``analyses.failure``), naming the backend by its ``label``.
+        4. Declare what else it can do by the capability attributes below and implement
+           the method each names; the defaults declare nothing, and a class that declares
+           a capability without overriding its method is refused when it is defined
+           (TypeError):
+
+           =============================  =================================================
+           declaration                    what the analyses then do
+           =============================  =================================================
+           ``gives_rates = True``         ``solve_positions(..., rates=True)`` fills
+                                          ``Positions.qd``, ``qdd``; the kinematic
+                                          analyses and the branch following use them
+                                          instead of the native pass's
+           ``moves_free_solids = True``   the equilibrium analysis descends the potential
+                                          energy by ``static_equilibrium``; without it, it
+                                          refuses free degrees of freedom on this backend
+           ``integrator = FIXED_STEP``    the dynamic analysis calls ``integrate`` with 2,
+                                          4, 8 … times the steps and extrapolates
+                                          (Richardson, Romberg) to its tolerance
+           ``integrator = ADAPTIVE``      the dynamic analysis calls ``motion``, which
+                                          meets the tolerance itself
+           ``integrator = NONE``          the dynamic analysis refuses free degrees of
+                                          freedom on this backend (a fully driven model
+                                          runs as kinetostatic)
+           =============================  =================================================
+
+        5. Keep the console quiet unless ``settings.verbose`` (or ``verbose``) is > 0.
+        6. Test it against the Exudyn backend on the examples (as
+           ``tests/backend/test_natural.py`` does the natural backend), and give it a row
+           in ``docs/architecture.md``.
 
     Attributes
     ----------
     name : str
         Its name in ``registry.BACKENDS`` (``[analysis] backend``, ``--backend``).
     label : str
-        How messages name it ("… Exudyn said: …").
+        How messages and the checks name it ("… Exudyn said: …", "Exudyn's multipliers").
     solver_name : str
         How messages name its position solver ("Exudyn's static solver did not converge").
     Settings : type
-        Its settings class; an instance has at least ``tolerance`` (Newton's, relative to
-        the mechanism's length) and ``verbose`` (0: quiet).
+        Its settings class, called with no argument for the defaults; an instance has at
+        least ``tolerance`` (Newton's, relative to the mechanism's length) and ``verbose``
+        (0: quiet).
     gives_rates : bool
         ``solve_positions(..., rates=True)`` returns velocities and accelerations too.
+        Default False.
     moves_free_solids : bool
-        It has ``static_equilibrium``, which moves the free degrees of freedom to a static
-        equilibrium (the ``equilibrium`` analysis needs it, and refuses free degrees of
-        freedom on a backend without).
-    integrates : bool
-        It integrates the equations of motion (``dynamic``), by one of two methods:
-        ``integrate(mech, times, q0, qd0, substeps, verbose)`` with a fixed step
-        (``substeps`` equal steps per interval of the equally spaced ``times``; a
-        ``Trajectory`` of q, q̇; the analysis refines it by Romberg), or, when the backend
-        has it, ``motion(mech, times, q0, qd0, tolerance, verbose) -> (q, qd, estimate,
-        steps)``: an adaptive integrator that meets ``tolerance`` · (1 + |value|) on every
-        x, y, fi and rate itself; q, qd (len(times), nq) at ``times`` (the first row the
-        start), ``estimate`` the error estimate reached per unit of value, ``steps`` the
-        steps of its finest run.
+        It implements ``static_equilibrium``. Default False.
+    integrator : Integrator
+        How it integrates the equations of motion: ``FIXED_STEP`` (it implements
+        ``integrate``), ``ADAPTIVE`` (it implements ``motion``) or ``NONE``. Default NONE.
+    integrator_name : str
+        With ``FIXED_STEP``: how messages name its integrator ("Exudyn's generalized-α
+        stops improving here").
     """
 
     name: ClassVar[str]
     label: ClassVar[str]
     solver_name: ClassVar[str]
     Settings: ClassVar[type]
-    gives_rates: ClassVar[bool]
-    moves_free_solids: ClassVar[bool]
-    integrates: ClassVar[bool]
+    gives_rates: ClassVar[bool] = False
+    moves_free_solids: ClassVar[bool] = False
+    integrator: ClassVar[Integrator] = Integrator.NONE
+    integrator_name: ClassVar[str] = ""
 
+    def __init_subclass__(cls, **kwargs):
+        """A subclass declares its identity, and a method for each capability it declares."""
+        super().__init_subclass__(**kwargs)
+        missing = [a for a in ("name", "label", "solver_name", "Settings") if a not in dir(cls)]
+        if missing:
+            raise TypeError(f"backend class {cls.__name__} does not set {', '.join(missing)} "
+                            "(Backend's identity attributes)")
+        needs = {"static_equilibrium": cls.moves_free_solids,
+                 "integrate": cls.integrator is Integrator.FIXED_STEP,
+                 "motion": cls.integrator is Integrator.ADAPTIVE}
+        for method, declared in needs.items():
+            if declared and vars(Backend)[method] is _own(cls, method):
+                raise TypeError(f"backend class {cls.__name__} declares what "
+                                f"Backend.{method} does but does not implement {method}")
+        if cls.integrator is Integrator.FIXED_STEP and not cls.integrator_name:
+            raise TypeError(f"backend class {cls.__name__} has a fixed-step integrator: "
+                            "name it (integrator_name)")
+
+    @abstractmethod
     def solve_positions(self, mech, times: np.ndarray, start: np.ndarray, settings, *,
                         redundant: bool = False, forces: bool = False,
                         anchor_stiffness: float = 0.0, rates: bool = False) -> Positions:
         """Configurations at the equally spaced ``times``, step after step from ``start``.
+
+        Every analysis calls it: the assembly (one time), the position solve of a run (in
+        parts of ``analyses.positions.PART_STEPS`` steps, each from where the last
+        ended), the branch following's re-solves, and the quasi-static check of the
+        reactions (``forces``, one time each).
 
         Parameters
         ----------
@@ -116,14 +218,20 @@ class Backend(Protocol):
             the guess; the equilibrium's descent steps).
         rates : bool
             Also return ``Positions.qd`` and ``qdd`` (ignored unless ``gives_rates``).
+
+        Returns
+        -------
+        Positions
+            ``q`` (len(times), nq) with NaN from ``solved`` on; ``multipliers`` with
+            ``forces``; ``qd``, ``qdd`` with ``rates`` on a backend that ``gives_rates``;
+            ``iterations`` if it counts them.
         """
-        ...
 
     def static_equilibrium(self, mech, t: float, start: np.ndarray, settings, *,
                            redundant: bool = False,
                            anchor_stiffness: float = 0.0) -> Positions:
         """A static equilibrium at time t, the free degrees of freedom moved to it from
-        ``start`` (only with ``moves_free_solids``): what the ``equilibrium`` analysis's
+        ``start`` (with ``moves_free_solids``): what the ``equilibrium`` analysis's
         descent calls (``analyses.equilibrium.descend``).
 
         The answer q satisfies the constraints C(q, t) = 0 (the actuators at their laws'
@@ -166,4 +274,81 @@ class Backend(Protocol):
             order with f + Cqᵀ λ = 0, f the loads and springs on x, y, fi (least norm where
             constraints are redundant); ``iterations``.
         """
-        ...
+        raise NotImplementedError(f"the {self.name} backend does not move free solids "
+                                  "(moves_free_solids is False)")
+
+    def integrate(self, mech, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray,
+                  substeps: int, verbose: int = 0) -> Trajectory:
+        """The motion from (q0, q̇0) at ``times[0]`` through the equally spaced ``times``,
+        by ``substeps`` equal steps per interval (with ``integrator = FIXED_STEP``): what
+        the ``dynamic`` analysis's step refinement calls (``analyses.dynamic.romberg``).
+
+        The equations of motion with the constraints, the actuators following their laws
+        at the integrator's own time, the masses, gravity, the torsors, the springs and
+        the dampers, the solids the model holds kept still. The method's error must fall
+        with the step at a known order (the analysis extrapolates two runs, assuming
+        order 2 or more), without the analysis's tolerance: the analysis refines.
+
+        Parameters
+        ----------
+        mech : Mechanism
+        times : numpy.ndarray
+            The output times [s], equally spaced, ``times[0]`` the start (one time: the
+            start alone, no step).
+        q0, qd0 : numpy.ndarray
+            (nq,) x, y, fi of every solid and their rates at ``times[0]``, consistent with
+            the constraints.
+        substeps : int
+            Steps per interval of ``times``.
+        verbose : int
+            0: quiet.
+
+        Returns
+        -------
+        Trajectory
+            q, q̇ (len(times), nq), the steps taken, and the integrator's ``error`` when it
+            failed (the analysis then tries again with twice the steps, and quotes the
+            error when the finest run allowed fails too).
+        """
+        raise NotImplementedError(f"the {self.name} backend has no fixed-step integrator "
+                                  f"(integrator is {self.integrator.name})")
+
+    def motion(self, mech, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray,
+               tolerance: float, verbose: int = 0):
+        """The motion from (q0, q̇0) at ``times[0]`` through ``times``, to ``tolerance``
+        (with ``integrator = ADAPTIVE``): what the ``dynamic`` analysis calls instead of
+        refining steps itself (``analyses.dynamic.romberg``).
+
+        The same equations as ``integrate``, integrated to tolerance · (1 + |value|) on
+        every x, y, fi and rate by the backend's own error control.
+
+        Parameters
+        ----------
+        mech : Mechanism
+        times : numpy.ndarray
+            The output times [s], ``times[0]`` the start.
+        q0, qd0 : numpy.ndarray
+            (nq,) x, y, fi of every solid and their rates at ``times[0]``, consistent with
+            the constraints.
+        tolerance : float
+            The analysis's ``[analysis] tolerance``, per unit of value.
+        verbose : int
+            0: quiet.
+
+        Returns
+        -------
+        q, qd : numpy.ndarray
+            (len(times), nq) at ``times``, the first row the start.
+        estimate : float
+            The error estimate reached, per unit of value (above ``tolerance`` when the
+            backend could not meet it: the analysis warns).
+        steps : int
+            The steps of its finest run.
+        """
+        raise NotImplementedError(f"the {self.name} backend has no adaptive integrator "
+                                  f"(integrator is {self.integrator.name})")
+
+
+def _own(cls: type, method: str):
+    """The function that ``cls`` resolves ``method`` to (the most derived definition)."""
+    return next(vars(c)[method] for c in cls.__mro__ if method in vars(c))

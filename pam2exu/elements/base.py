@@ -338,11 +338,11 @@ class Element:
 
     # ---- Exudyn ------------------------------------------------------------------------
     def build(self, ex) -> None:
-        """Add this element's Exudyn items to ``ex`` (a backend.system.ExudynSystem).
+        """Add this element's Exudyn items to ``ex`` (a backend.exudyn.system.ExudynSystem).
 
         Talk to Exudyn only through ``ex`` (``ex.items``, ``ex.add``, the marker helpers,
         ``ex.drive``), with keyword arguments: the same method then writes the element's
-        block of an exported script (``backend.script.ScriptSystem``, ``pam2exu export``).
+        block of an exported script (``backend.exudyn.script.ScriptSystem``, ``pam2exu export``).
         """
         raise NotImplementedError
 

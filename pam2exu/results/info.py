@@ -1,6 +1,7 @@
 """The facts of a run that are not columns: ``Results.info``, one typed field each."""
 from __future__ import annotations
 
+import warnings
 from collections.abc import MutableMapping
 from dataclasses import dataclass, fields
 
@@ -13,7 +14,9 @@ class RunInfo(MutableMapping):
 
     It reads as a dictionary of the facts that are set (``res.info["max_residual"]``,
     ``"equilibrium_error" in res.info``, ``dict(res.info)``); setting a name that is not a
-    field is a KeyError, so that no module can write a fact nobody reads.
+    field is a KeyError, so that no module can write a fact nobody reads. The old name
+    ``exudyn_seconds`` still reads and writes ``backend_seconds``, with a
+    DeprecationWarning (``RENAMED``).
 
     Attributes
     ----------
@@ -26,8 +29,9 @@ class RunInfo(MutableMapping):
         ``analyses.native.condition_numbers``) [-].
     max_residual : float
         Largest constraint residual at the backend's positions [m or rad].
-    exudyn_seconds : float
-        Time in the backend's position solves, building included [s].
+    backend_seconds : float
+        Time in the backend's position solves, building included [s] (``exudyn_seconds``
+        before: deprecated, still read).
     substeps : int
         Position solves per user step, when the motion per step needed more than one.
     max_condition_number : float
@@ -35,8 +39,8 @@ class RunInfo(MutableMapping):
     branch_resolves : int
         Steps solved again by the branch following (kinematic, kinetostatic).
     equilibrium_error : float
-        quasi_static: Exudyn's multipliers against the native equilibrium at the checked
-        steps, relative [-].
+        quasi_static: the backend's multipliers against the native equilibrium at the
+        checked steps, relative [-].
     reactions_from : str
         quasi_static: how the reactions were computed.
     power_balance_error : float
@@ -54,7 +58,7 @@ class RunInfo(MutableMapping):
         dynamic: the estimate of the time integration's error reached, per unit of value
         (|error| / (1 + |value|), largest over coordinates, rates and rows) [-].
     integration_steps : int
-        dynamic: the steps of the finest Exudyn run of a segment.
+        dynamic: the steps of the finest run of a segment (of the backend's integrator).
     undefined : str
         Columns asked for that are NaN by definition at some rows, and why (an
         instantaneous centre where its solid translates: ``points.columns``).
@@ -74,7 +78,7 @@ class RunInfo(MutableMapping):
     redundant_equations: int | None = None
     condition_number: float | None = None
     max_residual: float | None = None
-    exudyn_seconds: float | None = None
+    backend_seconds: float | None = None
     substeps: int | None = None
     max_condition_number: float | None = None
     branch_resolves: int | None = None
@@ -90,6 +94,10 @@ class RunInfo(MutableMapping):
     integration_steps: int | None = None
 
     def _field(self, key: str) -> str:
+        if key in RENAMED:
+            warnings.warn(f"the run fact {key!r} is now {RENAMED[key]!r}: {key!r} is "
+                          "deprecated", DeprecationWarning, stacklevel=3)
+            return RENAMED[key]
         if key not in _NAMES:
             raise KeyError(f"no run fact {key!r}{closest(key, _NAMES)}")
         return key
@@ -104,8 +112,51 @@ class RunInfo(MutableMapping):
         setattr(self, self._field(key), value)
 
     def __delitem__(self, key: str) -> None:
-        self[key]                                   # KeyError when not set
-        setattr(self, key, None)
+        name = self._field(key)
+        if getattr(self, name) is None:
+            raise KeyError(key)
+        setattr(self, name, None)
+
+    def checks(self, backend: str = "") -> list[str]:
+        """The consistency checks the run made, one phrase each (``Results.checks``).
+
+        Parameters
+        ----------
+        backend : str
+            The backend that ran, as messages name it (``Backend.label``; '' when unknown:
+            "the backend").
+
+        Returns
+        -------
+        list of str
+            The constraint residual [m], the backend's multipliers against the native
+            equilibrium (quasi_static, relative), the power balance (kinetostatic, [W]),
+            the reduced stiffness (equilibrium), the integration error (dynamic); those set.
+
+        Examples
+        --------
+        >>> facts = RunInfo(max_residual=3e-15, equilibrium_error=2e-15)
+        >>> facts.checks("Exudyn")[1]
+        "Exudyn's multipliers vs native equilibrium 2.0e-15 (relative)"
+        >>> facts.checks("the natural-coordinate backend")[1][:45]
+        "the natural-coordinate backend's multipliers "
+        """
+        out = []
+        if "max_residual" in self:
+            out.append(f"constraint residual {self['max_residual']:.1e} m")
+        if "equilibrium_error" in self:
+            out.append(f"{backend or 'the backend'}'s multipliers vs native equilibrium "
+                       f"{self['equilibrium_error']:.1e} (relative)")
+        if "power_balance_error" in self:
+            out.append(f"power balance {self['power_balance_error']:.2g} W "
+                       f"(finite-difference tolerance {self['power_balance_tolerance']:.2g} W)")
+        if "stiffness_eigenvalue" in self:
+            value = self["stiffness_eigenvalue"]
+            out.append(f"reduced stiffness {value:.3g} N/m ({'' if value > 0 else 'not '}stable)")
+        if "integration_error" in self:
+            out.append(f"integration error estimate {self['integration_error']:.1e} "
+                       f"(per unit of value, {self['integration_steps']} steps)")
+        return out
 
     def __iter__(self):
         return (name for name in _NAMES if getattr(self, name) is not None)
@@ -115,3 +166,6 @@ class RunInfo(MutableMapping):
 
 
 _NAMES = tuple(f.name for f in fields(RunInfo))
+#: run facts renamed, old name → new: the old name still reads and writes the new one
+#: (deprecated, with a DeprecationWarning)
+RENAMED = {"exudyn_seconds": "backend_seconds"}

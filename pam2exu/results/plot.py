@@ -234,7 +234,7 @@ def _with_units(res: Results, model) -> Results:
     if not any(missing.values()):
         return res
     return Results(res.t, {c: res[c] for c in res.columns}, {**res.units, **missing},
-                   res.analysis, res.model, res.warnings, res.info)
+                   res.analysis, res.model, res.warnings, res.info, res.backend)
 
 
 def _x_column(columns: list[str], x: str, where: str) -> str:

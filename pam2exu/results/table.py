@@ -54,6 +54,8 @@ class Results(Exports, Instants):
         Warnings issued during the run.
     info : RunInfo or dict, optional
         Facts about the run (see Attributes).
+    backend : str, optional
+        The backend that ran, as messages name it (``Backend.label``; '' when unknown).
 
     Attributes
     ----------
@@ -64,6 +66,8 @@ class Results(Exports, Instants):
         The analysis type.
     model : str
         The model's name.
+    backend : str
+        The backend that ran (``'Exudyn'``, ``'the natural-coordinate backend'``).
     warnings : list of str
         Warnings raised during the run (redundant constraints, singular positions, the
         power balance), also issued as Python warnings.
@@ -71,10 +75,11 @@ class Results(Exports, Instants):
         Run facts, read as a dictionary of those the run set: ``dof`` and
         ``redundant_equations`` (rank test at the initial guess), ``condition_number`` of
         the constraint Jacobian at the initial guess, ``max_residual`` (largest constraint
-        residual at the backend's positions [m or rad]), ``exudyn_seconds`` (time in the
-        backend's position solves [s]), and per analysis ``max_condition_number``,
-        ``branch_resolves``, ``equilibrium_error`` (relative), ``reactions_from``,
-        ``power_balance_error`` and ``power_balance_tolerance`` [W] (``RunInfo``).
+        residual at the backend's positions [m or rad]), ``backend_seconds`` (time in the
+        backend's position solves [s]; ``exudyn_seconds``, its old name, still reads it,
+        deprecated), and per analysis ``max_condition_number``, ``branch_resolves``,
+        ``equilibrium_error`` (relative), ``reactions_from``, ``power_balance_error`` and
+        ``power_balance_tolerance`` [W] (``RunInfo``).
 
     Examples
     --------
@@ -91,7 +96,8 @@ class Results(Exports, Instants):
     """
 
     def __init__(self, t, columns: dict[str, np.ndarray], units: dict[str, str] | None = None,
-                 analysis: str = "", model: str = "", warnings=None, info=None):
+                 analysis: str = "", model: str = "", warnings=None, info=None,
+                 backend: str = ""):
         t = np.asarray(t, dtype=float)
         self._names = ["t", *map(one_form, columns)]      # names in one Unicode form
         self._data = np.empty((len(self._names), len(t)))
@@ -100,7 +106,7 @@ class Results(Exports, Instants):
             self._data[i] = values
         self._index = {name: i for i, name in enumerate(self._names)}
         self.units = {"t": "s", **{one_form(k): v for k, v in (units or {}).items()}}
-        self.analysis, self.model = analysis, model
+        self.analysis, self.model, self.backend = analysis, model, backend
         self.warnings = list(warnings or [])
         self.info = RunInfo(**dict(info or {}))
 
@@ -228,7 +234,7 @@ class Results(Exports, Instants):
         """
         names = select_columns(self.columns, patterns)
         return Results(self.t, {n: self[n] for n in names}, self.units, self.analysis,
-                       self.model, self.warnings, self.info)
+                       self.model, self.warnings, self.info, self.backend)
 
     def summary(self, max_rows: int = 60, warnings: bool = True) -> str:
         """A short text table: unit, first and last value, minimum and maximum of each column.
@@ -276,36 +282,15 @@ class Results(Exports, Instants):
         return "\n".join(lines)
 
     def checks(self) -> list[str]:
-        """The consistency checks the analysis ran, one phrase each (from ``info``).
-
-        Returns
-        -------
-        list of str
-            The constraint residual [m], Exudyn's multipliers against the native equilibrium
-            (quasi_static, relative), the power balance (kinetostatic, [W]), the reduced
-            stiffness (equilibrium), the integration error (dynamic); those in ``info``.
+        """The consistency checks the analysis ran, one phrase each: ``RunInfo.checks`` of
+        ``info``, naming the backend that ran (``backend``).
 
         Examples
         --------
         >>> Results([0.0], {}, info={"max_residual": 3e-15}).checks()
         ['constraint residual 3.0e-15 m']
         """
-        info, out = self.info, []
-        if "max_residual" in info:
-            out.append(f"constraint residual {info['max_residual']:.1e} m")
-        if "equilibrium_error" in info:
-            out.append(f"Exudyn's multipliers vs native equilibrium {info['equilibrium_error']:.1e}"
-                       " (relative)")
-        if "power_balance_error" in info:
-            out.append(f"power balance {info['power_balance_error']:.2g} W "
-                       f"(finite-difference tolerance {info['power_balance_tolerance']:.2g} W)")
-        if "stiffness_eigenvalue" in info:
-            value = info["stiffness_eigenvalue"]
-            out.append(f"reduced stiffness {value:.3g} N/m ({'' if value > 0 else 'not '}stable)")
-        if "integration_error" in info:
-            out.append(f"integration error estimate {info['integration_error']:.1e} "
-                       f"(per unit of value, {info['integration_steps']} steps)")
-        return out
+        return self.info.checks(self.backend)
 
     def __repr__(self) -> str:
         return (f"<Results {self.analysis} '{self.model}': {len(self)} rows × "

@@ -153,7 +153,7 @@ def in_angles(res, angles: str | None):
     return type(res)(res.t, {c: res[c] * f if f != 1.0 else res[c]
                              for c, (f, _) in factors.items()},
                      {c: u for c, (_, u) in factors.items()}, res.analysis, res.model,
-                     res.warnings, res.info)
+                     res.warnings, res.info, res.backend)
 
 
 #: how a result CSV in degrees starts its second line, its units line (``units_line``)

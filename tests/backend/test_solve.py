@@ -12,7 +12,8 @@ import pytest
 import pam2exu
 from pam2exu.analyses.quasi_static import checked_steps
 from pam2exu.analyses.job import prepare
-from pam2exu.backend import ExudynSystem, SolveSettings, system
+from pam2exu.backend import ExudynSystem, SolveSettings
+from pam2exu.backend.exudyn import system
 
 
 @pytest.fixture(scope="module")

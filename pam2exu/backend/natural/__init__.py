@@ -16,7 +16,7 @@ from scipy import sparse
 
 from ...errors import SolverError
 from ...kinematics import ANGLES, PER_SOLID, column
-from ..base import Positions
+from ..base import Backend, Integrator, Positions
 from .formulation import Coordinate, Formulation, Frame
 from .dynamics import motion
 from .loads import multipliers
@@ -27,7 +27,7 @@ from .statics import Statics, pose_distance
 __all__ = ["Natural", "NaturalSettings", "Formulation", "Frame", "Coordinate"]
 
 
-class Natural:
+class Natural(Backend):
     """``Backend`` on the natural-coordinate formulation (``registry.BACKENDS['natural']``)."""
 
     name = "natural"
@@ -36,10 +36,10 @@ class Natural:
     Settings = NaturalSettings
     #: it can return velocities and accelerations with the positions
     gives_rates = True
-    #: the static equilibrium of free solids: ``static_equilibrium`` (``statics``); their
-    #: motion: ``motion`` (``dynamics``)
+    #: the static equilibrium of free solids: ``static_equilibrium`` (``statics``)
     moves_free_solids = True
-    integrates = True
+    #: their motion: ``motion`` (``dynamics``), to the tolerance by its own error control
+    integrator = Integrator.ADAPTIVE
 
     def __init__(self):
         self._forms: dict = {}

@@ -1,14 +1,20 @@
 """The Exudyn backend: each solve translates the mechanism (``ExudynSystem``) and runs
-Exudyn's static solver, one load step per time."""
+Exudyn's static solver, one load step per time.
+
+The package is the only code that imports exudyn: the translation (``system``), the time
+laws compiled to Exudyn symbolic functions (``symbolic``), the standalone script writer
+(``script``, ``pam2exu export``) and the time integration of the dynamic analysis
+(``integrate``).
+"""
 from __future__ import annotations
 
 import numpy as np
 
-from .base import Positions
+from ..base import Backend, Integrator, Positions
 from .system import ExudynSystem, SolveSettings
 
 
-class Exudyn:
+class Exudyn(Backend):
     """``Backend`` on Exudyn's static solver (``registry.BACKENDS['exudyn']``)."""
 
     name = "exudyn"
@@ -17,7 +23,8 @@ class Exudyn:
     Settings = SolveSettings
     gives_rates = False
     moves_free_solids = True
-    integrates = True
+    integrator = Integrator.FIXED_STEP
+    integrator_name = "Exudyn's generalized-α"
 
     def solve_positions(self, mech, times, start, settings, *, redundant=False, forces=False,
                         anchor_stiffness=0.0, rates=False) -> Positions:
@@ -43,7 +50,7 @@ class Exudyn:
                                     anchor_stiffness=anchor_stiffness)
 
     def integrate(self, mech, times, q0, qd0, substeps, verbose=0):
-        """``backend.integrate.integrate``: Exudyn's trapezoidal rule (``SolveDynamic``)
-        from (q0, q̇0) through ``times``, ``substeps`` steps per interval."""
+        """See ``Backend.integrate``: Exudyn's generalized-α (``SolveDynamic``) from (q0, q̇0)
+        through ``times``, ``substeps`` steps per interval (``integrate.integrate``)."""
         from .integrate import integrate
         return integrate(mech, times, q0, qd0, substeps, verbose=verbose)

@@ -11,13 +11,12 @@ the pendulum on a driven slider of tests/analyses/test_dynamic.py first-order ac
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 import exudyn as exu
 
-from ..kinematics import pose
+from ...kinematics import pose
+from ..base import Trajectory
 from .symbolic import SymbolicNamespace
 from .system import ExudynSystem
 
@@ -25,16 +24,6 @@ from .system import ExudynSystem
 #: diverged on a free four-bar with index-3 constraints (exudyn 1.13.6); 0.9 damps only
 #: what the step cannot resolve, an error the step refinement of ``dynamic`` controls
 SPECTRAL_RADIUS = 0.9
-
-
-@dataclass
-class Trajectory:
-    """q and q̇ (n, nq) at the output times of one integration, with its step count."""
-
-    q: np.ndarray
-    qd: np.ndarray
-    steps: int
-    error: str | None = None
 
 
 def settings(mech, start: float, end: float, steps: int, verbose: int = 0) -> dict:

@@ -6,7 +6,7 @@ element adds its own items through ``Element.build(system)``, using the helpers 
 Positions over time come from Exudyn's static solver, one load step per time step;
 actuators follow their laws through a pre-step function.
 
-The same construction also writes a standalone script (``backend.script.ScriptSystem``):
+The same construction also writes a standalone script (``backend.exudyn.script.ScriptSystem``):
 items are created only through ``self.mbs`` and ``self.items``, and ``begin`` marks where
 the items of each solid and element start.
 """
@@ -20,7 +20,7 @@ import numpy as np
 import exudyn as exu
 from exudyn import itemInterface as items
 
-from ..kinematics import State, column, pose
+from ...kinematics import State, column, pose
 from .symbolic import ON_GRID, offset_function
 
 log = logging.getLogger("pam2exu")

@@ -15,7 +15,7 @@ import numpy as np
 
 from exudyn import itemInterface
 
-from ..model.solid import Solid
+from ...model.solid import Solid
 from .system import ExudynSystem
 
 #: lines longer than this put one keyword argument per line
