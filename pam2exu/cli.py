@@ -301,7 +301,7 @@ def _check(args) -> int:
     import numpy as np
 
     from .analyses.job import check_mobility, prepare
-    from .analyses.native import require_driven
+    from .analyses.rank import require_driven
     job = prepare(args.model, args.analysis, args.t_end, args.steps, backend=args.backend)
     mech = job.mech
     model = mech.model

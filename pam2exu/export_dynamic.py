@@ -341,8 +341,7 @@ def _drive(system) -> str:
         return ""
     body, stepped = "", ""
     for (obj, par, law, shift), el in zip(system.drivers, system.driver_owners):
-        anchors = ", ".join(f"anc{k + 1} = {getattr(el, f'anc{k + 1}')!r}"
-                            for k in range(len(el.anchors)))
+        anchors = ", ".join(f"anc{k + 1} = {a!r}" for k, a in enumerate(el.given_anchors()))
         value = (f"{law.name}(t, {', '.join(code(c) for c in law.C)})"
                  + (f" + {code(shift)}" if shift else ""))
         comment = f"# {el.name}: {el.summary} ({anchors})"

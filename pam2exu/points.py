@@ -185,11 +185,6 @@ class Coupler:
         return transmission_angle(a, b, normal)
 
 
-def fixed_solids(mech) -> set[int]:
-    """The solids held by a ``fixed`` link (the ground)."""
-    return {el.ref1.solid for el in mech.elements if el.type == "fixed"}
-
-
 def couplers(mech) -> list[Coupler]:
     """The couplers whose transmission angle is defined, in the order of the solids.
 
@@ -198,7 +193,7 @@ def couplers(mech) -> list[Coupler]:
     from a fixed solid; the other, the output, is a rocker (a revolute to a fixed solid) or
     a slider (a prismatic on a fixed solid). Any other arrangement has no column.
     """
-    ground = fixed_solids(mech)
+    ground = mech.held
     around: dict[int, list] = {}
     for el in mech.constraints:
         for s in set(el.solids):
@@ -208,18 +203,19 @@ def couplers(mech) -> list[Coupler]:
         return any(el.drives and set(el.solids) - {x} <= ground and x in el.solids
                    and len(set(el.solids)) == 2 for el in around.get(x, ()))
 
-    def held(x: int, kind: str):
-        """The fixed solid's reference of a ``kind`` element between x and a fixed solid."""
+    def held(x: int, joint):
+        """The fixed solid's reference of an element between x and a fixed solid for which
+        ``joint(element)`` holds (a pin: ``Element.pins``, a slider: ``Element.slides``)."""
         for el in around.get(x, ()):
             others = [r for r in el.refs if r.solid != x]
-            if el.type == kind and len(others) == 1 and others[0].solid in ground:
+            if joint(el) and len(others) == 1 and others[0].solid in ground:
                 return others[0]
         return None
 
     out = []
     for s in range(len(mech.solids)):
         joints = around.get(s, [])
-        if s in ground or len(joints) != 2 or any(el.type != "revolute" for el in joints):
+        if s in ground or len(joints) != 2 or not all(el.pins for el in joints):
             continue
         ends = []
         for el in joints:
@@ -231,7 +227,8 @@ def couplers(mech) -> list[Coupler]:
         if len(inputs) != 1:
             continue
         (pin_in, _), (pin_out, x_out) = ends[inputs[0]], ends[1 - inputs[0]]
-        pivot, guide = held(x_out, "revolute"), held(x_out, "prismatic")
+        pivot = held(x_out, lambda el: el.pins)
+        guide = held(x_out, lambda el: el.slides)
         if pivot is not None or guide is not None:
             out.append(Coupler(s, pin_in, pin_out, pivot, None if pivot is not None else guide))
     return out

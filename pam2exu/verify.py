@@ -28,7 +28,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import ModelError, SolverError, TranslationError, closest
-from .kinematics import column
 from .model import Model, load
 from .registry import BACKENDS
 from .results.compare import compare
@@ -393,15 +392,10 @@ def _condition(mech, res: Results) -> float:
     """The worst finite condition number of a run: those it reports, and those at (at most
     SAMPLES of) its rows when it has the positions of every solid."""
     values = [res.info.get("max_condition_number"), res.info.get("condition_number")]
-    names = [f"{s.name}.{v}" for s in mech.solids for v in ("x", "y", "fi")]
-    if mech.n_equations and all(n in res.columns for n in names):
-        from .analyses.native import condition_numbers
+    if mech.n_equations and all(n in res.columns for n in mech.coordinate_columns()):
+        from .analyses.rank import condition_numbers
         rows = np.unique(np.linspace(0, len(res) - 1, min(len(res), SAMPLES)).astype(int))
-        q = np.empty((len(rows), mech.nq))
-        for i, s in enumerate(mech.solids):
-            for k, v in enumerate(("x", "y", "fi")):
-                q[:, column(i, k)] = res[f"{s.name}.{v}"][rows]
-        values += list(condition_numbers(mech, res.t[rows], q))
+        values += list(condition_numbers(mech, res.t[rows], mech.coordinates(res, rows=rows)))
     finite = [float(v) for v in values if v is not None and np.isfinite(v)]
     return max(finite, default=1.0)
 

@@ -5,7 +5,7 @@ configuration. Near a change point (a parallelogram whose links become collinear
 four-bar passing close to one) that start can be nearer to another assembly branch, and
 Newton converges there: the positions still close, but the mechanism has switched branch.
 The velocities tell: on a smooth motion they change by O(dt³) more than the accelerations
-predict between two steps (``native.continuity_defect``); a branch switch makes them jump.
+predict between two steps (``continuity.continuity_defect``); a branch switch makes them jump.
 
 Where they jump, the step is solved again by the backend, its Newton iteration now started from
 the Taylor predictor q + h q̇ + h²/2 q̈ of the last good step, which lies on the branch
@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ConditionWarning, SolverError
 from ..kinematics import ANGLES
-from . import native
+from . import continuity, native, rank
 from .checks import check_residual
 from .failure import motion_per_step, position_failure, singular_error
 from .job import Job, warn
@@ -98,11 +98,11 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
         if singular[0] or (singular.any() and not singular_ok):
             raise singular_error(job, int(np.argmax(singular)))
         scale = _scales(mech, qd)
-        defect = native.continuity_defect(tk, qd, qdd, scale, breakpoints)
+        defect = continuity.continuity_defect(tk, qd, qdd, scale, breakpoints)
         k = _first_jump(defect, singular, verified)
         while k is not None:         # numerically singular steps: their rates are round-off
             near = [i for i in (k - 1, k) if i > 0 and not singular[i]]
-            at = [i for i, c in zip(near, native.condition_numbers(mech, tk[near], qk[near]))
+            at = [i for i, c in zip(near, rank.condition_numbers(mech, tk[near], qk[near]))
                   if c > SINGULAR]
             if not at:
                 break
@@ -195,7 +195,7 @@ def _unwrap(mech, t, q, qd, solved):
     """q with angles that jumped by whole turns at a step (Newton at a singular position)
     brought back, when the constraints still hold after it (they are 2π-periodic in the
     angles of joints, not in those of actuators or transmissions)."""
-    turns = native.turns_jumped(t, q[:solved], qd, len(mech.solids))
+    turns = continuity.turns_jumped(t, q[:solved], qd, len(mech.solids))
     if not turns.any():
         return q
     out = q.copy()
@@ -216,7 +216,7 @@ def _track(job: Job, j0: int, k1: int, start, redundant: bool, count: int = SUBS
 def _unturn(mech, t, part, solved, start):
     """``part`` with whole turns removed from its angles so that it starts nearest
     ``start`` (where the constraints still hold after it)."""
-    turns = native.whole_turns(mech, float(t[0]), part[0], start)
+    turns = continuity.whole_turns(mech, float(t[0]), part[0], start)
     if not turns.any():
         return part
     out = part.copy()
@@ -301,7 +301,7 @@ def _warn_ill_conditioned(job: Job, q, singular, near=()) -> None:
     steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), samples)).astype(int),
                             np.asarray(near, dtype=int)[:samples]])
     steps = steps[~singular[steps]]
-    condition = native.condition_numbers(mech, t[steps], q[steps])
+    condition = rank.condition_numbers(mech, t[steps], q[steps])
     i = int(np.argmax(condition))
     worst = float(condition[i])
     job.info["max_condition_number"] = worst

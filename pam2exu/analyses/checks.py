@@ -6,7 +6,7 @@ import numpy as np
 
 from ..backend import Positions
 from ..errors import TranslationError
-from . import native
+from . import native, rank
 from .failure import position_failure
 from .job import Job
 
@@ -39,7 +39,7 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
             # singular Jacobian) can stop on a configuration that violates them; from the
             # start when they tie held solids only, which no backend moves
             before = q[max(first - 1, 0)]
-            disagreement, _ = native.contradiction(mech, float(t[first]), before)
+            disagreement, _ = rank.contradiction(mech, float(t[first]), before)
             if disagreement > tol:
                 raise position_failure(job, Positions(
                     q, first, "no error (it stopped on a configuration that violates the "

@@ -188,7 +188,7 @@ class Closures:
         self.mech = mech
         self.start = State([0.0], np.asarray(start, dtype=float)[None])
         #: the clearance elements, in element order, and the names of their parameters
-        self.elements = [el for el in mech.constraints if getattr(el, "clearance", False)]
+        self.elements = [el for el in mech.constraints if el.clearance]
         self.names = [f"{el.name}.{var.name}" for el in self.elements
                       for var in el.clearance_parameters]
         self.p, self.nq, self.m = len(self.names), mech.nq, mech.n_equations
@@ -237,7 +237,7 @@ class Closures:
         Fq = np.zeros((1, self.m, self.nq))
         W = np.zeros((1, self.nq, self.nq))
         for el, rows in zip(self.at(t), self.mech.rows):
-            if getattr(el, "clearance", False):
+            if el.clearance:
                 v, target = el.clearance_constraint(st, self.start)
             else:
                 v, target = el.constraint(st)

@@ -77,8 +77,7 @@ def account(model, res: Results) -> Results:
         model = load(model)
     require_rates(res.analysis, model.source)
     mech = model.mechanism()
-    names = [(s.name, k) for s in mech.solids for k in ("x", "y", "fi")]
-    wanted = [f"{n}.{d}{k}" for d in ("", "D", "DD") for n, k in names] + [
+    wanted = [c for d in ("", "D", "DD") for c in mech.coordinate_columns(d)] + [
         f"{el.name}.{next(w for w in el.wrench if w is not None)}" for el in mech.drivers]
     missing = [c for c in wanted if c not in res]
     if missing:
@@ -86,8 +85,7 @@ def account(model, res: Results) -> Results:
                          f"forces, and the result has no {', '.join(missing[:4])}"
                          f"{' …' if len(missing) > 4 else ''}: run without --outputs",
                          model.source)
-    q, qd, qdd = (np.column_stack([res[f"{n}.{d}{k}"] for n, k in names])
-                  for d in ("", "D", "DD"))
+    q, qd, qdd = (mech.coordinates(res, d) for d in ("", "D", "DD"))
     st = State(res.t, q, qd)
     applied = force_pass.applied_forces(mech, st, damping=True)
     _, kinetic = force_pass.inertia_forces(mech, st, qdd)

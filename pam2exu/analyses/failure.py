@@ -5,7 +5,7 @@ from __future__ import annotations
 from .. import registry
 from ..backend import Positions
 from ..errors import SolverError
-from . import closest, loops, native
+from . import closest, loops, native, rank
 from .job import Job
 
 
@@ -34,14 +34,14 @@ def position_failure(job: Job, found: Positions) -> SolverError:
     violated = ", ".join(f"{name} by {r:.3g}" for name, r in worst)
     drivers = ", ".join(f"'{e.name}'" for e in mech.drivers)
     elements = tuple(n for n, _ in worst)
-    disagreement, among = native.contradiction(mech, t, start)
+    disagreement, among = rank.contradiction(mech, t, start)
     step = _step_text(job, solved)
     if worst and disagreement > can_hold:
         since = (f"at t = {t:.6g} s" if solved == 0 else
                  f"from t = {float(times[solved - 1]):.6g} s to t = {t:.6g} s")
         names = ", ".join(f"'{n}'" for n in among)
         concerned = [e for e in mech.constraints if e.name in among]
-        extra = native.culprit(mech, t, start, among, disagreement)
+        extra = rank.culprit(mech, t, start, among, disagreement)
         bar = loops.bar_of(mech, extra) if extra is not None else None
         if bar is not None:           # the extra bar: the last one the file adds
             solid, concerned = bar

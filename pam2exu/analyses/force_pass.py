@@ -208,7 +208,7 @@ def _solve_transposed(mech, J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     columns M (one smaller solve), then λ_fixed = rhs_H − Cq[r, H]ᵀ λ_r.
     """
     rows, cols = native.moving(mech)
-    fixed = [(rr.start + k, column(el.ref1.solid, k))
+    fixed = [(rr.start + k, column(el.holds, k))
              for el, rr in zip(mech.constraints, mech.rows) if el.grounds for k in range(3)]
     held = [h for _, h in fixed]
     if len(rows) != len(cols) or len(set(held)) != len(held):

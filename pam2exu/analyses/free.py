@@ -1,11 +1,11 @@
 """The motions the constraints leave free at a configuration, and the solids they move:
 what the equilibrium analysis's stability check and the dynamic analysis's inertia check
-work on (``native.mobility`` counts them for the rank test of every analysis)."""
+work on (``rank.mobility`` counts them for the rank test of every analysis)."""
 from __future__ import annotations
 
 import numpy as np
 
-from .native import _rank
+from .rank import _rank
 
 
 def free_motions(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> np.ndarray:

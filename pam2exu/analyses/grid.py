@@ -51,7 +51,7 @@ class Plan:
 
 def driver_unit(el) -> tuple[str, float]:
     """(unit, most motion per solve step) of an actuator: rad, or m for a linear one."""
-    return ("m", MAX_LENGTH_STEP) if el.type == "linear_actuator" else ("rad", MAX_ANGLE_STEP)
+    return ("rad", MAX_ANGLE_STEP) if el.angular else ("m", MAX_LENGTH_STEP)
 
 
 def motion_per_step(law, times: np.ndarray) -> float:

@@ -19,7 +19,7 @@ from ..model.solid import SOLID_OUTPUTS
 from ..model.variation import pace_problems
 from ..results import Results, select_columns
 from ..results.info import RunInfo
-from . import grid, native
+from . import grid, rank
 
 
 @dataclass
@@ -68,7 +68,7 @@ def available_columns(mech, analysis: str) -> dict[str, Var]:
                 out[f"{el.name}.{var.name}"] = var
     if CLEARANCE in kind.levels:                 # the joints with clearance = true
         for el in mech.elements:
-            if getattr(el, "clearance", False):
+            if el.clearance:
                 for var in el.clearance_parameters + el.clearance_derived:
                     out[f"{el.name}.{var.name}"] = var
     return out
@@ -77,7 +77,7 @@ def available_columns(mech, analysis: str) -> dict[str, Var]:
 def derived_columns(mech) -> list[tuple[str, Var]]:
     """The opt-in columns (``points``), in order: per solid its instantaneous centre (if it
     is not fixed), its transmission angle (if it is a coupler), then its points' motion."""
-    ground, coupled = points.fixed_solids(mech), {c.solid for c in points.couplers(mech)}
+    ground, coupled = mech.held, {c.solid for c in points.couplers(mech)}
     out = []
     for i, s in enumerate(mech.solids):
         if i not in ground:
@@ -136,25 +136,25 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
     return job
 
 
-def check_mobility(job: Job, q0: np.ndarray, need_driven: bool | None = None) -> native.Mobility:
+def check_mobility(job: Job, q0: np.ndarray, need_driven: bool | None = None) -> rank.Mobility:
     """Rank test at the initial guess, before the backend is called (``warn_redundant``
     follows once positions are solved); ``need_driven`` (default: what the analysis
     declares, ``AnalysisType.driven``) raises MobilityError for a DOF not driven."""
     if need_driven is None:
         need_driven = registry.ANALYSES[job.analysis].driven
-    native.require_defined(job.mech, float(job.times[0]), q0)
-    mob = native.mobility(job.mech, float(job.times[0]), q0)
+    rank.require_defined(job.mech, float(job.times[0]), q0)
+    mob = rank.mobility(job.mech, float(job.times[0]), q0)
     job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
                     condition_number=mob.condition)
     if need_driven:
-        native.require_driven(job.mech, mob, job.analysis)
+        rank.require_driven(job.mech, mob, job.analysis)
     return mob
 
 
 def warn_redundant(job: Job, q: np.ndarray) -> None:
     """Warn once about redundant constraints, naming the elements of the self-stress found
     at the first solved configuration (where the rank test is exact)."""
-    mob = native.mobility(job.mech, float(job.times[0]), q)
+    mob = rank.mobility(job.mech, float(job.times[0]), q)
     if not mob.redundant or mob.dof:
         return
     names = ", ".join(f"'{n}'" for n in mob.redundant_elements)

@@ -1,7 +1,8 @@
 """Which loop of a mechanism cannot close, and which lengths conflict (failure diagnosis).
 
-The solids and the joints that tie points together (revolute, prismatic, pin_slot and
-linear_actuator) form a graph; the solids held by fixed links are one node, the frame. A
+The solids and the elements that tie points together (``Element.ties``: revolute, prismatic,
+pin_slot and linear_actuator) form a graph; the solids held by fixed links
+(``Mechanism.held``) are one node, the frame. A
 joint that cannot hold closes a loop: the shortest cycle through it. Around a loop each
 solid contributes the distance between the two points its joints use (its *link*), and a
 linear actuator its distance f(t). A loop of pins and actuators closes only if
@@ -27,8 +28,6 @@ import numpy as np
 
 from ..kinematics import rotate
 
-#: element types whose equations tie two points (the edges of the loop graph)
-TIES = ("revolute", "prismatic", "pin_slot", "linear_actuator")
 #: the node of the solids held by fixed links
 FRAME = -1
 
@@ -46,24 +45,19 @@ class Edge:
 
 def _point(ref) -> tuple[float, float]:
     """The local point of an anchor (a point, or a line's defining point)."""
-    return tuple(getattr(ref, "local", getattr(ref, "point", (0.0, 0.0))))
+    return tuple(ref.anchor_point)
 
 
 def edges(mech) -> list[Edge]:
-    """The ties of the mechanism, in the order of its elements."""
+    """The ties of the mechanism (``Element.ties``), in the order of its elements."""
     return [Edge(el, el.ref1.solid, el.ref2.solid, _point(el.ref1), _point(el.ref2))
-            for el in mech.constraints if el.type in TIES]
-
-
-def held(mech) -> set[int]:
-    """The solids held by fixed links (they form the frame)."""
-    return {el.ref1.solid for el in mech.constraints if el.grounds}
+            for el in mech.constraints if el.ties]
 
 
 def cycle_through(mech, element) -> list[tuple[Edge, bool]] | None:
     """The shortest loop through ``element``: its edges in order, each with True when it
     is walked from its solid a to its solid b; None when the element closes no loop."""
-    frame = held(mech)
+    frame = mech.held
     node = (lambda s: FRAME if s in frame else s)
     graph = edges(mech)
     start = next((e for e in graph if e.element is element), None)
@@ -102,13 +96,13 @@ def known_poses(mech, t: float) -> dict[int, tuple[np.ndarray, float]]:
     actuators alone: the held solids, then every solid an actuator turns relative to a
     known one and a revolute pins to a known one."""
     poses = {i: (np.array([float(s.x), float(s.y)]), float(s.fi))
-             for i, s in enumerate(mech.solids) if i in held(mech)}
+             for i, s in enumerate(mech.solids) if i in mech.held}
     angles = {i: fi for i, (_, fi) in poses.items()}
     changed = True
     while changed:
         changed = False
         for el in mech.drivers:
-            if el.type != "angular_actuator":
+            if not el.angular:
                 continue
             f = float(el.time_law()(np.array([t]))[0][0])
             s1, s2 = el.ref1.solid, el.ref2.solid
@@ -117,7 +111,7 @@ def known_poses(mech, t: float) -> dict[int, tuple[np.ndarray, float]]:
             elif s2 in angles and s1 not in angles:
                 angles[s1], changed = angles[s2] - f, True
         for el in mech.constraints:
-            if el.type != "revolute":
+            if not el.pins:
                 continue
             for mine, other in ((el.ref2, el.ref1), (el.ref1, el.ref2)):
                 if mine.solid in angles and mine.solid not in poses and other.solid in poses:
@@ -172,13 +166,9 @@ def _walk(mech, cycle):
 
 
 def _length(step, t: float) -> float | None:
-    """What an edge adds to the loop: 0 (a pin), f(t) (an actuator), None (it slides)."""
-    el = step[0].element
-    if el.type == "revolute":
-        return 0.0
-    if el.type == "linear_actuator":
-        return float(el.time_law()(np.array([t]))[0][0])
-    return None
+    """What an edge adds to the loop (``Element.tie_length``): 0 (a pin), f(t) (an actuator),
+    None (it slides)."""
+    return step[0].element.tie_length(t)
 
 
 @dataclass(frozen=True)
@@ -221,7 +211,7 @@ def describe_cycle(mech, cycle, t: float, poses, by: str) -> Diagnosis:
     ``by`` (words) put the solids of ``poses`` (index → (origin, fi))."""
     members = tuple(e.element.name for e, _ in cycle)
     steps, nodes = _walk(mech, cycle)
-    frame = held(mech)
+    frame = mech.held
     names = [_name(mech, steps[0][1])]
     for (e, *_), node in zip(steps, nodes):
         names += [f"–{e.element.name}–", _name(mech, node.solid_in)]
@@ -303,10 +293,10 @@ def _reach(steps, nodes, poses, t: float, by: str) -> str | None:
 def bar_of(mech, element) -> tuple[int, list] | None:
     """(solid, its two ties) when the tie ``element`` holds a binary bar: one of its two
     solids, not held, that has exactly two ties (the fifth bar of a parallelogram)."""
-    if element.type not in TIES:
+    if not element.ties:
         return None
     graph = edges(mech)
-    frame = held(mech)
+    frame = mech.held
     for solid in (element.ref2.solid, element.ref1.solid):
         ties = [e.element for e in graph if solid in (e.a, e.b)]
         if solid not in frame and len(ties) == 2:
@@ -395,7 +385,7 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
     from ..kinematics import State
 
     setters = [el for el in mech.constraints if el.drives or el.grounds]
-    placed = held(mech)
+    placed = set(mech.held)
     built: set = set()
     closed: set = set()       # the ties of the loops that closed
     units = _units(mech)

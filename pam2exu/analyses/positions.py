@@ -10,7 +10,7 @@ from ..backend import Positions
 from ..elements import ACCELERATION, VELOCITY
 from ..kinematics import ANGLES
 from ..progress import Progress
-from . import native
+from . import continuity, native, rank
 from .checks import check_residual
 from .failure import position_failure, singular_error
 from .job import Job, warn_redundant
@@ -105,7 +105,7 @@ def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nda
     if not found.solved:
         raise position_failure(job, found)
     q0 = found.q[0].copy()
-    q0[ANGLES] -= 2 * np.pi * native.whole_turns(mech, float(job.times[0]), q0, guess)
+    q0[ANGLES] -= 2 * np.pi * continuity.whole_turns(mech, float(job.times[0]), q0, guess)
     return q0
 
 
@@ -135,5 +135,5 @@ def velocities(job: Job, q: np.ndarray, redundant: bool):
     if qdd is not None:
         bad |= ~np.isfinite(qdd).all(axis=1)
     if bad.any():
-        raise singular_error(job, min(int(np.argmax(bad)), native.first_singular(mech, t, q)))
+        raise singular_error(job, min(int(np.argmax(bad)), rank.first_singular(mech, t, q)))
     return qd, qdd

@@ -77,6 +77,11 @@ class LinearActuator(Actuator):
     )
     equations = 1
     wrench = ("Força", None, None)
+    ties = True
+
+    def tie_length(self, t):
+        """f(t): the distance PQ its law sets."""
+        return float(self.time_law()(np.array([t]))[0][0])
 
     def report_frame(self, st):
         """At Q, x from P to Q (so that a positive force pushes Q away from P)."""

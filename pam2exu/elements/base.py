@@ -192,6 +192,20 @@ class Element:
     grounds: ClassVar[bool] = False
     #: the element drives a coordinate by a time law f(t) (an actuator: ``time_law``)
     drives: ClassVar[bool] = False
+    #: its equations tie a point of solid 1 to a point of solid 2 (a line's defining point,
+    #: for a line anchor): an edge of the graph of the mechanism's loops (``analyses.loops``);
+    #: ``tie_length`` says at what distance
+    ties: ClassVar[bool] = False
+    #: its two points coincide: the two solids can only turn about them (a pin joint): what
+    #: hinges gears to their arm (``Transmission``), places a solid whose angle is known
+    #: (``analyses.loops``) and makes a coupler's pivot (``points.couplers``)
+    pins: ClassVar[bool] = False
+    #: solid 2 can only slide along solid 1's line, without turning (a slider: the output
+    #: of a slider-crank's coupler, ``points.couplers``)
+    slides: ClassVar[bool] = False
+    #: ``clearance = true``: the joint has clearance parameters (shared/spec/clearance.md);
+    #: a key of the types with ``clearance_parameters`` only, always False for the others
+    clearance: ClassVar[bool] = False
 
     #: 1-based position in the file's [[element]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
@@ -269,10 +283,25 @@ class Element:
         self.ref1 = refs[0] if refs else None
         self.ref2 = refs[1] if len(refs) > 1 else None
 
+    def given_anchors(self) -> tuple:
+        """Its anchors as the model gives them: (anc1, anc2), one per entry of ``anchors``."""
+        return tuple(getattr(self, f"anc{k + 1}") for k in range(len(self.anchors)))
+
     @property
     def solids(self) -> tuple[int, ...]:
         """Indices of the solids the element acts on."""
         return tuple(r.solid for r in self.refs)
+
+    @property
+    def holds(self) -> int | None:
+        """The solid it holds at its pose (``grounds``: its first solid), None for the others."""
+        return self.ref1.solid if self.grounds else None
+
+    def tie_length(self, t: float) -> float | None:
+        """The distance [m] it keeps between the two points it ties (``ties``) at time t:
+        0 for a pin, f(t) for a distance actuator, None when the points slide (or it ties
+        none)."""
+        return None
 
     def angle_values(self, key: str) -> tuple[bool, ...]:
         """Which values of ``key`` are angles or angular rates (``Param.angles``; an

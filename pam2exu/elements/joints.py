@@ -79,6 +79,7 @@ class Revolute(Element):
     )
     equations = 2
     wrench = ("Fx", "Fy", None)
+    ties = pins = True
     clearance: bool = False
     params = {"clearance": _CLEARANCE}
     clearance_parameters = (
@@ -90,6 +91,10 @@ class Revolute(Element):
     #: C = P2 − P1 (``constraint``), F = C − j: the contract's P1 − P2 + j = 0
     clearance_terms = ((-1.0, 0.0), (0.0, -1.0))
     clearance_derived = (Var("jr", "m", CLEARANCE, "√(jx² + jy²): the radial clearance"),)
+
+    def tie_length(self, t):
+        """0: the two points coincide."""
+        return 0.0
 
     def clearance_derived_values(self, values):
         """jr = √(jx² + jy²)."""
@@ -145,6 +150,7 @@ class Prismatic(Element):
     )
     equations = 2
     wrench = (None, "Fnormal", "Mz")
+    ties = slides = True
     clearance: bool = False
     params = {"clearance": _CLEARANCE}
     clearance_parameters = (
@@ -220,6 +226,7 @@ class PinSlot(Element):
                    "force the guide (solid 1) exerts on the pin (solid 2), normal to the guide"),)
     equations = 1
     wrench = (None, "Fnormal", None)
+    ties = True
     clearance: bool = False
     params = {"clearance": _CLEARANCE}
     clearance_parameters = (
@@ -309,10 +316,10 @@ class Transmission(Element):
         return []
 
     def candidate_arms(self, scope) -> list[int]:
-        """Solids hinged by revolute joints to both solid 1 and solid 2."""
+        """Solids hinged by pin joints (``pins``: revolutes) to both solid 1 and solid 2."""
         hinged = {}
         for el in scope.elements:
-            if isinstance(el, Revolute) and el is not self:
+            if el.pins and el is not self:
                 try:
                     a, b = (scope.point(x).solid for x in (el.anc1, el.anc2))
                 except (LookupError, TypeError):

@@ -13,6 +13,8 @@ from __future__ import annotations
 import copy
 import math
 
+import numpy as np
+
 from ..elements import Element
 from ..errors import Problem, echo
 from ..limits import is_number
@@ -49,7 +51,7 @@ def element_in_radians(element: Element) -> Element:
         flags, value = element.angle_values(key), getattr(element, key)
         if not any(flags) or value is None:
             continue
-        if isinstance(value, (list, tuple)) or hasattr(value, "__len__"):
+        if isinstance(value, (list, tuple, np.ndarray)):
             value = [degrees_to_radians(v) if k < len(flags) and flags[k] else v
                      for k, v in enumerate(value)]
         elif flags[0]:

@@ -62,7 +62,7 @@ def html(model) -> str:
         points = ", ".join(s.points)
         rows.append(f"<tr><td>{e(s.name)}</td><td>solid</td><td>{e(points)}</td></tr>")
     for el in model.elements:
-        anchors = ", ".join(str(getattr(el, f"anc{k + 1}")) for k in range(len(el.anchors)))
+        anchors = ", ".join(str(a) for a in el.given_anchors())
         rows.append(f"<tr><td>{e(el.name)}</td><td>{e(el.type)}</td><td>{e(anchors)}</td></tr>")
     picture = _DRAWINGS[-1](model) if _DRAWINGS else ""
     return (f"<div class='pam2exu-model'><p><b>{head}</b></p>"

@@ -49,6 +49,11 @@ class Mechanism:
         angles in radians.
     constraints : list of Element
         The elements that add constraint equations, in order.
+    drivers : list of Element
+        The actuators among them (``Element.drives``), in order.
+    held : frozenset of int
+        The indices of the solids held at their pose by a fixed link (``Element.grounds``,
+        ``Element.holds``): the ground.
     rows : list of slice
         The rows of each constraint element's equations in C(q, t) = 0.
     n_equations : int
@@ -74,6 +79,8 @@ class Mechanism:
         self.constraints = [e for e in self.elements if e.equations]
         #: the actuators: constraint elements that drive a coordinate by a time law
         self.drivers = [e for e in self.constraints if e.drives]
+        #: the solids held at their pose by a fixed link (``Element.holds``): the ground
+        self.held = frozenset(e.holds for e in self.constraints if e.grounds)
 
         rows, start = [], 0
         for el in self.constraints:
@@ -106,7 +113,7 @@ class Mechanism:
             The bound variation of that point or line (``offsets(t)``: u(t) − u0 and
             u'(t)), or None when it does not vary.
         """
-        return self._varied.get((element.anchors[k], getattr(element, f"anc{k + 1}")))
+        return self._varied.get((element.anchors[k], element.given_anchors()[k]))
 
     @property
     def name(self) -> str:
@@ -133,6 +140,32 @@ class Mechanism:
         """
         import numpy as np
         return np.array([float(v) for s in self.solids for v in (s.x, s.y, s.fi)])
+
+    def coordinate_columns(self, rate: str = "") -> list[str]:
+        """The result columns of q (``rate`` "") or of its rates q̇ ("D") or q̈ ("DD"), in
+        the order of q: ``<solid>.x``, ``<solid>.y``, ``<solid>.fi`` of each solid."""
+        return [f"{s.name}.{rate}{k}" for s in self.solids for k in ("x", "y", "fi")]
+
+    def coordinates(self, res, rate: str = "", rows=slice(None)):
+        """q (or q̇, q̈: ``rate`` "D", "DD") from the columns of a result table, in radians.
+
+        Parameters
+        ----------
+        res : Results
+            A run of this mechanism with the columns ``coordinate_columns(rate)``, angles
+            in radians.
+        rate : str
+            "" for x, y, fi; "D" for their first, "DD" for their second time derivatives.
+        rows : slice or array of int
+            The rows to take (default all).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (rows, nq): the columns side by side, solid by solid (``kinematics.pose``).
+        """
+        import numpy as np
+        return np.column_stack([res[c][rows] for c in self.coordinate_columns(rate)])
 
     def initial_qd(self):
         """The initial-velocity guess q̇0 from the solids' Dx, Dy, Dfi (``dynamic``).

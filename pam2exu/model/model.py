@@ -210,7 +210,7 @@ class Model:
         if element.position is None:
             element.position = len(self.elements) + 1
         if element.name is None:
-            same = sum(1 for e in self.elements if e.type == element.type)
+            same = sum(1 for e in self.elements if type(e) is type(element))
             element.name = f"{element.type}{same + 1}"
         self.elements.append(element)
         return element

@@ -110,6 +110,11 @@ class SolidRef:
     solid: int
     label: str
 
+    @property
+    def anchor_point(self) -> tuple[float, float]:
+        """The point the anchor stands for, local coordinates [m]: the solid's origin."""
+        return (0.0, 0.0)
+
 
 @dataclass(frozen=True)
 class PointRef:
@@ -118,6 +123,11 @@ class PointRef:
     solid: int
     local: tuple[float, float]
     label: str
+
+    @property
+    def anchor_point(self) -> tuple[float, float]:
+        """The point the anchor stands for, local coordinates [m]: the point itself."""
+        return self.local
 
 
 @dataclass(frozen=True)
@@ -128,6 +138,11 @@ class LineRef:
     point: tuple[float, float]
     angle: float
     label: str
+
+    @property
+    def anchor_point(self) -> tuple[float, float]:
+        """The point the anchor stands for, local coordinates [m]: the line's defining point."""
+        return self.point
 
     @property
     def direction(self) -> tuple[float, float]:

@@ -311,6 +311,6 @@ def variation_problems(variations: list[Variation], scope: Scope, elements) -> \
 def _anchored(elements) -> set[tuple[str, str]]:
     """(kind, "solid.item") of every point and line a constraint element anchors."""
     return {(kind, anchor) for el in elements if el.equations
-            for k, kind in enumerate(el.anchors) if kind in ("point", "line")
-            and isinstance(anchor := getattr(el, f"anc{k + 1}"), str)}
+            for kind, anchor in zip(el.anchors, el.given_anchors())
+            if kind in ("point", "line") and isinstance(anchor, str)}
 

@@ -170,8 +170,7 @@ def _mark_unmet(scene, q, size: float) -> list[str]:
         if np.max(np.abs(residual[rows]), initial=0.0) <= 1e-9 * max(size, 1.0):
             continue
         unmet.append(el.name)
-        points = [st.point(r.solid, getattr(r, "local", getattr(r, "point", (0.0, 0.0))))
-                  .value[0] for r in getattr(el, "refs", ())]
+        points = [st.point(r.solid, r.anchor_point).value[0] for r in el.refs]
         with scene.pen.owner(f"{el.type}:{el.name}"):
             scene.pen.unmet(points)
     return unmet

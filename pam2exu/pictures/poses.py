@@ -81,8 +81,7 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
     else:
         res = run(model, analysis=analysis, t_end=t_end, steps=steps, outputs=list(_POSE),
                   angles="rad")
-    q = np.column_stack([res[f"{s.name}.{k}"] for s in mech.solids for k in ("x", "y", "fi")])
-    return mech, np.array(res.t), q
+    return mech, np.array(res.t), mech.coordinates(res)
 
 
 def pose(model, t: float = 0.0):

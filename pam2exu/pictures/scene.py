@@ -63,9 +63,8 @@ def extent(mech, q_all, extra=()) -> tuple[np.ndarray, np.ndarray]:
         for p in s.points.values():
             pts.append(st.point(i, [float(v) for v in p]).value)
     for el in mech.elements:                   # line points, anchors given as bare solids
-        for ref in getattr(el, "refs", ()):
-            local = getattr(ref, "local", getattr(ref, "point", (0.0, 0.0)))
-            pts.append(st.point(ref.solid, local).value)
+        for ref in el.refs:
+            pts.append(st.point(ref.solid, ref.anchor_point).value)
     if len(extra):
         pts.append(np.asarray(extra, dtype=float).reshape(-1, 2))
     pts = np.vstack(pts)
@@ -99,10 +98,9 @@ class Scene:
                                 if s.points else np.zeros((0, 2))) for s in mech.solids]
         lo, hi = self._box(q_all, extra)
         self.size = float(max(hi - lo)) or 1.0
-        grounded = {el.ref1.solid for el in mech.elements if el.grounds}
-        moving = [i for i in range(len(mech.solids)) if i not in grounded]
+        moving = [i for i in range(len(mech.solids)) if i not in mech.held]
         colors = {i: PALETTE[k % len(PALETTE)] for k, i in enumerate(moving)}
-        self.pen = Pen(ax, self.size, grounded, colors)
+        self.pen = Pen(ax, self.size, mech.held, colors)
         # the box with a margin, widened to the shape of the axes (the figure less room
         # for the labels and the title), then equal scales by shrinking the axes a little
         lo, hi = lo - MARGIN * self.size, hi + MARGIN * self.size

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kinematics import State, perp
-from ..points import fixed_solids, instantaneous_centre, point_motion
+from ..points import instantaneous_centre, point_motion
 from ..results.plot import PictureError
 
 #: the longest arrow, as a fraction of the mechanism's size (the larger side of its box)
@@ -87,10 +87,6 @@ def _row(model, t: float, analysis: str, outputs):
     return res, 0
 
 
-def _pose_columns(mech):
-    return [f"{s.name}.{k}" for s in mech.solids for k in ("x", "y", "fi")]
-
-
 def at_instant(model, t: float, kind: str):
     """(mechanism, q (3·solids,), Arrows) at time t for ``kind`` 'v', 'a' or 'F'.
 
@@ -106,12 +102,12 @@ def at_instant(model, t: float, kind: str):
     if kind == "F":
         return _forces(model, mech, t)
     rates = ("Dx", "Dy", "Dfi") + (("DDx", "DDy", "DDfi") if kind == "a" else ())
-    res, k = _row(model, t, "kinematic", _pose_columns(mech)
+    res, k = _row(model, t, "kinematic", mech.coordinate_columns()
                   + [f"{s.name}.{r}" for s in mech.solids for r in rates])
-    q = np.array([res[c][k] for c in _pose_columns(mech)])
+    q = mech.coordinates(res)[k]
     points, values, names = [], [], []
     for i, s in enumerate(mech.solids):
-        if i in fixed_solids(mech):
+        if i in mech.held:
             continue
         get = lambda *rs: np.array([[float(res[f"{s.name}.{r}"][k]) for r in rs]])  # noqa: E731
         local = {n: tuple(float(c) for c in p) for n, p in s.points.items()} or {"": (0, 0)}
@@ -134,8 +130,8 @@ def _forces(model, mech, t):
     carriers = [el for el in mech.elements if el.equations and el.wrench
                 and (el.wrench[0] or el.wrench[1])]
     wanted = [f"{el.name}.{w}" for el in carriers for w in el.wrench[:2] if w]
-    res, k = _row(model, t, "kinetostatic", _pose_columns(mech) + wanted)
-    q = np.array([res[c][k] for c in _pose_columns(mech)])
+    res, k = _row(model, t, "kinetostatic", mech.coordinate_columns() + wanted)
+    q = mech.coordinates(res)[k]
     st = State([t], q[None, :])
     points, values = [], []
     for el in carriers:
@@ -152,12 +148,12 @@ def centres(model, t: float):
     not fixed (``points.instantaneous_centre``, from a kinematic run as for ``v``); a solid
     that translates at t has none (left out)."""
     mech = model.mechanism()
-    res, k = _row(model, t, "kinematic", _pose_columns(mech)
+    res, k = _row(model, t, "kinematic", mech.coordinate_columns()
                   + [f"{s.name}.{r}" for s in mech.solids for r in ("Dx", "Dy", "Dfi")])
-    q = np.array([res[c][k] for c in _pose_columns(mech)])
+    q = mech.coordinates(res)[k]
     out = []
     for i, s in enumerate(mech.solids):
-        if i in fixed_solids(mech):
+        if i in mech.held:
             continue
         get = lambda *rs: np.array([[float(res[f"{s.name}.{r}"][k]) for r in rs]])  # noqa: E731
         centre = instantaneous_centre(get("x", "y"), get("Dx", "Dy"), get("Dfi")[0],

@@ -26,7 +26,7 @@ class RunInfo(MutableMapping):
         Redundant constraint equations (rank test at the initial guess).
     condition_number : float
         Condition number of the constraint Jacobian at the initial guess (equilibrated;
-        ``analyses.native.condition_numbers``) [-].
+        ``analyses.rank.condition_numbers``) [-].
     max_residual : float
         Largest constraint residual at the backend's positions [m or rad].
     backend_seconds : float

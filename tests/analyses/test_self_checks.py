@@ -54,7 +54,7 @@ def test_the_translation_of_the_examples_passes_the_residual_check():
 
 
 def test_a_velocity_jump_among_steps_that_all_jump_is_followed():
-    """A branch switch shows as a velocity jump (``native.continuity_defect``) above JUMP =
+    """A branch switch shows as a velocity jump (``continuity.continuity_defect``) above JUMP =
     5 % of the velocities' scale, or as a spike above its neighbours. On a coarse grid near
     a change point every step jumps: no step stands out of the median of its neighbours,
     so only the absolute criterion finds the first jump (step 3 here)."""

@@ -12,7 +12,7 @@ import exudyn as exu
 from exudyn.solver import ComputeSystemDegreeOfFreedom
 
 import pam2exu
-from pam2exu.analyses import native
+from pam2exu.analyses import native, rank
 from pam2exu.backend import ExudynSystem, SolveSettings
 from pam2exu.elements import ELEMENTS
 from pam2exu.kinematics import State
@@ -102,7 +102,7 @@ def _slider_crank(path, drop=()):
 @pytest.mark.parametrize("drop, dof", [((), 0), (("motor",), 1), (("motor", "guide"), 3)])
 def test_degrees_of_freedom_agree_with_exudyn(examples, drop, dof):
     mech = _slider_crank(examples / "slider_crank.toml", drop)
-    ours = native.mobility(mech, 0.0, mech.initial_q())
+    ours = rank.mobility(mech, 0.0, mech.initial_q())
     theirs = ComputeSystemDegreeOfFreedom(ExudynSystem(mech).mbs)
     assert ours.dof == theirs["degreeOfFreedom"] == dof
     assert ours.redundant == theirs["redundantConstraints"] == 0

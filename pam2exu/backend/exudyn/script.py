@@ -91,7 +91,7 @@ class RecordingItems:
     """Stands for ``exudyn.itemInterface``: ``items.X(**kw)`` records an Item."""
 
     def __getattr__(self, kind: str):
-        if not hasattr(itemInterface, kind):
+        if kind not in vars(itemInterface):
             raise AttributeError(f"exudyn.itemInterface has no {kind}")
 
         def make(*args, **kwargs):
@@ -178,8 +178,7 @@ class ScriptSystem(ExudynSystem):
                     f"{k} = {{point = {list(v.get('point', (0.0, 0.0)))}, "
                     f"angle = {v.get('angle', 0.0)}}}" for k, v in owner.lines.items()))
             if i in self.grounded:
-                holder = next(el.name for el in mech.elements
-                              if el.grounds and el.ref1.solid == i)
+                holder = next(el.name for el in mech.elements if el.holds == i)
                 lines.append(f"#     held by the fixed link '{holder}': Exudyn ground at "
                              "this pose")
             elif self.integrated:
@@ -198,7 +197,7 @@ class ScriptSystem(ExudynSystem):
         if owner == "sensors":
             return ["# --- sensors: x, y, fi of every moving solid at every load step"]
         el = owner
-        keys = [f"anc{k + 1} = {getattr(el, f'anc{k + 1}')!r}" for k in range(len(el.anchors))]
+        keys = [f"anc{k + 1} = {a!r}" for k, a in enumerate(el.given_anchors())]
         keys += [f"{key} = {getattr(el, key)!r}" for key, param in el.params.items()
                  if getattr(el, key) is not None
                  and not (param.extension and not getattr(el, key))]   # clearance = False
@@ -206,7 +205,7 @@ class ScriptSystem(ExudynSystem):
                  f"#     {', '.join(keys)}"]
         if not self.builds(el):
             if el.grounds:
-                lines.append(f"#     '{mech.solids[el.ref1.solid].name}' is Exudyn ground: "
+                lines.append(f"#     '{mech.solids[el.holds].name}' is Exudyn ground: "
                              "no item needed")
             else:
                 lines.append("#     a force element: not in this constraints-only system "
@@ -254,7 +253,7 @@ class ScriptSystem(ExudynSystem):
             return "l", kw["markerNumber"].stem.removesuffix("_mass") + "_gravity"
         if kind.startswith("Sensor"):
             return "s", kw["nodeNumber"].stem
-        stem = owner.name if hasattr(owner, "name") else str(owner)
+        stem = owner if isinstance(owner, str) else owner.name
         if kind.startswith("Load"):
             return "l", stem
         return ("n" if kind.startswith("Node") else "m" if kind.startswith("Marker")

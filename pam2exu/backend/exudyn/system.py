@@ -158,8 +158,7 @@ class ExudynSystem:
         # constraints-only systems model a solid held by a fixed link as Exudyn ground at
         # its pose: fewer coordinates and equations (the fixed link's reaction is not
         # needed from Exudyn then)
-        self.grounded = set() if forces and not ground_fixed else {
-            el.ref1.solid for el in mech.elements if el.grounds}
+        self.grounded = set() if forces and not ground_fixed else set(mech.held)
         self.nodes, self.bodies = [], []
         self.start = mech.initial_q() if start is None else np.asarray(start, dtype=float)
         rates = None if start_rates is None else np.asarray(start_rates, dtype=float)
@@ -229,7 +228,7 @@ class ExudynSystem:
         """Whether the element adds Exudyn items to this system: force elements only to
         force systems, and a fixed link not when its solid is modelled as ground."""
         return bool(element.equations or self.forces) and not (
-            element.grounds and element.ref1.solid in self.grounded)
+            element.grounds and element.holds in self.grounded)
 
     # ---- helpers for Element.build ---------------------------------------------------------
     def add(self, element, item, kind: str = "object"):
@@ -240,7 +239,7 @@ class ExudynSystem:
 
     def point_marker(self, ref):
         """MarkerBodyRigid at a point (PointRef, a LineRef's defining point, a SolidRef's origin)."""
-        local = getattr(ref, "local", getattr(ref, "point", (0.0, 0.0)))
+        local = ref.anchor_point
         key = ("point", ref.solid, tuple(local))
         if key not in self._markers:
             self._markers[key] = self.mbs.AddMarker(self.items.MarkerBodyRigid(

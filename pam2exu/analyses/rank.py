@@ -1,0 +1,168 @@
+"""Rank tests of the constraint Jacobian Cq: its conditioning, the degrees of freedom the
+constraints leave and the equations they repeat (``Mobility``), whether redundant equations
+contradict each other and which element added last makes them, the first singular step."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import MobilityError, ModelError, Problem
+from ..kinematics import State
+from .native import chunks, equations, residuals
+
+
+def condition_numbers(mech, t, q) -> np.ndarray:
+    """κ(Cq) at each step: largest over smallest singular value of the constraint Jacobian,
+    its rows and columns equilibrated first (each scaled to unit length, three passes), so
+    that units and the choice of length scale drop out; ∞ at a singular position.
+
+    The one condition number of pam2exu (``pam2exu check``, ``Results.info``, the
+    ConditionWarning). The shipped examples: 1.5 to 8.6 over their motion; a four-bar
+    0.2° from a change point: about 190.
+    """
+    J = equations(mech, State(t, q)).jacobian
+    if J.shape[1] == 0:
+        return np.full(len(J), np.inf)
+    for _ in range(3):
+        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+        J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
+    s = np.linalg.svd(J, compute_uv=False)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return s[:, 0] / s[:, min(J.shape[1], mech.nq) - 1]
+
+
+@dataclass
+class Mobility:
+    """Degrees of freedom and redundancy of the constraints at one configuration."""
+
+    dof: int
+    redundant: int
+    free_solids: list[str]
+    redundant_elements: list[str]
+    condition: float
+
+    def describe(self) -> str:
+        text = f"{self.dof} degree(s) of freedom left free by the actuators"
+        if self.redundant:
+            text += f", {self.redundant} redundant constraint equation(s)"
+        return text
+
+
+def _rank(mech, t: float, q: np.ndarray, rtol: float, rows=None):
+    """(U, s, Vt, rank) of the SVD of Cq at (q, t), with the angle columns scaled by the
+    length scale so that all columns have units of length (only the equations ``rows``,
+    when given); None without equations."""
+    J = equations(mech, State([t], q[None, :])).jacobian[0]
+    if rows is not None:
+        J = J[rows]
+    J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
+    if J.shape[0] == 0:
+        return None
+    U, s, Vt = np.linalg.svd(J)
+    return U, s, Vt, int(np.sum(s > rtol * max(1.0, s[0] if s.size else 1.0)))
+
+
+def require_defined(mech, t: float, q: np.ndarray) -> None:
+    """ModelError when some constraint equation is not defined at the initial guess q
+    (a linear actuator whose two points coincide there has no direction)."""
+    with np.errstate(all="ignore"):
+        eq = equations(mech, State([t], q[None, :]))
+    bad = [el for el, rows in zip(mech.constraints, mech.rows)
+           if not (np.isfinite(eq.residual[0, rows]).all()
+                   and np.isfinite(eq.jacobian[0, rows]).all())]
+    if bad:
+        raise ModelError([Problem(el.where, (
+            "its equation is not defined at the initial guess: its two points coincide "
+            "there, so the distance between them has no direction. Give the solids x, y, fi "
+            "that put the points apart (near the assembled position)")) for el in bad],
+            mech.model.source)
+
+
+def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
+    """Rank test of Cq at (q, t): free degrees of freedom and redundant equations."""
+    svd = _rank(mech, t, q, rtol)
+    if svd is None:
+        return Mobility(mech.nq, 0, [s.name for s in mech.solids], [], np.inf)
+    U, s, Vt, rank = svd
+    dof, redundant = mech.nq - rank, U.shape[0] - rank
+    free = []
+    if dof:
+        null = Vt[rank:].T                           # (nq, dof)
+        weight = np.linalg.norm(null.reshape(len(mech.solids), 3, dof), axis=(1, 2))
+        free = [sv.name for sv, w in zip(mech.solids, weight) if w > 1e-6]
+    dependent = []
+    if redundant:
+        left = U[:, rank:]                           # (m, redundant)
+        weight = np.linalg.norm(left, axis=1)
+        for el, rows in zip(mech.constraints, mech.rows):
+            if np.max(weight[rows]) > 1e-6:
+                dependent.append(el.name)
+    condition = float(condition_numbers(mech, [t], q[None, :])[0])
+    return Mobility(dof, redundant, free, dependent, condition)
+
+
+def contradiction(mech, t: float, q: np.ndarray, rtol: float = 1e-9,
+                  without=None) -> tuple[float, list[str]]:
+    """How far redundant constraints contradict each other at time t, near configuration q.
+
+    With N the left null space of Cq(q) (the combinations of equations that no change of q
+    can alter, to first order), |Nᵀ C(q, t)| is a violation no configuration near q can
+    remove: the constraints' targets disagree. Returns that size (in the equations' units,
+    m or rad) and the elements whose equations make it up. Zero when Cq has full row rank.
+    ``without``: an element whose equations are left out.
+    """
+    keep = np.ones(mech.n_equations, dtype=bool)
+    if without is not None:
+        keep[mech.rows[mech.constraints.index(without)]] = False
+    svd = _rank(mech, t, q, rtol, keep)
+    if svd is None or svd[3] == svd[0].shape[0]:
+        return 0.0, []
+    left = np.zeros((mech.n_equations, svd[0].shape[0] - svd[3]))
+    left[keep] = svd[0][:, svd[3]:]                        # (m, redundant)
+    disagreement = left.T @ residuals(mech, np.array([t]), q[None, :])[0]
+    share = np.abs(left @ disagreement)                    # each equation's part in it
+    names = [el.name for el, rows in zip(mech.constraints, mech.rows)
+             if np.max(share[rows]) > 1e-6 * max(float(np.max(share)), 1e-300)]
+    return float(np.linalg.norm(disagreement)), names
+
+
+def culprit(mech, t: float, q: np.ndarray, among: list[str], size: float):
+    """The last element of ``among`` (in the file's order; joints before actuators and
+    fixed links) without whose equations the others no longer contradict each other (the
+    extra constraint a user added last), or None. ``size``: the contradiction with it, the
+    scale of "no longer"."""
+    concerned = [e for e in mech.constraints if e.name in among]
+    setters = [e for e in concerned if e.drives or e.grounds]
+    joints = [e for e in concerned if e not in setters]
+    for el in [*reversed(joints), *reversed(setters)]:
+        if contradiction(mech, t, q, without=el)[0] <= 1e-3 * size:
+            return el
+    return None
+
+
+def require_driven(mech, mob: Mobility, analysis: str) -> None:
+    """Raise MobilityError when some degree of freedom is not driven."""
+    if mob.dof <= 0:
+        return
+    solids = ", ".join(f"'{s}'" for s in mob.free_solids)
+    raise MobilityError(Problem(
+        f"{analysis} analysis",
+        f"the mechanism has {mob.dof} free degree(s) of freedom that no actuator drives: "
+        f"solid(s) {solids} can still move. Add an angular_actuator or linear_actuator "
+        f"(or a fixed link) for each free degree of freedom, or run an analysis that "
+        f"lets them go: assembly (the pose nearest the guess), equilibrium (at rest under "
+        f"the loads) or dynamic (in motion)."), mech.model.source)
+
+
+def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
+    """Index of the first step where Cq is (numerically) rank-deficient, else the last step."""
+    n = len(t)
+    for s in chunks(mech, n):
+        J = equations(mech, State(t[s], q[s])).jacobian
+        sv = np.linalg.svd(J, compute_uv=False)
+        rank = np.sum(sv > rtol * sv[:, :1], axis=1)
+        bad = np.nonzero(rank < mech.nq)[0]
+        if bad.size:
+            return s.start + int(bad[0])
+    return n - 1
