@@ -6,15 +6,19 @@ breakpoint, so the value there describes the motion that follows.
 
 Each law is written against a small array namespace ``xp`` (``where``, ``cos``,
 ``sin``) so the same expression serves NumPy and any other backend.
+
+Each law is declared once, in ``LAWS`` (a ``LawForm``): its function, whether it is a
+transition, the units of its constants, its Catalan alias and the formulas an exported
+script writes (``law_code`` makes the script's functions from them).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
-__all__ = ["Law", "LAWS", "LAW_ALIASES", "F_ORDERS", "VALUES_OF_F", "law_names"]
+__all__ = ["Law", "LawForm", "LAWS", "LAW_ALIASES", "F_ORDERS", "VALUES_OF_F", "law_names"]
 
 
 def polynomial(t, C, xp=np):
@@ -67,34 +71,80 @@ def _transition(shape: Callable) -> Callable:
         ddf = xp.where(before, 0.0, xp.where(inside, rise * dds / (span * span), 0.0))
         return f, df, ddf
 
-    s = shape.__doc__.split("=", 1)[1].strip().rstrip(".")       # "3u² − 2u³"
+    s = _formula(shape)                                           # "3u² − 2u³"
     law.__doc__ = _transition.__doc__.replace(" s(u)", " " + s if s == "u" else f"({s})")
     return law
 
 
-ramp = _transition(_ramp_shape)
-bezier_c1 = _transition(_bezier_c1_shape)
-bezier_c2 = _transition(_bezier_c2_shape)
+def _formula(function: Callable) -> str:
+    """The right-hand side of a law's or a shape's one-line docstring: "f = X." -> "X"."""
+    return function.__doc__.split("=", 1)[1].strip().rstrip(".")
 
-#: law name -> (function, needs C1 < C2)
-LAWS: dict[str, tuple[Callable, bool]] = {
-    "polynomial": (polynomial, False),
-    "harmonic": (harmonic, False),
-    "ramp": (ramp, True),
-    "bezier_c1": (bezier_c1, True),
-    "bezier_c2": (bezier_c2, True),
+
+class LawForm(NamedTuple):
+    """A time law, declared once: what computes it, what it needs, how a script writes it.
+
+    function:   (t, C, xp) -> (f, f', f''), its docstring "f = …" the formula in words
+    interval:   a transition from C3 to C4 between the times C1 < C2 (checked by the
+                model's validation; C1 and C2 are its breakpoints)
+    orders:     per constant, the unit it carries as a power of seconds under f's unit: 0
+                for f itself [u], 1 for [u/s], 2 for [u/s²], 3 for [u/s³]; None for a
+                constant in its own unit (the times C1, C2 of a transition [s]; a
+                harmonic's ω [rad/s] and phase [rad])
+    code:       f as an exported script computes it, Python in t and C1 … C4 (``np.cos``),
+                the same operations as ``function`` (the same values, bit for bit); a
+                transition's s(u), in u
+    rate_code:  f'(t) likewise, to round-off (a transition's s'(u); None: s' = 1, a ramp)
+    rate_words: ``rate_code`` in words, for the script's docstring
+    alias:      PAM's Catalan name, if it has one
+    shape:      a transition's s(u) (``_ramp_shape`` …), its docstring "s(u) = …"
+    """
+
+    function: Callable
+    interval: bool
+    orders: tuple[int | None, int | None, int | None, int | None]
+    code: str
+    rate_code: str | None
+    rate_words: str | None
+    alias: str | None = None
+    shape: Callable | None = None
+
+    @property
+    def words(self) -> str:
+        """The formula in words: f's ("C1 + C2 t + …"), a transition's s(u) ("3u² − 2u³")."""
+        return _formula(self.shape or self.function)
+
+
+def _transition_form(shape: Callable, code: str, rate_code: str | None,
+                     rate_words: str | None, alias: str | None = None) -> LawForm:
+    """A transition law from its shape s(u): f = C3 + (C4 − C3) s(u)."""
+    return LawForm(_transition(shape), True, (None, None, 0, 0), code, rate_code, rate_words,
+                   alias, shape)
+
+
+#: law name -> its declaration, in the order of the contract's table
+LAWS: dict[str, LawForm] = {
+    "polynomial": LawForm(polynomial, False, (0, 1, 2, 3),
+                          "C1 + t * (C2 + t * (C3 + t * C4))",
+                          "C2 + t * (2.0 * C3 + 3.0 * C4 * t)", "C2 + 2 C3 t + 3 C4 t^2",
+                          "polinomica"),
+    "harmonic": LawForm(harmonic, False, (0, 0, None, None), "C1 + C2 * np.cos(C3 * t + C4)",
+                        "-C2 * C3 * np.sin(C3 * t + C4)", "-C2 C3 sin(C3 t + C4)",
+                        "harmonica"),
+    "ramp": _transition_form(_ramp_shape, "u", None, None, "rampa"),
+    "bezier_c1": _transition_form(_bezier_c1_shape, "u * u * (3.0 - 2.0 * u)",
+                                  "6.0 * u * (1.0 - u)", "6u - 6u^2"),
+    "bezier_c2": _transition_form(_bezier_c2_shape,
+                                  "u * u * u * (10.0 + u * (-15.0 + 6.0 * u))",
+                                  "30.0 * u * u * (1.0 - u) ** 2", "30u^2 (1 - u)^2"),
 }
+ramp, bezier_c1, bezier_c2 = (LAWS[name].function for name in ("ramp", "bezier_c1",
+                                                                  "bezier_c2"))
 
-#: law name -> per constant, the unit it carries as a power of seconds under f's unit: 0 for
-#: f itself [u], 1 for [u/s], 2 for [u/s²], 3 for [u/s³]; None for a constant in its own unit
-#: (the times C1, C2 of a transition [s]; a harmonic's ω [rad/s] and phase [rad])
+#: law name -> per constant, the unit it carries as a power of seconds under f's unit
+#: (``LawForm.orders``)
 F_ORDERS: dict[str, tuple[int | None, int | None, int | None, int | None]] = {
-    "polynomial": (0, 1, 2, 3),
-    "harmonic": (0, 0, None, None),
-    "ramp": (None, None, 0, 0),
-    "bezier_c1": (None, None, 0, 0),
-    "bezier_c2": (None, None, 0, 0),
-}
+    name: form.orders for name, form in LAWS.items()}
 
 #: law name -> which constants are in the unit of f (per s, s², s³): C1…C4 of a polynomial,
 #: C1 and C2 of a harmonic (C3 and C4 are the cosine's ω [rad/s] and phase [rad]), C3 and C4
@@ -103,8 +153,8 @@ F_ORDERS: dict[str, tuple[int | None, int | None, int | None, int | None]] = {
 VALUES_OF_F: dict[str, tuple[bool, bool, bool, bool]] = {
     name: tuple(order is not None for order in orders) for name, orders in F_ORDERS.items()}
 
-#: Catalan PAM names
-LAW_ALIASES = {"polinomica": "polynomial", "harmonica": "harmonic", "rampa": "ramp"}
+#: Catalan PAM names (``LawForm.alias``)
+LAW_ALIASES = {form.alias: name for name, form in LAWS.items() if form.alias}
 
 
 def law_names() -> list[str]:
@@ -206,11 +256,11 @@ class Law:
         """
         if xp is np:
             t = np.asarray(t, dtype=float)
-            f, df, ddf = LAWS[self.name][0](t, self.C, xp)
+            f, df, ddf = LAWS[self.name].function(t, self.C, xp)
             shape = np.shape(t)
             return (np.broadcast_to(f, shape) * 1.0, np.broadcast_to(df, shape) * 1.0,
                     np.broadcast_to(ddf, shape) * 1.0)
-        return LAWS[self.name][0](t, self.C, xp)
+        return LAWS[self.name].function(t, self.C, xp)
 
     def value(self, t: float) -> float:
         """f(t) for a scalar t, as a Python float (used in solver callbacks).
@@ -241,4 +291,4 @@ class Law:
         >>> Law("ramp", [0.5, 1.0, 0.0, 1.0]).breakpoints()
         (0.5, 1.0)
         """
-        return self.C[:2] if LAWS[self.name][1] else ()
+        return self.C[:2] if LAWS[self.name].interval else ()

@@ -161,10 +161,10 @@ def laws_markdown() -> str:
     """The time laws: name, Catalan alias, f(t) as the law function's docstring states it."""
     aliases = {law: alias for alias, law in LAW_ALIASES.items()}
     rows = []
-    for name, (function, span) in LAWS.items():
+    for name, form in LAWS.items():
         alias = f" [`{aliases[name]}`]" if name in aliases else ""
-        formula = _first_line(function).rstrip(".")
-        rows.append((f"`{name}`{alias}", formula, "C1 < C2" if span else "–"))
+        formula = _first_line(form.function).rstrip(".")
+        rows.append((f"`{name}`{alias}", formula, "C1 < C2" if form.interval else "–"))
     return "\n".join(_table(("law", "f(t)", "needs"), rows)) + "\n"
 
 

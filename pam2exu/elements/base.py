@@ -422,7 +422,7 @@ class Actuator(Element):
     def more_problems(self, scope):
         law = LAW_ALIASES.get(self.law, self.law)
         c1, c2 = constants(self.C)[:2]
-        if LAWS[law][1] and not c1 < c2:
+        if LAWS[law].interval and not c1 < c2:
             return [f"law '{self.law}' needs C1 < C2 (start and end of the motion, s), "
                     f"got C1 = {c1:g}, C2 = {c2:g}"]
         return []
@@ -432,7 +432,7 @@ class Actuator(Element):
         format's rule), so C4 = 0 is where it goes (from C3, between C1 and C2)."""
         law = LAW_ALIASES.get(self.law, self.law)
         given = len(self.C) if isinstance(self.C, (list, tuple, np.ndarray)) else 1
-        if not LAWS[law][1] or given >= 4:
+        if not LAWS[law].interval or given >= 4:
             return []
         c1, c2, c3, c4 = constants(self.C)
         missing = ", ".join(f"C{k + 1}" for k in range(given, 4))
