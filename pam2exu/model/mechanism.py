@@ -146,7 +146,7 @@ class Mechanism:
         the order of q: ``<solid>.x``, ``<solid>.y``, ``<solid>.fi`` of each solid."""
         return [f"{s.name}.{rate}{k}" for s in self.solids for k in ("x", "y", "fi")]
 
-    def coordinates(self, res, rate: str = "", rows=slice(None)):
+    def coordinates(self, res, rate: str = "", rows=None):
         """q (or q̇, q̈: ``rate`` "D", "DD") from the columns of a result table, in radians.
 
         Parameters
@@ -156,8 +156,8 @@ class Mechanism:
             in radians.
         rate : str
             "" for x, y, fi; "D" for their first, "DD" for their second time derivatives.
-        rows : slice or array of int
-            The rows to take (default all).
+        rows : array of int, optional
+            The rows to take; all of them when None.
 
         Returns
         -------
@@ -165,6 +165,7 @@ class Mechanism:
             Shape (rows, nq): the columns side by side, solid by solid (``kinematics.pose``).
         """
         import numpy as np
+        rows = slice(None) if rows is None else rows
         return np.column_stack([res[c][rows] for c in self.coordinate_columns(rate)])
 
     def initial_qd(self):
