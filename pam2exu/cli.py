@@ -332,7 +332,7 @@ def _check(args) -> int:
     print()
     width = max([len(e.name) for e in mech.elements] + [4])
     for e in mech.elements:
-        anchors = ", ".join(str(getattr(e, f"anc{k + 1}")) for k in range(len(e.anchors)))
+        anchors = ", ".join(str(a) for a in e.given_anchors())
         print(f"  {e.name:<{width}}  {e.type:<17} {anchors}")
     if ANALYSES[job.analysis].driven:
         sys.stdout.flush()
