@@ -142,8 +142,18 @@ class Mechanism:
         return np.array([float(v) for s in self.solids for v in (s.x, s.y, s.fi)])
 
     def coordinate_columns(self, rate: str = "") -> list[str]:
-        """The result columns of q (``rate`` "") or of its rates q̇ ("D") or q̈ ("DD"), in
-        the order of q: ``<solid>.x``, ``<solid>.y``, ``<solid>.fi`` of each solid."""
+        """The result columns of q or of its rates, in the order of q.
+
+        Parameters
+        ----------
+        rate : str
+            "" for x, y, fi; "D" for their first, "DD" for their second time derivatives.
+
+        Returns
+        -------
+        list of str
+            ``<solid>.<rate>x``, ``<solid>.<rate>y``, ``<solid>.<rate>fi`` of each solid.
+        """
         return [f"{s.name}.{rate}{k}" for s in self.solids for k in ("x", "y", "fi")]
 
     def coordinates(self, res, rate: str = "", rows=None):
