@@ -15,7 +15,7 @@ from types import SimpleNamespace
 import numpy as np
 
 import pam2exu
-from pam2exu.analyses import branch, native
+from pam2exu.analyses import branch, continuity, native
 
 FOUR_BAR = Path(__file__).resolve().parents[2] / "examples" / "four_bar.toml"
 a, b, c, d = 0.1, 0.35, 0.3, 0.4             # crank, coupler, rocker, ground [m]
@@ -59,7 +59,7 @@ def test_a_re_solve_on_the_other_assembly_mode_is_never_better():
 
 def test_a_whole_turn_the_motor_demands_is_not_taken_back():
     """Two steps, t = 0 and 1 s, with rates 0 given: the motor's law puts the crank at
-    f(1) = 2π, a whole turn more than the rates predict, so ``native.turns_jumped`` counts
+    f(1) = 2π, a whole turn more than the rates predict, so ``continuity.turns_jumped`` counts
     one turn. Taking it back would break the motor's equation by 2π: ``_unwrap`` must keep
     q. The rocker off by a whole turn (its joints are 2π-periodic) is taken back."""
     mech = pam2exu.load(FOUR_BAR).mechanism()
@@ -67,7 +67,7 @@ def test_a_whole_turn_the_motor_demands_is_not_taken_back():
     q = np.array([pose(0.0), pose(2 * math.pi)])
     still = np.zeros_like(q)
     assert np.max(np.abs(native.residuals(mech, t, q))) < 1e-15
-    assert native.turns_jumped(t, q, still, 4)[1].tolist() == [0, 1, 0, 0]
+    assert continuity.turns_jumped(t, q, still, 4)[1].tolist() == [0, 1, 0, 0]
     np.testing.assert_array_equal(branch._unwrap(mech, t, q, still, 2), q)
     t = np.array([0.0, 1e-9])
     turned = np.array([pose(0.0), pose(2 * math.pi * 1e-9)])
