@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 
 from .errors import ModelError, Pam2ExuError, PictureError, Problem
-from .registry import ANALYSES, analysis_type
+from .registry import OPTIONS, analysis_type, analyses_reading
 
 
 class UsageError(Pam2ExuError):
@@ -69,18 +69,26 @@ def run_outputs(args) -> list[str] | None:
             *([args.x] if args.x else [])]
 
 
+def analysis_options(args) -> dict:
+    """The analysis options (``registry.OPTIONS``) as the command line gives them
+    (``--NAME``; None: the model's)."""
+    return {name: getattr(args, name) for name in OPTIONS}
+
+
 def check_analysis_options(args, model) -> None:
-    """UsageError for options the run's analysis does not use (``--tolerance``), ModelError
-    for ``--energy`` of an analysis without rates and forces: before the run."""
+    """UsageError for analysis options (``--tolerance``, ``registry.OPTIONS``) the run's
+    analysis does not read, ModelError for ``--energy`` of an analysis without rates and
+    forces: before the run."""
     from .analyses.energy import require_rates
     name = args.analysis or model.analysis.type
     kind = analysis_type(name) if isinstance(name, str) else None
     if kind is None:
         return                                   # run reports the settings
-    if args.tolerance is not None and not kind.integrates:
-        known = ", ".join(a.name for a in ANALYSES.values() if a.integrates)
-        raise UsageError(f"--tolerance is the time integration's ({known}); the {kind.name} "
-                         f"analysis does not use it: drop --tolerance")
+    for option, value in analysis_options(args).items():
+        if value is not None and option not in kind.options:
+            known = ", ".join(analyses_reading(option))
+            raise UsageError(f"--{option} is {OPTIONS[option].owner} ({known}); the "
+                             f"{kind.name} analysis does not use it: drop --{option}")
     if args.energy:
         require_rates(kind.name, model.source)
 

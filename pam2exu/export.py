@@ -14,6 +14,7 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
+from . import registry
 from .law_code import LAW_CODE
 
 __all__ = ["LAW_CODE", "export", "script"]
@@ -116,7 +117,7 @@ sys.exit(0 if solved == steps + 1 else 1)
 
 def script(model, t_end: float | None = None, steps: int | None = None,
            forces: bool = False, file: str = "script.py", analysis: str | None = None,
-           tolerance: float | None = None) -> str:
+           **options) -> str:
     """The source of the standalone Exudyn script of a model (see ``export``).
 
     Parameters
@@ -138,8 +139,9 @@ def script(model, t_end: float | None = None, steps: int | None = None,
         dynamics script (``export_dynamic``; ``forces`` does not apply, the masses and
         forces are always in); any other, or a fully driven model: the positions by
         Exudyn's static solver.
-    tolerance : float, optional
-        The dynamic analysis's tolerance (default: the model's [analysis] tolerance).
+    **options
+        The analysis options (``registry.OPTIONS``) of the integrating analysis's script:
+        ``tolerance``, the dynamic analysis's (default: the model's [analysis] tolerance).
 
     Returns
     -------
@@ -176,9 +178,11 @@ def script(model, t_end: float | None = None, steps: int | None = None,
     from .backend.exudyn.script import ScriptSystem, code
     from .backend.exudyn.system import SolveSettings, solver_options
 
-    if _analysis(model, analysis) == "dynamic":
+    registry.refuse_unknown_options(options, "script")
+    kind = _analysis(model, analysis)
+    if kind.integrates:                   # the script of its time integration
         from .export_dynamic import dynamic_script
-        source = dynamic_script(model, t_end, steps, file, tolerance)
+        source = dynamic_script(model, kind.name, t_end, steps, file, **options)
         if source is not None:
             return source                 # else fully driven: the kinematic positions
     # the job and the checks of a kinematic run: same interval, same mobility errors
@@ -197,9 +201,9 @@ def script(model, t_end: float | None = None, steps: int | None = None,
             + _results(mech, system))
 
 
-def _analysis(model, analysis: str | None) -> str:
-    """The analysis's name (an alias resolved): ``analysis``, else the model's type."""
-    from . import registry
+def _analysis(model, analysis: str | None):
+    """The analysis's declaration (``registry.AnalysisType``; a Catalan name too):
+    ``analysis``, else the model's type."""
     from .model import Model, load
     if analysis is None:
         analysis = (model if isinstance(model, Model) else load(model)).analysis.type
@@ -208,7 +212,7 @@ def _analysis(model, analysis: str | None) -> str:
         from .errors import ModelError
         raise ModelError(f"unknown analysis {analysis!r}: known are "
                          + ", ".join(registry.ANALYSES))
-    return kind.name
+    return kind
 
 
 def _header(mech, system, times, forces: bool, file: str) -> str:
@@ -275,8 +279,7 @@ def _fill(opening: str, entries: list[str], closing: str) -> str:
 
 
 def export(model, path, t_end: float | None = None, steps: int | None = None,
-           forces: bool = False, analysis: str | None = None,
-           tolerance: float | None = None) -> Path:
+           forces: bool = False, analysis: str | None = None, **options) -> Path:
     """Write a model as a standalone Exudyn script; returns its path.
 
     The script (imports: ``exudyn``, ``numpy``) builds the Exudyn system pam2exu builds, one
@@ -303,8 +306,9 @@ def export(model, path, t_end: float | None = None, steps: int | None = None,
         Default: the model's [analysis] type. ``'dynamic'`` with a degree of freedom left
         free writes the forward-dynamics script instead (docs/export.md, "Dynamic models"):
         Exudyn's SolveDynamic with the step count of the analysis, Richardson-extrapolated.
-    tolerance : float, optional
-        The dynamic analysis's tolerance (default: the model's [analysis] tolerance).
+    **options
+        The analysis options (``registry.OPTIONS``): ``tolerance``, the dynamic analysis's
+        (default: the model's [analysis] tolerance).
 
     Returns
     -------
@@ -332,5 +336,5 @@ def export(model, path, t_end: float | None = None, steps: int | None = None,
     """
     path = Path(path)
     path.write_text(script(model, t_end, steps, forces, file=path.name, analysis=analysis,
-                           tolerance=tolerance), encoding="utf-8")
+                           **options), encoding="utf-8")
     return path

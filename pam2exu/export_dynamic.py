@@ -217,11 +217,12 @@ print(f"wrote {{steps + 1}} rows to {{csv_file}}")
 '''
 
 
-def dynamic_script(model, t_end=None, steps=None, file: str = "script.py",
-                   tolerance=None) -> str | None:
+def dynamic_script(model, analysis: str, t_end=None, steps=None, file: str = "script.py",
+                   **options) -> str | None:
     """The source of the dynamic script of a model (see the module), or None when every
     degree of freedom is driven (its positions are then the kinematic ones: the caller
-    writes the positions script).
+    writes the positions script); ``analysis``: the name of the analysis integrating the
+    motion, ``options`` its options (``registry.OPTIONS``: ``tolerance``).
 
     Raises every error of ``run(model, analysis="dynamic")``.
     """
@@ -232,8 +233,7 @@ def dynamic_script(model, t_end=None, steps=None, file: str = "script.py",
     from .backend.exudyn.script import ScriptSystem
 
     # the script is Exudyn's generalized-alpha: its pieces and steps from the Exudyn backend
-    job = prepare(model, "dynamic", t_end, steps, POSITIONS, backend="exudyn",
-                  tolerance=tolerance)
+    job = prepare(model, analysis, t_end, steps, POSITIONS, backend="exudyn", **options)
     mech, t = job.mech, job.times
     mob = check_mobility(job, mech.initial_q(), need_driven=False)
     if mob.dof == 0:
@@ -271,10 +271,10 @@ def _header(mech, system, job, pieces: list, file: str) -> str:
            "impulse of pam2exu's contract (M and C_q from Exudyn)" if jumps else "")
         + " and writes x, y, fi of every solid at the output times as CSV.",
         92).replace("\0", " ")
-    estimate = float(job.info["integration_error"])
+    estimate, tolerance = float(job.info["integration_error"]), job.options["tolerance"]
     most = max(steps for _, _, steps, _ in pieces)
     accuracy = textwrap.fill(
-        f"Accuracy: pam2exu's dynamic analysis asked for tolerance {job.tolerance:g} "
+        f"Accuracy: pam2exu's dynamic analysis asked for tolerance {tolerance:g} "
         "(the error of every coordinate and rate at most tolerance (1 + |value|), SI "
         "units). It halved its step until two successive Richardson extrapolations agreed "
         f"(Romberg), piece by piece (the most steps: {most}), and its error estimate is "
@@ -294,13 +294,13 @@ def _header(mech, system, job, pieces: list, file: str) -> str:
     return _HEAD.format(title=f"{mech.name}: forward dynamics by Exudyn's SolveDynamic",
                         about=about, accuracy=accuracy, file=Path(file).name,
                         csv=f"{Path(file).stem}.csv", items=items, t_end=float(times[-1]),
-                        steps=len(times) - 1, every=job.every, tolerance=job.tolerance,
+                        steps=len(times) - 1, every=job.every, tolerance=tolerance,
                         grid=("" if job.every == 1 else
                               f"; the analysis integrates through {job.every} times as many "
                               "(times), the CSV keeps every every-th"),
                         pieces_comment=_comment(
                             f"integration pieces, as pam2exu's dynamic analysis integrated "
-                            f"them at tolerance {job.tolerance:g}: {segments}, a piece's times "
+                            f"them at tolerance {tolerance:g}: {segments}, a piece's times "
                             "equally spaced. Each: start and end [s], the rows of times it "
                             "fills, the steps of the analysis's finest run over it (the "
                             "script runs it and the run with half as many, and extrapolates "

@@ -3,16 +3,26 @@
 Everything that needs to know which analyses or backends exist reads these tables: the
 model (names and PAM's Catalan aliases, in its validation), ``pam2exu.analyses`` (what an
 analysis computes, whether it needs every degree of freedom driven, which function runs
-it), the CLI and the generated reference pages.
+it), the CLI and the generated reference pages. The ``AnalysisType`` itself, not its name,
+travels with a run (``Job.analysis_type``, ``Results.analysis_type``): whoever needs to know
+what an analysis gives (motion, forces, one row, a time integration) asks it, and no
+module but this one compares an analysis's name.
+
+The options some analyses take besides type, t_end, steps, outputs and backend
+(``tolerance`` today) are declared once, in ``OPTIONS``: the model's ``[analysis]`` keys,
+their defaults and checks, ``run``'s keywords, the job's ``options``, the command line's
+``--NAME`` and the docs' checks read them from there, and an ``AnalysisType`` names the
+ones it reads (``options``).
 
 Adding an analysis is one module with its function ``f(job) -> Results`` and one entry in
-``ANALYSES``; adding a backend is one module (or package) with a subclass of
+``ANALYSES``; an option, one entry in ``OPTIONS`` (and its name in the ``options`` of the
+analyses that read it); adding a backend is one module (or package) with a subclass of
 ``pam2exu.backend.Backend`` (its contract) and one entry in ``BACKENDS``.
 
 A declaration names what implements it as ``'module:attribute'``, imported when first
 used (a callable may be given instead): so reading and validating a model loads neither
 the analyses nor Exudyn, and this module imports nothing of the package but the output
-levels.
+levels and what an option's message is written with (``errors.echo``, ``limits.is_number``).
 """
 from __future__ import annotations
 
@@ -21,6 +31,8 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from .elements.base import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY
+from .errors import echo
+from .limits import is_number
 
 
 def resolve(target: str | Callable) -> Any:
@@ -29,6 +41,76 @@ def resolve(target: str | Callable) -> Any:
         return target
     module, _, attribute = target.partition(":")
     return getattr(importlib.import_module(module), attribute)
+
+
+@dataclass(frozen=True)
+class AnalysisOption:
+    """A setting that some analyses take besides type, t_end, steps, outputs and backend.
+
+    One declaration read by: the model (its ``[analysis]`` key, an attribute of
+    ``Model.analysis`` with this default, checked by ``Analysis.problems``), ``run`` (a
+    keyword of that name), the job (``Job.options``), the command line (``--NAME`` of
+    ``run`` and ``export``, refused for an analysis that does not read it) and the docs'
+    checks (docs/model-format.md lists the key).
+
+    Parameters
+    ----------
+    name : str
+        Its ``[analysis]`` key, ``run``'s keyword and the command line's ``--NAME``.
+    default : float
+        Its value when neither the model nor the run gives one.
+    low, high : float
+        The values allowed: low < value ≤ high.
+    meaning : str
+        What the value is, for the message of a value out of range.
+    owner : str
+        Whose option it is (``"the time integration's"``), for the command line's refusal.
+    help : str
+        ``pam2exu run --help``'s text.
+    brief : str
+        A short name for ``pam2exu export --help`` (``"… (default: the model's)"``).
+    metavar : str
+        The command line's placeholder of its value.
+    """
+
+    name: str
+    default: float
+    low: float
+    high: float
+    meaning: str
+    owner: str
+    help: str
+    brief: str
+    metavar: str = "VALUE"
+
+    def problem(self, value) -> str | None:
+        """What is wrong with ``value`` (one message), None when it is allowed."""
+        if is_number(value) and self.low < value <= self.high:
+            return None
+        return (f"{self.name} must be a number in ({self.low:g}, {self.high:g}], "
+                f"{self.meaning}, got {echo(value)}")
+
+
+#: the options of the analyses, in the order of the [analysis] table
+OPTIONS: dict[str, AnalysisOption] = {o.name: o for o in (
+    AnalysisOption("tolerance", 1e-8, 0.0, 1e-2,
+                   meaning="the error allowed per unit of a coordinate or rate",
+                   owner="the time integration's",
+                   help="dynamic: the time integration's error allowed per unit of each "
+                        "coordinate and rate (default: the model's [analysis] tolerance, "
+                        "else 1e-8)",
+                   brief="the dynamic analysis's tolerance", metavar="TOL"),
+)}
+
+
+def with_options(settings: type) -> type:
+    """The class ``settings`` (``model.Analysis``, before ``@dataclass`` makes its fields)
+    given one annotated attribute more per option, of its name and default: the fields
+    the ``[analysis]`` table and ``run`` take."""
+    for option in OPTIONS.values():
+        settings.__annotations__[option.name] = type(option.default).__name__
+        setattr(settings, option.name, option.default)
+    return settings
 
 
 @dataclass(frozen=True)
@@ -58,8 +140,11 @@ class AnalysisType:
     function : str or callable
         ``'module:function'`` of ``f(job) -> Results``, or the function itself.
     integrates : bool
-        Its results come from a time integration to ``[analysis] tolerance`` (the others
-        ignore the tolerance).
+        It integrates the motion in time (its free solids move under the loads): pictures
+        over time show it, ``export`` writes its integration script.
+    options : tuple of str
+        The ``OPTIONS`` it reads (the others are refused on the command line and ignored
+        by ``run``).
     """
 
     name: str
@@ -71,10 +156,22 @@ class AnalysisType:
     function: str | Callable
     element_outputs: bool = True
     integrates: bool = False
+    options: tuple = ()
 
     def run(self, job):
         """Run the analysis on a prepared ``Job``."""
         return resolve(self.function)(job)
+
+    @property
+    def gives_forces(self) -> bool:
+        """Its outputs include forces (reactions, actuators' forces and torques)."""
+        return FORCE in self.levels
+
+    @property
+    def gives_rates(self) -> bool:
+        """It gives velocities, accelerations and forces over an interval (what the energy
+        account needs)."""
+        return {VELOCITY, ACCELERATION, FORCE} <= self.levels and not self.at_start
 
 
 @dataclass(frozen=True)
@@ -119,7 +216,8 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("dynamic", "dinamica", _ALL, driven=False, at_start=False,
                  summary="forward dynamics: the free degrees of freedom move under the "
                  "loads, to [analysis] tolerance",
-                 function="pam2exu.analyses.dynamic:dynamic", integrates=True),
+                 function="pam2exu.analyses.dynamic:dynamic", integrates=True,
+                 options=("tolerance",)),
 )}
 
 #: the backends; the first is the default
@@ -145,6 +243,19 @@ def analysis_type(name: str) -> AnalysisType | None:
     if name in ANALYSES:
         return ANALYSES[name]
     return next((a for a in ANALYSES.values() if a.alias == name), None)
+
+
+def refuse_unknown_options(options: dict, caller: str = "run") -> None:
+    """TypeError, as Python's for a keyword a function does not take, for a name of
+    ``options`` that is no analysis option (``OPTIONS``)."""
+    unknown = [k for k in options if k not in OPTIONS]
+    if unknown:
+        raise TypeError(f"{caller}() got an unexpected keyword argument {unknown[0]!r}")
+
+
+def analyses_reading(option: str) -> list[str]:
+    """The analyses (names, in order) that read the option ``option`` (``OPTIONS``)."""
+    return [a.name for a in ANALYSES.values() if option in a.options]
 
 
 def analyses_giving(level: str, owner: str = "element") -> list[str]:

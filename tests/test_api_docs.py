@@ -222,7 +222,7 @@ def test_element_parameters_come_from_their_declarations():
 DOCTEST_MODULES = ["pam2exu", "pam2exu.errors", "pam2exu.laws", "pam2exu.model.model",
                    "pam2exu.model.analysis",
                    "pam2exu.model.solid", "pam2exu.model.loader", "pam2exu.analyses",
-                   "pam2exu.results.table", "pam2exu.results.names", "pam2exu.results.reading",
+                   "pam2exu.results.table", "pam2exu.results.table_csv", "pam2exu.results.names", "pam2exu.results.reading",
                    "pam2exu.results.compare", "pam2exu.results.comparison",
                    "pam2exu.results.units", "pam2exu.results.plot", "pam2exu.results.info",
                    "pam2exu.pictures.mechanism", "pam2exu.export", "pam2exu.verify"]

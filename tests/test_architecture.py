@@ -248,7 +248,7 @@ def test_a_dummy_analysis_needs_only_its_registry_entry_and_function(monkeypatch
     calls = []
 
     def centre(job):
-        calls.append(job.analysis)
+        calls.append(job.analysis_type.name)
         check_mobility(job, job.mech.initial_q())
         q = positions(job, redundant=False)
         return collect(job, q + 1.0)
@@ -259,13 +259,53 @@ def test_a_dummy_analysis_needs_only_its_registry_entry_and_function(monkeypatch
     path = ROOT / "examples" / "four_bar.toml"
     res = pam2exu.run(path, analysis="centre_ca", steps=4)
     kin = pam2exu.run(path, analysis="kinematic", steps=4, outputs=list(res.columns))
-    assert calls == ["centre"] and res.analysis == "centre"
+    assert calls == ["centre"] and res.analysis == "centre" and res.analysis_type is entry
     assert res.columns == kin.columns and "motor.f(t)" in res.columns
     np.testing.assert_array_equal(res["crank.x"], kin["crank.x"] + 1.0)
     model = pam2exu.load(path)
     model.elements.remove(model["motor"])
     with pytest.raises(pam2exu.MobilityError):
         pam2exu.run(model, analysis="centre", steps=4)
+
+
+def test_an_analysis_option_is_read_from_its_declaration(monkeypatch, capsys):
+    """``tolerance``, declared once in ``registry.OPTIONS``: the model's attribute and its
+    default, the loader's key, the range checked, run's keyword (another one a TypeError),
+    the job's value, the command line's --tolerance (its help; refused for an analysis
+    whose entry does not name it) all follow the declaration, changed here."""
+    from dataclasses import replace
+
+    import argparse
+
+    from pam2exu.analyses.job import prepare
+    from pam2exu.cli import main
+    from pam2exu.console import check_analysis_options
+    from pam2exu.model import Analysis, loader
+
+    path = str(ROOT / "examples" / "four_bar.toml")
+    declared = registry.OPTIONS["tolerance"]
+    assert Analysis().tolerance == declared.default == 1e-8
+    assert "tolerance" in loader._ANALYSIS_KEYS and "tolerance" in Analysis.EXTENSIONS
+    assert registry.analyses_reading("tolerance") == ["dynamic"]
+    monkeypatch.setitem(registry.OPTIONS, "tolerance", replace(
+        declared, high=1e-6, owner="a test's", help="the help of the declaration"))
+    assert Analysis(tolerance=1e-5).problems() == [
+        "tolerance must be a number in (0, 1e-06], the error allowed per unit of a "
+        "coordinate or rate, got 1e-05"]
+    assert prepare(path, "dynamic", steps=2, tolerance=1e-7).options == {"tolerance": 1e-7}
+    with pytest.raises(TypeError, match="unexpected keyword argument 'tolerence'"):
+        prepare(path, "dynamic", steps=2, tolerence=1e-7)
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    assert "the help of the declaration" in " ".join(capsys.readouterr().out.split())
+    assert main(["run", path, "-a", "kinematic", "--tolerance", "1e-9"]) == 2
+    assert capsys.readouterr().err == (
+        "pam2exu: command line: --tolerance is a test's (dynamic); the kinematic analysis "
+        "does not use it: drop --tolerance\n")
+    monkeypatch.setitem(registry.ANALYSES, "assembly", replace(
+        registry.ANALYSES["assembly"], options=("tolerance",)))
+    given = argparse.Namespace(analysis="assembly", tolerance=1e-9, energy=None)
+    assert check_analysis_options(given, pam2exu.load(path)) is None    # now it reads it
 
 
 def test_every_analysis_and_backend_of_the_registry_resolves():

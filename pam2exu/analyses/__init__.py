@@ -15,7 +15,7 @@ from .job import prepare, warn_input
 
 
 def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
-        backend=None, angles=None, tolerance=None):
+        backend=None, angles=None, **options):
     """Run an analysis and return its Results.
 
     ``pam2exu.run`` is this function, with ``t_end``, ``steps``, ``outputs`` and ``solver``
@@ -45,9 +45,10 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
         The unit of the angular columns (fi, Dfi, DDfi, f(t) of an angular actuator,
         fi_rel, …): ``'rad'`` or ``'deg'`` (deg, deg/s, deg/s²); default: the model's
         ``[model] angles``.
-    tolerance : float, optional
-        The dynamic analysis's integration tolerance (``Analysis.tolerance``) per unit of
-        value [-]; default: the model's [analysis] tolerance.
+    **options
+        The analysis options (``registry.OPTIONS``), by name; each defaults to the model's
+        [analysis] key of that name. ``tolerance`` (float): the dynamic analysis's
+        integration tolerance per unit of value [-]. Another keyword is a TypeError.
 
     Returns
     -------
@@ -80,12 +81,12 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
     """
     job = None
     try:
-        job = prepare(model, analysis, t_end, steps, outputs, solver, backend, tolerance)
+        job = prepare(model, analysis, t_end, steps, outputs, solver, backend, **options)
         if angles not in (None, *ANGLE_UNITS):
             raise ModelError(f"angles must be 'rad' or 'deg' (the unit of the angular "
                              f"results), got {echo(angles)}", job.mech.model.source)
         warn_input(job)
-        return in_angles(ANALYSES[job.analysis].run(job), angles or job.mech.model.angles)
+        return in_angles(job.analysis_type.run(job), angles or job.mech.model.angles)
     except SolverError as exc:       # the rows kept before it, in the run's angle unit
         if exc.partial is not None:
             exc.partial = in_angles(exc.partial, angles or job.mech.model.angles)
@@ -102,7 +103,7 @@ def unexpected(exc: Exception, job, model) -> SolverError:
     doing = job.stage if job is not None else "reading and checking the model"
     what = ("ran out of memory" if isinstance(exc, MemoryError)
             else f"failed unexpectedly ({type(exc).__name__}: {exc})")
-    analysis = f"the {job.analysis} analysis" if job is not None else "pam2exu"
+    analysis = f"the {job.analysis_type.name} analysis" if job is not None else "pam2exu"
     return SolverError(
         f"{analysis} of {source} {what} while {doing}. This is a fault of pam2exu: please "
         "report it with the model file (rerun with --debug for the traceback, or catch "

@@ -98,7 +98,7 @@ def motion(job: Job, q0: np.ndarray, qd0: np.ndarray, pieces: list | None = None
     (where the velocities jump: ``impulse``), each one to the tolerance (``romberg``).
     ``pieces``: a list that receives every run's (times, rows it fills, steps of its finest
     run, whether it ends at a breakpoint), in order (``export_dynamic`` repeats them)."""
-    mech, t = job.mech, job.times
+    mech, t, tolerance = job.mech, job.times, job.options["tolerance"]
     dt = float(t[1] - t[0])
     # a breakpoint within round-off of a row is that row's time
     breaks = sorted({float(t[np.argmin(np.abs(t - b))])
@@ -127,9 +127,9 @@ def motion(job: Job, q0: np.ndarray, qd0: np.ndarray, pieces: list | None = None
         start = end
     job.info["integration_error"] = worst
     job.info["integration_steps"] = steps
-    if worst > job.tolerance:
+    if worst > tolerance:
         warn(job, f"the time integration reached an error estimate of {worst:.2g} per unit "
-                  f"of value, not the tolerance {job.tolerance:g}: "
+                  f"of value, not the tolerance {tolerance:g}: "
                   + (f"{job.backend.label} cannot integrate more accurately here. Ask for "
                      "a looser tolerance, or a shorter interval"
                      if job.backend.integrator is Integrator.ADAPTIVE
@@ -180,8 +180,9 @@ def romberg(job: Job, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray,
     (``Integrator.ADAPTIVE``: ``Backend.motion``) meets the tolerance itself.
     ``at_break``: the last time is a law breakpoint, where the velocity equations change:
     that row is left as integrated (the state before the jump)."""
+    tolerance = job.options["tolerance"]
     if job.backend.integrator is Integrator.ADAPTIVE:
-        q, qd, estimate, steps = job.backend.motion(job.mech, times, q0, qd0, job.tolerance,
+        q, qd, estimate, steps = job.backend.motion(job.mech, times, q0, qd0, tolerance,
                                                     verbose=job.solver.verbose)
         return (q, qd), estimate, steps
     n = len(times) - 1
@@ -209,7 +210,7 @@ def romberg(job: Job, times: np.ndarray, q0: np.ndarray, qd0: np.ndarray,
                 # a floor: twice in a row the estimate did not halve when the step did
                 stalled = stalled + 1 if estimate > 0.5 * last else 0
                 last = min(last, estimate)
-                if estimate <= job.tolerance or s * n * 2 > MOST_STEPS or stalled >= STALLS:
+                if estimate <= tolerance or s * n * 2 > MOST_STEPS or stalled >= STALLS:
                     return R, estimate, s * n
             best = R
         s *= 2

@@ -18,7 +18,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import cumulative_simpson
 
-from ..elements.base import ACCELERATION, FORCE, VELOCITY
 from ..kinematics import State
 from ..model import Model, load
 from ..results import Results
@@ -104,23 +103,18 @@ def account(model, res: Results) -> Results:
 
 
 def require_rates(kind: str, source) -> None:
-    """ModelError unless the analysis ``kind`` gives what the account needs: velocities,
-    accelerations and forces over an interval (kinetostatic, dynamic). An unknown name
-    passes: ``run`` says which names there are."""
+    """ModelError unless the analysis named ``kind`` gives what the account needs:
+    velocities, accelerations and forces over an interval (``AnalysisType.gives_rates``:
+    kinetostatic, dynamic). An unknown name passes: ``run`` says which names there are."""
     from ..errors import ModelError
     from ..registry import ANALYSES, analysis_type
 
     found = analysis_type(kind)
-    if found is not None and not _gives_rates(found):
-        names = [a.name for a in ANALYSES.values() if _gives_rates(a)]
+    if found is not None and not found.gives_rates:
+        names = [a.name for a in ANALYSES.values() if a.gives_rates]
         raise ModelError(f"the energy account needs velocities, accelerations and forces: "
                          f"a {' or '.join(names)} run, not {kind!r} "
                          f"({' or '.join('-a ' + n for n in names)})", source)
-
-
-def _gives_rates(kind) -> bool:
-    """Whether an ``AnalysisType`` gives velocities, accelerations and forces in time."""
-    return {VELOCITY, ACCELERATION, FORCE} <= kind.levels and not kind.at_start
 
 
 def _since_start(t: np.ndarray, power: np.ndarray) -> np.ndarray:

@@ -2,7 +2,6 @@
 the constraints that contradict each other, the dead point, or Newton's divergence."""
 from __future__ import annotations
 
-from .. import registry
 from ..backend import Positions
 from ..errors import SolverError
 from . import closest, loops, native, rank
@@ -104,7 +103,7 @@ def position_failure(job: Job, found: Positions) -> SolverError:
 def _step_text(job: Job, k: int) -> str:
     """Where step k of the solve grid is, in the user's steps."""
     steps = (len(job.times) - 1) // job.every
-    if registry.ANALYSES[job.analysis].at_start:
+    if job.analysis_type.at_start:
         return "the assembly"
     if job.every == 1:
         return f"step {k} of {steps}"
@@ -119,7 +118,7 @@ def singular_error(job: Job, k: int) -> SolverError:
         f"at t = {t[k]:.6g} s (step {k}) the mechanism is at a singular (dead-point) "
         f"position: the constraint Jacobian loses rank, so the actuator(s) "
         f"{', '.join(drivers) or '(none)'} cannot drive it through this position and "
-        f"velocities{'' if job.analysis == 'kinematic' else ' and reactions'} are not "
+        f"velocities{' and reactions' if job.analysis_type.gives_forces else ''} are not "
         "defined. Drive the mechanism by another member, or stop the interval before this "
         "time.", time=float(t[k]), step=k)
 

@@ -31,7 +31,8 @@ class Job:
     """
 
     mech: object
-    analysis: str
+    #: the analysis (its declaration: ``registry.AnalysisType``), asked what it gives
+    analysis_type: registry.AnalysisType
     times: np.ndarray
     columns: list[str]
     units: dict[str, str]
@@ -46,13 +47,14 @@ class Job:
     motion: tuple | None = None
     #: what the analysis is doing, for the message of an unexpected failure
     stage: str = "checking the analysis settings"
-    #: the dynamic analysis's integration tolerance (``Analysis.tolerance``)
-    tolerance: float = 1e-8
+    #: the value of every analysis option (``registry.OPTIONS``: name → value); the
+    #: analysis reads those its type declares (``AnalysisType.options``)
+    options: dict = field(default_factory=lambda: {o.name: o.default
+                                                    for o in registry.OPTIONS.values()})
 
 
-def available_columns(mech, analysis: str) -> dict[str, Var]:
-    """Every column the analysis can produce, in order: solids, then elements."""
-    kind = registry.ANALYSES[analysis]
+def available_columns(mech, kind: registry.AnalysisType) -> dict[str, Var]:
+    """Every column the analysis ``kind`` can produce, in order: solids, then elements."""
     out, derived = {}, {}
     for c, var in derived_columns(mech) if kind.element_outputs else ():
         if var.level in kind.levels:             # opt-in: points, centres, couplers
@@ -90,15 +92,18 @@ def derived_columns(mech) -> list[tuple[str, Var]]:
 
 
 def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
-            backend=None, tolerance=None) -> Job:
+            backend=None, **options) -> Job:
     """Load and validate the model, apply the overrides, choose the columns and the backend
-    (``solver``: the backend's settings, default ``backend.Settings()``)."""
+    (``solver``: the backend's settings, default ``backend.Settings()``); ``options``: the
+    analysis options (``registry.OPTIONS``, e.g. ``tolerance``), TypeError for another
+    keyword."""
+    registry.refuse_unknown_options(options)
     if not isinstance(model, Model):
         model = load(model)
     settings = replace(model.analysis, **{k: v for k, v in
                                           dict(type=analysis, t_end=t_end, steps=steps,
                                                outputs=outputs, backend=backend,
-                                               tolerance=tolerance).items()
+                                               **options).items()
                                           if v is not None})
     problems = [Problem("[analysis]", m) for m in settings.problems()]
     if problems:
@@ -109,7 +114,7 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
         too_fast = pace_problems(mech.variations, settings.t_end, settings.steps)
         if too_fast:
             raise ModelError([Problem(*p) for p in too_fast], model.source)
-    available = available_columns(mech, kind.name)
+    available = available_columns(mech, kind)
     try:
         if settings.outputs is None:             # the default: every column not opt-in
             columns = [c for c in available if not points.is_opt_in(c)]
@@ -128,9 +133,10 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
     if ACCELERATION in levels:
         levels.add(VELOCITY)
     engine = registry.BACKENDS[settings.backend].create()
-    job = Job(mech, kind.name, plan.times, columns, {c: available[c].unit for c in columns},
+    job = Job(mech, kind, plan.times, columns, {c: available[c].unit for c in columns},
               levels, engine, solver if solver is not None else engine.Settings(),
-              every=plan.every, motion=plan.motion, tolerance=settings.tolerance)
+              every=plan.every, motion=plan.motion,
+              options={o: getattr(settings, o) for o in registry.OPTIONS})
     if plan.every > 1:
         job.info["substeps"] = plan.every
     return job
@@ -141,13 +147,13 @@ def check_mobility(job: Job, q0: np.ndarray, need_driven: bool | None = None) ->
     follows once positions are solved); ``need_driven`` (default: what the analysis
     declares, ``AnalysisType.driven``) raises MobilityError for a DOF not driven."""
     if need_driven is None:
-        need_driven = registry.ANALYSES[job.analysis].driven
+        need_driven = job.analysis_type.driven
     rank.require_defined(job.mech, float(job.times[0]), q0)
     mob = rank.mobility(job.mech, float(job.times[0]), q0)
     job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
                     condition_number=mob.condition)
     if need_driven:
-        rank.require_driven(job.mech, mob, job.analysis)
+        rank.require_driven(job.mech, mob, job.analysis_type.name)
     return mob
 
 
@@ -209,7 +215,7 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
     if notes:
         job.info["undefined"] = "; ".join(notes)
     values.update(extra)
-    res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis,
+    res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis_type,
                   mech.name, job.warnings, job.info, job.backend.label)
     table = res.to_numpy()[:, 1:]        # a view of the table's storage: no copies
     np.add(table, 0.0, out=table)        # no negative zeros in tables
@@ -231,8 +237,8 @@ def check_finite(job: Job, t: np.ndarray, values: dict[str, np.ndarray]) -> None
     names = [name for name, rows in bad.items() if rows[0] == k]
     shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
     raise SolverError(
-        f"the {job.analysis} analysis gave values that are not numbers (NaN or infinite) "
-        f"first at t = {t[k]:.6g} s (row {k}), in {shown}"
+        f"the {job.analysis_type.name} analysis gave values that are not numbers (NaN or "
+        f"infinite) first at t = {t[k]:.6g} s (row {k}), in {shown}"
         + (f"; {len(bad)} columns in all" if len(bad) > len(names) else "")
         + ". The mechanism is at or near a position where these are not defined (a "
           "singular position, two points of an element that coincide): end the interval "

@@ -8,17 +8,16 @@ from .. import limits, registry
 from ..errors import closest, echo
 from ..limits import is_number as _number
 
-#: the loosest integration tolerance of the dynamic analysis (its error per unit of value)
-MAX_TOLERANCE = 1e-2
-
-
 @dataclass
+@registry.with_options
 class Analysis:
     """What to run: ``type``, the interval [0, ``t_end``] in ``steps`` intervals, ``outputs``.
 
     The ``[analysis]`` table of a model file, ``Model.analysis`` in Python: the defaults of
     ``run``, whose arguments override them for one run. Values are checked by
-    ``problems`` (called by ``Model.problems`` and by ``run``), not here.
+    ``problems`` (called by ``Model.problems`` and by ``run``), not here. Besides the
+    parameters of every analysis, it has one attribute per analysis option
+    (``pam2exu.registry.OPTIONS``: its declaration gives the default and the check).
 
     Parameters
     ----------
@@ -38,9 +37,10 @@ class Analysis:
         What solves the positions: ``'exudyn'`` (the default; ``pam2exu.registry.BACKENDS``
         lists the backends).
     tolerance : float
-        Accuracy required of the ``dynamic`` analysis's time integration: its error at
-        most tolerance · (1 + |value|) on every coordinate and rate, SI units;
-        0 < tolerance ≤ 1e-2 [-]. Other analyses ignore it.
+        An option (``registry.OPTIONS``): the accuracy required of the ``dynamic``
+        analysis's time integration: its error at most tolerance · (1 + |value|) on every
+        coordinate and rate, SI units; 0 < tolerance ≤ 1e-2 [-], default 1e-8. Other
+        analyses ignore it.
 
     Examples
     --------
@@ -53,10 +53,9 @@ class Analysis:
     steps: int = 100
     outputs: list[str] | None = None
     backend: str = registry.DEFAULT_BACKEND
-    tolerance: float = 1e-8
 
     #: keys beyond the contract's [analysis] table (docs/model-format.md says so)
-    EXTENSIONS = ("backend", "tolerance")
+    EXTENSIONS = ("backend", *registry.OPTIONS)
 
     def __post_init__(self):
         self._canonical_type()
@@ -106,7 +105,5 @@ class Analysis:
                 or not all(isinstance(o, str) for o in self.outputs)):
 
             out.append("outputs must be a list of names or patterns, e.g. [\"crank.*\", \"Fx\"]")
-        if not _number(self.tolerance) or not 0 < self.tolerance <= MAX_TOLERANCE:
-            out.append(f"tolerance must be a number in (0, {MAX_TOLERANCE:g}], the error "
-                       f"allowed per unit of a coordinate or rate, got {echo(self.tolerance)}")
+        out += [p for o in registry.OPTIONS.values() if (p := o.problem(getattr(self, o.name)))]
         return out

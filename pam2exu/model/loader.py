@@ -4,6 +4,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
+from .. import registry
 from ..elements import ALIASES, ELEMENTS, misplaced_clearance
 from ..errors import ModelError, Problem, closest, echo
 from ..limits import shown
@@ -16,7 +17,7 @@ from .variation import Variation
 _MODEL_KEYS = ("name", "gravity", "angles")
 _SOLID_KEYS = ("name", "x", "y", "fi", "mass", "inertia", "cog", "points", "lines", "Dx", "Dy",
                "Dfi")
-_ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs", "backend", "tolerance")
+_ANALYSIS_KEYS = ("type", "t_end", "steps", "outputs", "backend", *registry.OPTIONS)
 _TABLES = ("model", "solid", "element", "variation", "analysis")
 
 

@@ -104,7 +104,7 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     <Figure size 800x600 with 1 Axes>
     """
     from .pen import VECTOR_COLORS
-    from .vectors import at_instant, centres
+    from .vectors import KINDS, at_instant, centres
     model = _model(model)
     arrows = None
     if guess:
@@ -116,8 +116,7 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         when = "initial guess (x, y, fi as given, not assembled)"
     elif vectors:
         mech, q, arrows = at_instant(model, t, vectors)
-        analysis = "kinetostatic" if vectors == "F" else "kinematic"
-        when = f"t = {t:g} s ({analysis} run)"
+        when = f"t = {t:g} s ({KINDS[vectors][0]} run)"
     else:
         mech, q = pose(model, t)
         when = f"t = {t:g} s ({motion(model)} run)" if t else "assembled at t = 0"

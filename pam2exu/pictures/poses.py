@@ -26,12 +26,12 @@ def _model(model):
 
 
 def motion(model) -> str:
-    """The run a picture of ``model`` over time shows: ``'dynamic'`` for a model whose
-    [analysis] integrates the motion (its free solids move under the loads; Catalan name
-    too), else ``'kinematic'``."""
+    """The run a picture of ``model`` over time shows: the model's [analysis] type when it
+    integrates the motion (``AnalysisType.integrates``: its free solids move under the
+    loads; a Catalan name read as the contract's), else ``'kinematic'``."""
     from ..registry import analysis_type
     kind = analysis_type(model.analysis.type)
-    return "dynamic" if kind is not None and kind.integrates else "kinematic"
+    return kind.name if kind is not None and kind.integrates else "kinematic"
 
 
 def configurations(model, t_end: float | None = None, steps: int | None = None,
@@ -72,12 +72,14 @@ def configurations(model, t_end: float | None = None, steps: int | None = None,
         Exudyn's solver did not converge.
     """
     from ..analyses import run
+    from ..registry import analysis_type
     model = _model(model)
     mech = model.mechanism()
     if analysis is None:
         analysis = motion(model)
-    if analysis == "assembly":
-        res = run(model, analysis="assembly", outputs=list(_POSE[:3]), angles="rad")
+    kind = analysis_type(analysis)
+    if kind is not None and kind.at_start:       # one row, t = 0: no interval, no rates
+        res = run(model, analysis=analysis, outputs=list(_POSE[:3]), angles="rad")
     else:
         res = run(model, analysis=analysis, t_end=t_end, steps=steps, outputs=list(_POSE),
                   angles="rad")

@@ -102,7 +102,7 @@ def at_instant(model, t: float, kind: str):
     if kind == "F":
         return _forces(model, mech, t)
     rates = ("Dx", "Dy", "Dfi") + (("DDx", "DDy", "DDfi") if kind == "a" else ())
-    res, k = _row(model, t, "kinematic", mech.coordinate_columns()
+    res, k = _row(model, t, KINDS[kind][0], mech.coordinate_columns()
                   + [f"{s.name}.{r}" for s in mech.solids for r in rates])
     q = mech.coordinates(res)[k]
     points, values, names = [], [], []
@@ -130,7 +130,7 @@ def _forces(model, mech, t):
     carriers = [el for el in mech.elements if el.equations and el.wrench
                 and (el.wrench[0] or el.wrench[1])]
     wanted = [f"{el.name}.{w}" for el in carriers for w in el.wrench[:2] if w]
-    res, k = _row(model, t, "kinetostatic", mech.coordinate_columns() + wanted)
+    res, k = _row(model, t, KINDS["F"][0], mech.coordinate_columns() + wanted)
     q = mech.coordinates(res)[k]
     st = State([t], q[None, :])
     points, values = [], []
@@ -148,7 +148,7 @@ def centres(model, t: float):
     not fixed (``points.instantaneous_centre``, from a kinematic run as for ``v``); a solid
     that translates at t has none (left out)."""
     mech = model.mechanism()
-    res, k = _row(model, t, "kinematic", mech.coordinate_columns()
+    res, k = _row(model, t, KINDS["v"][0], mech.coordinate_columns()
                   + [f"{s.name}.{r}" for s in mech.solids for r in ("Dx", "Dy", "Dfi")])
     q = mech.coordinates(res)[k]
     out = []

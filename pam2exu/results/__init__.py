@@ -5,7 +5,8 @@ from .comparison import Comparison, VariableComparison
 from .plot import plot
 from .info import RunInfo
 from .reading import read_csv, read_names
-from .table import Results, select_columns
+from .names import select_columns
+from .table import Results
 
 __all__ = ["Results", "select_columns", "read_csv", "plot", "compare", "Comparison",
            "VariableComparison", "CompareInputError", "read_names", "RunInfo"]

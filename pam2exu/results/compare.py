@@ -28,7 +28,7 @@ from .comparison import Comparison, VariableComparison
 from .interpolation import interpolate, interpolation_error
 from .names import listing
 from .reading import Table, load_table, names_map, time_precision
-from .table import select_columns
+from .names import select_columns
 from .units import RADIAN_UNITS, angle_factor, declared_units, unit_of
 
 RTOL = 1e-9

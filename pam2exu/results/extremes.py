@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..elements import ELEMENTS
-from .table import csv_field
+from ..elements import CLEARANCE, ELEMENTS
+from .table_csv import csv_field
 
 #: the variables of the joints' clearance parameters and of what derives from them
 CLEARANCE_VARIABLES = frozenset(v.name for cls in ELEMENTS.values()
@@ -34,8 +34,10 @@ class Extreme:
 
 def clearance_columns(res) -> list[str]:
     """The result's clearance columns (``<joint>.<parameter>``), in its order; none unless
-    it comes from the clearance analysis."""
-    if res.analysis != "clearance":
+    it comes from an analysis that gives clearance parameters (``CLEARANCE`` among its
+    levels: the clearance analysis)."""
+    kind = res.analysis_type
+    if kind is None or CLEARANCE not in kind.levels:
         return []
     return [c for c in res.columns if c.rpartition(".")[2] in CLEARANCE_VARIABLES]
 

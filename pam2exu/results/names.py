@@ -1,4 +1,5 @@
-"""Column names in pam2exu's spelling: PAM's own spellings, names maps, lists of names.
+"""Column names in pam2exu's spelling: PAM's own spellings, names maps, lists of names, and
+the columns a list of patterns chooses (``select_columns``).
 
 A column is ``<name>.<variable>``. Files exported from PAM spell some variables otherwise
 (``Forca``, ``f``, ``Df``); ``SPELLINGS`` brings them to pam2exu's (``Força``, ``f(t)``,
@@ -9,6 +10,8 @@ columns or the solid or element before the dot. ``compare``, ``read_csv``, ``plo
 from __future__ import annotations
 
 import fnmatch
+
+from ..errors import ModelError, Problem, closest
 from ..limits import one_form
 from ..points import OPT_IN
 
@@ -95,3 +98,58 @@ def selects(pattern: str, column: str) -> bool:
         return False
     variable = column.rpartition(".")[2]
     return variable not in OPT_IN or pattern.rpartition(".")[2][:1] not in ("*", "?", "[", "")
+
+
+def _pattern(p: str) -> str:
+    """A bare variable name ``Fx`` means every ``*.Fx``."""
+    return p if "." in p or p == "t" else f"*.{p}"
+
+
+def select_columns(columns: list[str], patterns) -> list[str]:
+    """Columns matching any pattern: full names, ``solid.*``, ``*.Fx`` or a bare ``Fx``.
+
+    Patterns are shell-style (``fnmatch``, case-sensitive); one without a dot means that
+    variable of every solid and element (``Fx`` is ``*.Fx``). ``t`` matches nothing and is
+    no error (it is always in a table). PAM's spellings are read as pam2exu's
+    (``names.spelled``: ``Forca`` is ``Força``, ``motor.f`` is ``motor.f(t)``).
+
+    Parameters
+    ----------
+    columns : list of str
+        The column names to choose from.
+    patterns : str or list of str
+        The patterns; None chooses every column.
+
+    Returns
+    -------
+    list of str
+        The columns matching any pattern, in the order of ``columns``.
+
+    Raises
+    ------
+    ModelError
+        A pattern matches no column (one problem per pattern, with the nearest name).
+
+    Examples
+    --------
+    >>> select_columns(["crank.fi", "crank.Dfi", "B.Fx", "C.Fx"], ["Fx", "crank.fi"])
+    ['crank.fi', 'B.Fx', 'C.Fx']
+    >>> select_columns(["crank.fi"], "crank.fy")
+    Traceback (most recent call last):
+    ...
+    pam2exu.errors.ModelError: outputs: 'crank.fy' matches no variable...(did you mean 'crank.fi'?)
+    """
+    if patterns is None:
+        return list(columns)
+    if isinstance(patterns, str):
+        patterns = [patterns]
+    chosen, problems = set(), []
+    for p in map(spelled, patterns):
+        hits = [c for c in columns if selects(_pattern(p), c)]
+        if not hits and p != "t":
+            problems.append(Problem("outputs", f"'{p}' matches no variable of this analysis"
+                                               f"{closest(p, columns)}"))
+        chosen.update(hits)
+    if problems:
+        raise ModelError(problems)
+    return [c for c in columns if c in chosen]

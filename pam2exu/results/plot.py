@@ -14,7 +14,8 @@ from ..errors import ModelError, PictureError, closest
 from ..model import Model, load
 from .names import SPELLINGS, canonical_name
 from .reading import read_csv
-from .table import Results, select_columns
+from .names import select_columns
+from .table import Results
 from .units import in_angles, unit_of
 
 #: default resolution [dots per inch]; with ``WIDTH`` inches a plot is 880 px wide

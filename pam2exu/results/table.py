@@ -1,23 +1,24 @@
 """The result of an analysis: one table of named columns, PAM's variable names.
 
-``Results`` and its CSV writer (``Results.to_csv``), with the fast reader of exactly what the
-writer writes (``_read_own``); any result CSV file is read by ``reading.read_csv``.
+``Results``: the columns over time, what made them (the analysis, the model), the run's
+warnings and facts, and the table's views (a column, a selection, the summary, the
+checks). Its files are written elsewhere: CSV by ``table_csv`` (``Results.to_csv``), the
+other forms by ``writers``; any result CSV file is read by ``reading.read_csv``.
 """
 from __future__ import annotations
 
-import csv
-import io
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, Problem, closest
+from ..errors import closest
 from ..limits import one_form
+from ..registry import AnalysisType, analysis_type
 from .info import RunInfo
 from .instant import Instants
-from .names import selects, spelled
-from .units import units_line
-from .writers import BOM, Exports, csv_translation
+from .names import select_columns
+from .table_csv import write_csv
+from .writers import Exports
 
 
 class Results(Exports, Instants):
@@ -46,8 +47,9 @@ class Results(Exports, Instants):
         Column name → values (rows,), in the order of the table; copied into the table.
     units : dict, optional
         Column name → SI unit (``"rad"``, ``"N·m"``, …); ``t`` is always ``"s"``.
-    analysis : str
-        The analysis that made the table (``'kinematic'``, …; '' when unknown).
+    analysis : str or AnalysisType
+        The analysis that made the table: its declaration (``registry.AnalysisType``) or
+        its name (``'kinematic'``, …; '' when unknown).
     model : str
         The model's name ('' when unknown).
     warnings : list of str, optional
@@ -63,7 +65,12 @@ class Results(Exports, Instants):
         Column name → SI unit, ``t`` included (``"s"``); a column read from a CSV file
         without a known unit has ''.
     analysis : str
-        The analysis type.
+        The analysis's name (``'kinematic'``, …; '' when unknown): what summaries and
+        files say.
+    analysis_type : AnalysisType or None
+        The analysis's declaration (``registry.ANALYSES``), found by its name (None for
+        a name the registry does not know, or '', as for a table read from a CSV file):
+        what it gives (``levels``, one row ``at_start``, …).
     model : str
         The model's name.
     backend : str
@@ -106,9 +113,25 @@ class Results(Exports, Instants):
             self._data[i] = values
         self._index = {name: i for i, name in enumerate(self._names)}
         self.units = {"t": "s", **{one_form(k): v for k, v in (units or {}).items()}}
-        self.analysis, self.model, self.backend = analysis, model, backend
+        self.analysis, self.model = analysis, model     # the name (``analysis``'s setter)
+        self.backend = backend
         self.warnings = list(warnings or [])
         self.info = RunInfo(**dict(info or {}))
+
+    @property
+    def analysis(self) -> str:
+        """The analysis's name ('' when unknown); set from a name or an ``AnalysisType``."""
+        return self._analysis
+
+    @analysis.setter
+    def analysis(self, value) -> None:
+        self._analysis = value.name if isinstance(value, AnalysisType) else value
+
+    @property
+    def analysis_type(self):
+        """The analysis's declaration (``registry.AnalysisType``), looked up by its name
+        (Catalan names too); None when the registry knows no analysis of that name."""
+        return analysis_type(self._analysis)
 
     @property
     def t(self) -> np.ndarray:
@@ -192,19 +215,7 @@ class Results(Exports, Instants):
         >>> res.to_csv("crank.csv")                     # doctest: +SKIP
         PosixPath('crank.csv')
         """
-        path, translate = Path(path), csv_translation(sep, decimal)
-        tmp = path.with_name(path.name + ".part")
-        try:
-            with open(tmp, "wb") as fh:
-                fh.write((BOM if bom else b"") + (_csv_header(self._names, sep) + "\n").encode())
-                fh.write(units_line(self._names, self.units, sep).encode())   # degrees only
-                for lines in _csv_lines(self._data.T):
-                    fh.write(lines if translate is None else translate[lines])
-            tmp.replace(path)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
-        return path
+        return write_csv(Path(path), self._names, self._data.T, self.units, sep, decimal, bom)
 
     def select(self, patterns) -> "Results":
         """A new table with the columns that match ``patterns`` (see ``select_columns``).
@@ -295,190 +306,3 @@ class Results(Exports, Instants):
     def __repr__(self) -> str:
         return (f"<Results {self.analysis} '{self.model}': {len(self)} rows × "
                 f"{len(self.columns)} columns>")
-
-
-#: values the CSV writer formats at once: ~20 bytes each, so its memory stays bounded
-_BLOCK = 1 << 20
-_COMMA, _NEWLINE, _MINUS, _ZERO = b",\n-0"
-#: the bytes of the lines of numbers that ``_csv_block`` writes (only such text reaches
-#: scipy's C++ reader: scipy 1.17's crashes on some other, e.g. a last line '…,7e')
-_WRITTEN = b"0123456789.-e,\nnaifty"
-
-
-def _csv_header(names, sep: str = ",") -> str:
-    """The header line (no line end): names ``sep`` separated, quoted when CSV needs it.
-
-    A name holding ',', ';', '"' or a line break is written in quotes, '"' doubled.
-
-    Examples
-    --------
-    >>> _csv_header(["t", "a,b.x", 'q"uo.y', "Força.Fx"])
-    't,"a,b.x","q""uo.y",Força.Fx'
-    """
-    return sep.join(csv_field(n) for n in names)
-
-
-def csv_field(name: str) -> str:
-    """A name as a CSV field: in quotes, '"' doubled, when it holds ',', ';', '"' or a
-    line break (``_csv_header``, the extremes' file)."""
-    return '"' + name.replace('"', '""') + '"' if any(c in name for c in ',;"\r\n') else name
-
-
-def _csv_block(values: np.ndarray) -> np.ndarray:
-    """CSV lines of a (rows, columns) float block: the shortest digits that read back exactly.
-
-    scipy's Matrix Market writer (fast_matrix_market: shortest round-trip digits, C++,
-    several threads) writes the numbers one a line, row after row; every line end but each
-    row's last becomes ',', and letters become lower case (``1e-5``, ``nan``, ``infinity``).
-
-    Parameters
-    ----------
-    values : numpy.ndarray
-        float64, shape (rows, columns), rows ≥ 1.
-
-    Returns
-    -------
-    numpy.ndarray
-        The ASCII text as uint8 (writable to a binary file as it is): one line per row, each
-        ended by '\\n'.
-
-    Examples
-    --------
-    >>> _csv_block(np.array([[0.1 + 0.2, -0.0, 1e300], [5e-324, 2.0, -np.inf]])).tobytes()
-    b'3.0000000000000004e-1,-0,1e300\\n5e-324,2,-infinity\\n'
-    """
-    import scipy.io
-    out = io.BytesIO()
-    scipy.io.mmwrite(out, values.T, field="real", symmetry="general")
-    head, start = out.getbuffer()[:1024].tobytes(), 0
-    while head.startswith(b"%", start):       # the banner and comment lines
-        start = head.index(b"\n", start) + 1
-    start = head.index(b"\n", start) + 1       # the size line
-    text = np.frombuffer(out.getbuffer(), np.uint8, offset=start)
-    ends = np.flatnonzero(text == _NEWLINE)
-    if ends.size != values.size:
-        raise RuntimeError(f"scipy.io.mmwrite wrote {ends.size} lines for {values.size} numbers")
-    text |= 0x20                  # 'E' → 'e', 'NaN' → 'nan'; digits, '.', '-' have the bit
-    text[ends] = _COMMA
-    text[ends[values.shape[1] - 1::values.shape[1]]] = _NEWLINE
-    return text
-
-
-def _csv_lines(values: np.ndarray):
-    """``_csv_block`` of a (rows, columns) array, ``_BLOCK`` values at a time (uint8 text)."""
-    step = max(1, _BLOCK // max(values.shape[1], 1))
-    for start in range(0, values.shape[0], step):
-        yield _csv_block(values[start:start + step])
-
-
-def _pattern(p: str) -> str:
-    """A bare variable name ``Fx`` means every ``*.Fx``."""
-    return p if "." in p or p == "t" else f"*.{p}"
-
-
-def select_columns(columns: list[str], patterns) -> list[str]:
-    """Columns matching any pattern: full names, ``solid.*``, ``*.Fx`` or a bare ``Fx``.
-
-    Patterns are shell-style (``fnmatch``, case-sensitive); one without a dot means that
-    variable of every solid and element (``Fx`` is ``*.Fx``). ``t`` matches nothing and is
-    no error (it is always in a table). PAM's spellings are read as pam2exu's
-    (``names.spelled``: ``Forca`` is ``Força``, ``motor.f`` is ``motor.f(t)``).
-
-    Parameters
-    ----------
-    columns : list of str
-        The column names to choose from.
-    patterns : str or list of str
-        The patterns; None chooses every column.
-
-    Returns
-    -------
-    list of str
-        The columns matching any pattern, in the order of ``columns``.
-
-    Raises
-    ------
-    ModelError
-        A pattern matches no column (one problem per pattern, with the nearest name).
-
-    Examples
-    --------
-    >>> select_columns(["crank.fi", "crank.Dfi", "B.Fx", "C.Fx"], ["Fx", "crank.fi"])
-    ['crank.fi', 'B.Fx', 'C.Fx']
-    >>> select_columns(["crank.fi"], "crank.fy")
-    Traceback (most recent call last):
-    ...
-    pam2exu.errors.ModelError: outputs: 'crank.fy' matches no variable...(did you mean 'crank.fi'?)
-    """
-    if patterns is None:
-        return list(columns)
-    if isinstance(patterns, str):
-        patterns = [patterns]
-    chosen, problems = set(), []
-    for p in map(spelled, patterns):
-        hits = [c for c in columns if selects(_pattern(p), c)]
-        if not hits and p != "t":
-            problems.append(Problem("outputs", f"'{p}' matches no variable of this analysis"
-                                               f"{closest(p, columns)}"))
-        chosen.update(hits)
-    if problems:
-        raise ModelError(problems)
-    return [c for c in columns if c in chosen]
-
-
-def _read_own(path: Path) -> Results | None:
-    """A file exactly as ``to_csv`` writes it, read fast; None for any other file.
-
-    scipy's Matrix Market reader (fast_matrix_market: fast_float, correctly rounded, C++)
-    reads the numbers; they are taken only when ``_csv_lines`` writes them back as the
-    file's own bytes, so they are what the general reader (``reading.load_table``, which
-    ``compare`` uses) reads, bit for bit, whatever the file holds. Anything else (another
-    writer's digits, comments, ';', a byte-order mark, CRLF) is None, and ``read_csv`` reads
-    it the general way.
-
-    Parameters
-    ----------
-    path : Path
-        The CSV file.
-
-    Returns
-    -------
-    Results or None
-        The file's columns under its header's names, ``t`` first; None when the file is
-        not exactly ``to_csv``'s (or cannot be read: the general reader says why).
-    """
-    import scipy.io
-    try:
-        raw = path.read_bytes()
-        end = raw.index(b"\n")
-        header = raw[:end].decode("utf-8")
-        names = next(csv.reader([header]), [])
-    except (OSError, ValueError, csv.Error):   # UnicodeDecodeError is a ValueError
-        return None
-    body = raw[end + 1:]
-    rows = body.count(b"\n")
-    if rows == 0 or not body.endswith(b"\n") or body.translate(None, _WRITTEN) \
-            or names[:1] != ["t"] or len(set(names)) < len(names) or _csv_header(names) != header:
-        return None
-    banner = f"%%MatrixMarket matrix array real general\n{len(names)} {rows}\n".encode()
-    try:
-        values = scipy.io.mmread(io.BytesIO(banner + body.replace(b",", b"\n")))
-    except ValueError:
-        return None
-    text = np.frombuffer(raw, np.uint8)
-    if b"-0," in body or b"-0\n" in body:      # the reader makes "-0" +0.0
-        ends = end + 1 + np.flatnonzero((text[end + 1:] == _COMMA) | (text[end + 1:] == _NEWLINE))
-        if ends.size != values.size:
-            return None
-        starts = np.r_[end + 1, ends[:-1] + 1]
-        k = np.flatnonzero((ends - starts == 2) & (text[starts] == _MINUS)
-                           & (text[starts + 1] == _ZERO))
-        values[k % len(names), k // len(names)] = -0.0
-    at = end + 1
-    for block in _csv_lines(values.T):
-        if not np.array_equal(text[at:at + block.size], block):
-            return None
-        at += block.size
-    if at != text.size:
-        return None
-    return Results(values[0], dict(zip(names[1:], values[1:])))

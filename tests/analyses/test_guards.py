@@ -208,3 +208,19 @@ steps = 100
             pam2exu.run(path)
     assert not isinstance(info.value, pam2exu.TranslationError)
     assert info.value.time == pytest.approx(0.01)
+
+
+@pytest.mark.parametrize("analysis, undefined", [
+    ("kinematic", "velocities are not defined"),
+    ("kinetostatic", "velocities and reactions are not defined"),
+    ("quasi_static", "velocities and reactions are not defined")])
+def test_a_singular_position_names_what_the_analysis_would_give(analysis, undefined):
+    """The singular-position message says reactions are undefined too when the analysis
+    gives forces (``AnalysisType.gives_forces``), not by its name."""
+    from types import SimpleNamespace
+
+    from pam2exu.analyses.failure import singular_error
+    from pam2exu.registry import ANALYSES
+    job = SimpleNamespace(times=np.array([0.0, 0.5]), mech=SimpleNamespace(drivers=[]),
+                          analysis_type=ANALYSES[analysis])
+    assert undefined in str(singular_error(job, 1))

@@ -154,7 +154,8 @@ def test_levels():
     """quasi_static gives points' positions and transmission angles, not their rates nor
     centres (velocity level); the point columns of a position-only run equal the formula."""
     cols = pam2exu.analyses.job.available_columns(
-        pam2exu.load(EXAMPLES / "four_bar.toml").mechanism(), "quasi_static")
+        pam2exu.load(EXAMPLES / "four_bar.toml").mechanism(),
+        pam2exu.registry.ANALYSES["quasi_static"])
     assert "coupler.P.x" in cols and "coupler.transmission_angle" in cols
     assert "coupler.P.Dx" not in cols and "coupler.ICx" not in cols
     res = pam2exu.run(EXAMPLES / "four_bar.toml", analysis="quasi_static", steps=10,

@@ -7,7 +7,7 @@ import pytest
 
 import pam2exu
 from pam2exu.errors import ModelError
-from pam2exu.results import Results, select_columns, table as table_module
+from pam2exu.results import Results, reading, select_columns, table_csv
 from pam2exu.results.reading import load_table
 
 COLUMNS = ["crank.x", "crank.fi", "guide.Fx", "motor.f(t)", "spring.Força", "rod.Fx"]
@@ -83,7 +83,7 @@ def test_csv_hard_values_read_back_bit_for_bit(tmp_path):
     """Random bit patterns, subnormals, ±0, the extremes, every power of 10 and of 2."""
     res = square(hard_values())
     path = res.to_csv(tmp_path / "hard.csv")
-    own = table_module._read_own(path)                 # read_csv's fast reader, checked
+    own = reading._read_own(path)                 # read_csv's fast reader, checked
     assert own is not None
     np.testing.assert_array_equal(bits(own.to_numpy()), bits(res.to_numpy()))
     back = pam2exu.read_csv(path)
@@ -131,7 +131,7 @@ def test_csv_in_blocks_is_the_same_file(tmp_path, monkeypatch):
     """Rows are formatted a block at a time (bounded memory): the blocks join seamlessly."""
     res = square(hard_values()[:500])
     whole = res.to_csv(tmp_path / "whole.csv").read_bytes()
-    monkeypatch.setattr(table_module, "_BLOCK", 20)          # 2 rows of 7 values a block
+    monkeypatch.setattr(table_csv, "BLOCK", 20)          # 2 rows of 7 values a block
     assert res.to_csv(tmp_path / "blocks.csv").read_bytes() == whole
     back = pam2exu.read_csv(tmp_path / "blocks.csv")
     np.testing.assert_array_equal(bits(back.to_numpy()), bits(res.to_numpy()))
@@ -177,8 +177,8 @@ def test_csv_edited_by_hand_is_read_the_general_way(tmp_path, edit):
     other = tmp_path / "other.csv"
     other.write_text(edit(own.read_text(encoding="utf-8")), encoding="utf-8")
     assert other.read_bytes() != own.read_bytes()
-    assert table_module._read_own(own) is not None
-    assert table_module._read_own(other) is None
+    assert reading._read_own(own) is not None
+    assert reading._read_own(other) is None
     expected = load_table(other, "results", {})
     back = pam2exu.read_csv(other)
     np.testing.assert_array_equal(bits(back.t), bits(expected.t))
@@ -206,7 +206,7 @@ def test_csv_fast_reader_agrees_with_the_general_one_on_damaged_files(tmp_path):
             else:
                 text[k] = rng.choice(alphabet)
         path.write_bytes(bytes(text))
-        fast = table_module._read_own(path)
+        fast = reading._read_own(path)
         if fast is None:
             continue
         taken += 1
@@ -245,8 +245,8 @@ def test_csv_failure_leaves_the_old_file_and_no_part_file(tmp_path, monkeypatch)
         blocks.append(values)
         return b"1,2,3,4,5,6,7\n" * len(values)
 
-    monkeypatch.setattr(table_module, "_BLOCK", 14)
-    monkeypatch.setattr(table_module, "_csv_block", fail_on_the_second)
+    monkeypatch.setattr(table_csv, "BLOCK", 14)
+    monkeypatch.setattr(table_csv, "csv_block", fail_on_the_second)
     with pytest.raises(OSError, match="disk full"):
         res.to_csv(path)
     assert blocks                                          # it failed half way
@@ -286,3 +286,16 @@ def test_run_outputs_selects_and_computes_only_those(examples):
     assert res.columns == ["slider.x", "motor.Df(t)"]
     assert res.units == {"t": "s", "slider.x": "m", "motor.Df(t)": "rad/s"}
     assert len(res) == 21
+
+
+def test_the_analysis_is_a_name_and_its_declaration():
+    """``analysis`` is the name (what files and summaries say), ``analysis_type`` the
+    registry's declaration of that name (a Catalan name too); given the declaration, the
+    table keeps its name; a table that does not know (read from CSV) has None."""
+    from pam2exu.registry import ANALYSES
+    res = Results([0.0], {"a.x": [1.0]}, analysis=ANALYSES["clearance"])
+    assert res.analysis == "clearance" and res.analysis_type is ANALYSES["clearance"]
+    assert res.select(["a.x"]).analysis_type is ANALYSES["clearance"]
+    catalan = Results([0.0], {"a.x": [1.0]}, analysis="cinematica")
+    assert catalan.analysis == "cinematica" and catalan.analysis_type is ANALYSES["kinematic"]
+    assert Results([0.0], {"a.x": [1.0]}).analysis_type is None
