@@ -19,9 +19,9 @@ import argparse
 import sys
 import warnings
 
-from ..version import __version__
 from ..console import UsageError, Warnings
 from ..errors import ModelError, OutputError, Pam2ExuError, SolverError
+from ..version import __version__
 from . import check, compare, elements, export, pictures, run, verify
 
 #: each command's function, ``f(args, warnings) -> exit code``
