@@ -229,6 +229,8 @@ BACKENDS: dict[str, BackendType] = {b.name: b for b in (
                 "pam2exu.backend.natural:Natural"),
 )}
 DEFAULT_BACKEND = "exudyn"
+#: the second formulation, which ``pam2exu verify`` holds against the default by default
+SECOND_FORMULATION = "natural"
 
 
 def backends_that(can: Callable[[type], bool]) -> list[str]:

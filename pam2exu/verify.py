@@ -29,14 +29,14 @@ import numpy as np
 
 from .errors import ModelError, SolverError, TranslationError, closest
 from .model import Model, load
-from .registry import BACKENDS
+from .registry import BACKENDS, DEFAULT_BACKEND, SECOND_FORMULATION
 from .results.compare import compare
 from .results.comparison import Comparison
 from .results.names import listing
 from .results.table import Results
 
 #: the backends compared by default: the default one, and the one it is verified against
-BACKENDS_COMPARED = ("exudyn", "natural")
+BACKENDS_COMPARED = (DEFAULT_BACKEND, SECOND_FORMULATION)
 #: margin over the estimated error, and the smallest relative tolerance
 SAFETY, FLOOR = 100.0, 1e-10
 #: unit → (family, power of the length scale L in it)

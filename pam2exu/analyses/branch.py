@@ -70,7 +70,7 @@ def _resolve(job: Job, k: int, start: np.ndarray, redundant: bool):
     """The backend's Positions at steps k… from ``start`` at step k (with its rates if it
     gives them)."""
     return job.backend.solve_positions(job.mech, job.times[k:], start, job.solver,
-                                       redundant=redundant, rates=True)
+                                       redundant=redundant, rates=job.backend.gives_rates)
 
 
 def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: bool = True):

@@ -42,7 +42,8 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     if len(job.times) == 1:                      # the assembly itself
         found = Positions(start[None], 1, None, start)
     else:
-        found = solve_in_parts(job, start, redundant, VELOCITY in job.levels)
+        found = solve_in_parts(job, start, redundant,
+                               VELOCITY in job.levels and job.backend.gives_rates)
         if found.solved:         # step 0 is the assembly (Newton moved it by round-off)
             found.q[0] = start
     job.info["backend_seconds"] = _time.perf_counter() - clock

@@ -105,6 +105,32 @@ def test_the_dynamic_analysis_follows_the_declared_integrator(monkeypatch):
     assert isinstance(caught.value.__cause__, _Reached)       # 64 steps / 4 intervals
 
 
+class RatelessNatural(Natural):
+    """The natural backend declaring that it gives no rates (it records what it is asked)."""
+    name = "rateless"
+    gives_rates = False
+    asked: list = []
+
+    def solve_positions(self, *args, rates=False, **kwargs):
+        self.asked.append(rates)
+        return super().solve_positions(*args, rates=rates, **kwargs)
+
+
+def test_rates_are_asked_only_of_a_backend_that_gives_them(monkeypatch):
+    """A backend that declares ``gives_rates = False`` is never asked for them: the native
+    pass computes the velocities, equal to the natural backend's own within 1e-9 (relative
+    to the largest rate); its positions are the natural backend's bit for bit."""
+    _register(monkeypatch, RatelessNatural)
+    RatelessNatural.asked.clear()
+    mine = pam2exu.run(FOUR_BAR, "kinematic", steps=8, backend="rateless")
+    theirs = pam2exu.run(FOUR_BAR, "kinematic", steps=8, backend="natural")
+    assert RatelessNatural.asked and not any(RatelessNatural.asked)
+    assert np.array_equal(mine["rocker.fi"], theirs["rocker.fi"])
+    for name in ("rocker.Dfi", "coupler.Dx", "rocker.DDfi"):
+        scale = np.max(np.abs(theirs[name]))
+        assert np.max(np.abs(mine[name] - theirs[name])) <= 1e-9 * scale, name
+
+
 @pytest.fixture(scope="module")
 def quasi_static():
     """The four-bar's quasi-static run on each backend (4 steps)."""
