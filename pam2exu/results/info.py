@@ -35,22 +35,23 @@ class RunInfo(MutableMapping):
     substeps : int
         Position solves per user step, when the motion per step needed more than one.
     max_condition_number : float
-        Worst condition number sampled over the run (kinematic, kinetostatic) [-].
+        Worst condition number sampled over the run (kinematic, kinetostatic, dynamic)
+        [-].
     branch_resolves : int
-        Steps solved again by the branch following (kinematic, kinetostatic).
+        Steps solved again by the branch following (kinematic, kinetostatic, dynamic).
     equilibrium_error : float
-        quasi_static: the backend's multipliers against the native equilibrium at the
+        quasi_static, equilibrium: the backend's multipliers against the native equilibrium at the
         checked steps, relative [-].
     reactions_from : str
-        quasi_static: how the reactions were computed.
+        quasi_static, equilibrium: how the reactions were computed.
     power_balance_error : float
-        kinetostatic: largest violation of the power balance [W].
+        kinetostatic, dynamic: largest violation of the power balance [W].
     power_balance_tolerance : float
-        kinetostatic: its tolerance, from the finite difference's own error [W].
+        kinetostatic, dynamic: its tolerance, from the finite difference's own error [W].
     power_balance_steps : int
-        kinetostatic: steps at which the power balance was checked.
+        kinetostatic, dynamic: steps at which the power balance was checked.
     power_balance : str
-        kinetostatic: why the power balance was not checked (too few rows).
+        kinetostatic, dynamic: why the power balance was not checked (too few rows).
     stiffness_eigenvalue : float
         equilibrium: the smallest eigenvalue of the reduced tangent stiffness, angles scaled
         by the length scale (> 0: stable) [N/m].
