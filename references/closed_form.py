@@ -16,6 +16,8 @@ x-like columns; 1 rad, ω, ω² for angles; ω a typical driver speed).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 #: examples/four_bar.toml: crank a, coupler b, rocker c, ground d [m]
@@ -105,6 +107,19 @@ def four_bar(a, b, c, d, th, dth, ddth):
     ddpsi = (a * ddth * np.sin(phi - th) - a * dth**2 * np.cos(th - phi) - b * dphi**2
              + c * dpsi**2 * np.cos(psi - phi)) / (c * np.sin(phi - psi))
     return (phi, dphi, ddphi), (psi, dpsi, ddpsi)
+
+
+def four_bar_angles(a, b, c, d, theta, mode=1):
+    """(φ, ψ) of the coupler and the rocker of ``four_bar``'s linkage at one crank angle θ:
+    φ = atan2(O4 − A) + mode·γ, γ by the law of cosines in the triangle A B O4, ψ =
+    atan2(B − O4); mode 1: the coupler above the line A-O4, −1: the other assembly mode."""
+    A = a * np.array([math.cos(theta), math.sin(theta)])
+    D = np.array([d, 0.0]) - A
+    delta = math.hypot(*D)
+    phi = math.atan2(D[1], D[0]) + mode * math.acos((b * b + delta**2 - c * c)
+                                                    / (2 * b * delta))
+    B = A + b * np.array([math.cos(phi), math.sin(phi)])
+    return phi, math.atan2(B[1], B[0] - d)
 
 
 def rigid_point(r, dr, ddr, fi, dfi, ddfi, s):

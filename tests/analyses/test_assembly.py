@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import pam2exu
+from references.closed_form import four_bar_angles
 
 #: each test runs on each backend (``every_backend`` in conftest.py)
 pytestmark = pytest.mark.usefixtures("every_backend")
@@ -25,15 +26,9 @@ SOLIDS = ("ground", "crank", "coupler", "rocker")
 
 
 def four_bar_pose(theta, mode=1):
-    """(φ, ψ) of the coupler and the rocker at crank angle θ, coupler above A-O4 (see the
-    module docstring); mode = −1: the other assembly mode, coupler below."""
-    A = a * np.array([math.cos(theta), math.sin(theta)])
-    D = np.array([d, 0.0]) - A
-    delta = math.hypot(*D)
-    phi = math.atan2(D[1], D[0]) + mode * math.acos((b * b + delta**2 - c * c)
-                                                    / (2 * b * delta))
-    B = A + b * np.array([math.cos(phi), math.sin(phi)])
-    return phi, math.atan2(B[1], B[0] - d)
+    """(φ, ψ) of the example's coupler and rocker at crank angle θ, coupler above A-O4;
+    mode = −1: the other assembly mode, coupler below (``references.closed_form``)."""
+    return four_bar_angles(a, b, c, d, theta, mode)
 
 
 def joint_gaps(res):

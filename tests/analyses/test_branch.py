@@ -16,6 +16,7 @@ import numpy as np
 
 import pam2exu
 from pam2exu.analyses import branch, continuity, native
+from references.closed_form import four_bar_angles
 
 FOUR_BAR = Path(__file__).resolve().parents[2] / "examples" / "four_bar.toml"
 a, b, c, d = 0.1, 0.35, 0.3, 0.4             # crank, coupler, rocker, ground [m]
@@ -23,15 +24,9 @@ a, b, c, d = 0.1, 0.35, 0.3, 0.4             # crank, coupler, rocker, ground [m
 
 def pose(theta: float, mode: int = 1) -> np.ndarray:
     """q = (x, y, fi) of ground, crank, coupler, rocker at crank angle θ; mode 1: coupler
-    above the line A–O4 (the example's), −1: below. φ = atan2(O4 − A) ± γ, γ by the law of
-    cosines in the triangle A B O4, ψ = atan2(B − O4)."""
+    above the line A–O4 (the example's), −1: below (``references.closed_form``)."""
+    phi, psi = four_bar_angles(a, b, c, d, theta, mode)
     A = a * np.array([math.cos(theta), math.sin(theta)])
-    D = np.array([d, 0.0]) - A
-    delta = math.hypot(*D)
-    phi = math.atan2(D[1], D[0]) + mode * math.acos((b * b + delta**2 - c * c)
-                                                    / (2 * b * delta))
-    B = A + b * np.array([math.cos(phi), math.sin(phi)])
-    psi = math.atan2(B[1], B[0] - d)
     return np.array([0, 0, 0, 0, 0, theta, A[0], A[1], phi, d, 0, psi], dtype=float)
 
 
