@@ -11,8 +11,7 @@ The API reference is docs/api.md.
 >>> res = pam2exu.run(model, analysis="kinematic")          # doctest: +SKIP
 >>> res["slider.Dx"]                                        # doctest: +SKIP
 """
-from .elements import (ELEMENTS, AngularActuator, Fixed, LinearActuator, PinSlot, Prismatic,
-                       Revolute, Spring, Torsor, TorsionalSpring, Transmission)
+from .elements import ELEMENTS
 from .errors import (MobilityError, ModelError, OutputError, Pam2ExuError, SolverError,
                      TranslationError)
 from .export import export
@@ -26,6 +25,10 @@ from .results.compare import compare
 from .results.plot import PictureError
 from .verify import Verification, verify
 from .version import __version__
+
+#: every element class under its own name (``pam2exu.Revolute``), read from ``ELEMENTS``
+#: (registering a type in ``pam2exu/elements/__init__.py`` is all it takes)
+globals().update({cls.__name__: cls for cls in ELEMENTS.values()})
 
 
 
@@ -187,8 +190,7 @@ def energy(model, analysis=None, **settings):
 
 __all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "Results", "read_csv",
            "compare", "Comparison", "verify", "Verification", "export", "plot", "draw", "animate",
-           "ELEMENTS", "Fixed", "Revolute", "Prismatic", "PinSlot", "Transmission", "Torsor",
-           "Spring", "TorsionalSpring", "AngularActuator", "LinearActuator", "Pam2ExuError",
+           "ELEMENTS", *(cls.__name__ for cls in ELEMENTS.values()), "Pam2ExuError",
            "ModelError", "MobilityError", "SolverError", "TranslationError",
            "CompareInputError", "PictureError", "OutputError", "RedundancyWarning",
            "ConsistencyWarning", "ConditionWarning", "VariationWarning", "InputWarning"]

@@ -24,6 +24,5 @@ def misplaced_clearance(kind: str) -> str:
             "have clearance (the clearance analysis); remove the key")
 
 __all__ = ["ELEMENTS", "ALIASES", "CLEARANCE_TYPES", "misplaced_clearance", "Element", "Var",
-           "POSITION", "VELOCITY", "ACCELERATION", "FORCE", "CLEARANCE", "Fixed", "Revolute",
-           "Prismatic", "PinSlot", "Transmission", "Torsor", "Spring", "TorsionalSpring",
-           "AngularActuator", "LinearActuator"]
+           "POSITION", "VELOCITY", "ACCELERATION", "FORCE", "CLEARANCE",
+           *(cls.__name__ for cls in ELEMENTS.values())]

@@ -163,6 +163,9 @@ class Element:
     #: type name in the model file, and PAM's Catalan name
     type: ClassVar[str] = ""
     alias: ClassVar[str] = ""
+    #: the specification that adds the type to the format (e.g. ``"clearance.md"``), for a
+    #: type beyond the contract's ten (model-format.md's element table); None for those
+    extension: ClassVar[str | None] = None
     #: what anc1 and anc2 must name: "solid", "point" or "line" (one entry per anchor)
     anchors: ClassVar[tuple[str, ...]] = ()
     #: what each anchor is, in PAM's words (default "solid 1", "solid 2")

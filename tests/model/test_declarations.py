@@ -9,8 +9,9 @@ from pam2exu.model import Model
 from pam2exu.model.solid import LineRef, PointRef, SolidRef
 from pam2exu.results import Results
 
-#: type -> (ties, pins, slides, grounds, drives): the roles the loops' diagnosis, the
-#: couplers, the drawings and the backends ask for
+#: type -> (ties, pins, slides, grounds, drives) of the contract's ten types: the roles the
+#: loops' diagnosis, the couplers, the drawings and the backends ask for (a type an extension
+#: adds, ``Element.extension``, pins its roles in its own test)
 ROLES = {
     "fixed": (False, False, False, True, False),
     "revolute": (True, True, False, False, False),
@@ -25,11 +26,20 @@ ROLES = {
 }
 
 
-@pytest.mark.parametrize("kind", list(ELEMENTS))
+def test_the_roles_cover_the_contracts_types():
+    assert list(ROLES) == [kind for kind, cls in ELEMENTS.items() if not cls.extension]
+
+
+@pytest.mark.parametrize("kind", list(ROLES))
 def test_each_type_declares_its_roles(kind):
     cls = ELEMENTS[kind]
     assert (cls.ties, cls.pins, cls.slides, cls.grounds, cls.drives) == ROLES[kind]
-    # a tie needs two anchors that stand for points; a pin or a slider is a tie
+
+
+@pytest.mark.parametrize("kind", list(ELEMENTS))
+def test_the_roles_of_each_type_are_consistent(kind):
+    """A tie needs two anchors that stand for points; a pin or a slider is a tie."""
+    cls = ELEMENTS[kind]
     assert not cls.ties or len(cls.anchors) == 2 and "solid" not in cls.anchors
     assert cls.ties or not (cls.pins or cls.slides)
 
