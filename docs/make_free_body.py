@@ -22,9 +22,10 @@ symbol between the bodies (spring, actuators).
 ``free_body_sketch(element_type, path)`` writes one sketch and returns what it drew
 (``FreeBody``); ``python docs/make_free_body.py OUTDIR`` writes ``OUTDIR/fbd_<type>.png``
 for every type in ``FREE_BODY_TYPES`` (docs/img/ holds them, for the glossary of output
-names):
+names), or for the types named after it:
 
     python docs/make_free_body.py docs/img
+    python docs/make_free_body.py docs/img linear_actuator
 
 Docs tooling beside docs/make_api.py: pam2exu never imports it (tests/test_free_body.py
 loads it by its path). Run from a clone, it puts the repository root on ``sys.path``.
@@ -531,9 +532,11 @@ def main(argv=None) -> int:
         description="Write OUTDIR/fbd_<type>.png, the free-body sketch of every element type "
                     "that reports a force or a torque (and of the applied torsor).")
     parser.add_argument("outdir", type=Path, help="directory to write to (created if missing)")
+    parser.add_argument("types", nargs="*", metavar="TYPE",
+                        help="only these element types (default: every one)")
     args = parser.parse_args(argv)
     args.outdir.mkdir(parents=True, exist_ok=True)
-    for t in FREE_BODY_TYPES:
+    for t in args.types or FREE_BODY_TYPES:
         drawn = free_body_sketch(t, args.outdir / f"fbd_{t}.png")
         print(drawn.path)
     return 0

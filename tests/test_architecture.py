@@ -213,6 +213,38 @@ def test_the_model_layer_knows_nothing_above_it():
     assert {m: n for m, n in up.items() if n} == {}
 
 
+def _layers() -> dict[str, int]:
+    """The layer of each top-level module or package, read from docs/architecture.md's
+    numbered list between ``<!-- layers -->`` and ``<!-- /layers -->`` (1 lowest)."""
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    block = text.split("<!-- layers -->")[1].split("<!-- /layers -->")[0]
+    return {name: int(k) for k, row in re.findall(r"^(\d+)\. (.+)$", block, re.M)
+            for name in re.findall(r"`(\w+)`", row)}
+
+
+def _top(module: str) -> str:
+    """``pam2exu.analyses.job`` → ``analyses``; the package itself → ``__init__``."""
+    return module.split(".")[1] if "." in module else "__init__"
+
+
+def test_the_layers_import_only_downwards():
+    """Every module's dependencies (module level, lazy, annotations; the registry's doors
+    into its plug-ins excepted) lie in its own layer of docs/architecture.md or below, and
+    every top-level module and package of pam2exu has a layer there."""
+    layer = _layers()
+    assert sorted({_top(m) for m in MODULES} - set(layer)) == []
+    up = sorted(f"{m} -> {n}" for m, edges in _lazy_graph(GRAPH).items() for n in edges
+                if layer[_top(n)] > layer[_top(m)])
+    assert up == []
+
+
+def test_the_layer_check_sees_an_arrow_up():
+    """The model importing the analyses (layer 3 → 6) is an arrow up."""
+    layer = _layers()
+    assert layer[_top("pam2exu.model.model")] < layer[_top("pam2exu.analyses.job")]
+    assert layer["__init__"] == max(layer.values()) and layer["errors"] == 1
+
+
 def test_no_module_imports_from_the_package_face():
     """The package face (``pam2exu/__init__.py``) only re-exports: no module of the package
     imports a name from it (``__version__`` is ``pam2exu.version``'s)."""

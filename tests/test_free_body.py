@@ -282,6 +282,14 @@ def test_script_writes_every_sketch(tmp_path, capsys):
                                                for t in FREE_BODY_TYPES]
 
 
+def test_script_writes_the_sketches_named(tmp_path, capsys):
+    """``python docs/make_free_body.py docs/img TYPE``: a new type's sketch alone."""
+    out = tmp_path / "img"
+    assert free_body.main([str(out), "spring"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["fbd_spring.png"]
+    assert capsys.readouterr().out.split() == [str(out / "fbd_spring.png")]
+
+
 def test_free_body_sketch_returns_what_it_drew(tmp_path):
     drawn = free_body_sketch("prismatic", tmp_path / "p.png")
     assert drawn.path == tmp_path / "p.png" and drawn.type == "prismatic"
