@@ -116,6 +116,8 @@ def element_markdown(cls: type[Element], level: int = 3, anchor: bool = True) ->
     alias = f" [`{cls.alias}`]" if cls.alias != cls.type else ""
     lines = [f'<a id="{cls.type}"></a>', ""] if anchor else []
     lines += [f"{'#' * level} `{cls.type}`{alias}", "", _sentence(cls.summary), ""]
+    if cls.extension:
+        lines += [f"An extension of the format ({cls.extension}), not one of PAM's types.", ""]
     or_alias = f' (or `"{cls.alias}"`)' if cls.alias != cls.type else ""
     keys = [("type", f'`"{cls.type}"`{or_alias}', "required"),
             ("name", "unique name", f"`{cls.type}<n>`")]

@@ -209,6 +209,18 @@ def test_cli_elements_unknown_type_is_a_model_error():
     assert "articulacio" in done.stderr
 
 
+def test_a_type_an_extension_adds_is_marked_as_one():
+    """``Element.extension``: its section says so (the contract's types say nothing)."""
+    from dataclasses import dataclass
+
+    @dataclass(eq=False)
+    class Rod(ELEMENTS["linear_actuator"]):
+        type, extension = "rod", "rod.md"
+    assert "An extension of the format (rod.md), not one of PAM's types." in \
+        reference.element_markdown(Rod)
+    assert "extension" not in reference.element_markdown(ELEMENTS["revolute"])
+
+
 def test_migration_page_maps_every_pam_element_and_law():
     text = (ROOT / "docs" / "migrating.md").read_text(encoding="utf-8")
     for kind in CONTRACT_TYPES:
