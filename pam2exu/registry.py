@@ -27,6 +27,7 @@ levels and what an option's message is written with (``errors.echo``, ``limits.i
 from __future__ import annotations
 
 import importlib
+import textwrap
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -71,6 +72,9 @@ class AnalysisOption:
         A short name for ``pam2exu export --help`` (``"… (default: the model's)"``).
     metavar : str
         The command line's placeholder of its value.
+    doc : str
+        What the value is, in full, for its entry in ``model.Analysis``'s docstring (and
+        docs/api.md); ``meaning`` when empty.
     """
 
     name: str
@@ -82,6 +86,17 @@ class AnalysisOption:
     help: str
     brief: str
     metavar: str = "VALUE"
+    doc: str = ""
+
+    def parameter_doc(self) -> str:
+        """Its entry in the Parameters section of ``model.Analysis``'s docstring."""
+        readers = " and ".join(f"``{a}``" for a in analyses_reading(self.name))
+        text = (f"An analysis option (``registry.OPTIONS``) of {readers}, which the other "
+                f"analyses ignore: {self.doc or self.meaning}; {self.low:g} < {self.name} ≤ "
+                f"{self.high:g}, default {self.default:g}.")
+        return (f"    {self.name} : {type(self.default).__name__}\n"
+                + textwrap.fill(text, 92, initial_indent=" " * 8, subsequent_indent=" " * 8)
+                + "\n")
 
     def problem(self, value) -> str | None:
         """What is wrong with ``value`` (one message), None when it is allowed."""
@@ -99,17 +114,24 @@ OPTIONS: dict[str, AnalysisOption] = {o.name: o for o in (
                    help="dynamic: the time integration's error allowed per unit of each "
                         "coordinate and rate (default: the model's [analysis] tolerance, "
                         "else 1e-8)",
-                   brief="the dynamic analysis's tolerance", metavar="TOL"),
+                   brief="the dynamic analysis's tolerance", metavar="TOL",
+                   doc="the accuracy required of the time integration: its error at most "
+                       "tolerance · (1 + |value|) on every coordinate and rate, SI units [-]"),
 )}
 
 
 def with_options(settings: type) -> type:
     """The class ``settings`` (``model.Analysis``, before ``@dataclass`` makes its fields)
     given one annotated attribute more per option, of its name and default: the fields
-    the ``[analysis]`` table and ``run`` take."""
+    the ``[analysis]`` table and ``run`` take; and their entries
+    (``AnalysisOption.parameter_doc``) in its docstring's Parameters, before its Examples."""
     for option in OPTIONS.values():
         settings.__annotations__[option.name] = type(option.default).__name__
         setattr(settings, option.name, option.default)
+    entries = "".join(option.parameter_doc() for option in OPTIONS.values())
+    if settings.__doc__:                          # (none under python -OO)
+        settings.__doc__ = settings.__doc__.replace("\n    Examples\n",
+                                                    f"{entries}\n    Examples\n", 1)
     return settings
 
 

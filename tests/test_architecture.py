@@ -324,7 +324,7 @@ def test_an_analysis_option_is_read_from_its_declaration(monkeypatch, capsys):
     assert Analysis(tolerance=1e-5).problems() == [
         "tolerance must be a number in (0, 1e-06], the error allowed per unit of a "
         "coordinate or rate, got 1e-05"]
-    assert prepare(path, "dynamic", steps=2, tolerance=1e-7).options == {"tolerance": 1e-7}
+    assert prepare(path, "dynamic", steps=2, tolerance=1e-7).options["tolerance"] == 1e-7
     with pytest.raises(TypeError, match="unexpected keyword argument 'tolerence'"):
         prepare(path, "dynamic", steps=2, tolerence=1e-7)
     with pytest.raises(SystemExit):
@@ -338,6 +338,24 @@ def test_an_analysis_option_is_read_from_its_declaration(monkeypatch, capsys):
         registry.ANALYSES["assembly"], options=("tolerance",)))
     given = argparse.Namespace(analysis="assembly", tolerance=1e-9, energy=None)
     assert check_analysis_options(given, pam2exu.load(path)) is None    # now it reads it
+
+
+def test_the_options_document_themselves_in_the_analysis_settings(monkeypatch):
+    """``Model.analysis``'s docstring (and so docs/api.md) has each option's entry, written
+    from its declaration: its readers, what it is, its range and default."""
+    from dataclasses import replace
+
+    from pam2exu.model import Analysis
+
+    entry = registry.OPTIONS["tolerance"].parameter_doc()
+    assert entry in Analysis.__doc__ and entry.startswith("    tolerance : float\n")
+    words = " ".join(entry.split())
+    assert "of ``dynamic``, which the other analyses ignore" in words
+    assert "0 < tolerance ≤ 0.01, default 1e-08." in words
+    monkeypatch.setitem(registry.ANALYSES, "assembly", replace(
+        registry.ANALYSES["assembly"], options=("tolerance",)))
+    assert "of ``assembly`` and ``dynamic``," in " ".join(
+        registry.OPTIONS["tolerance"].parameter_doc().split())
 
 
 def test_every_analysis_and_backend_of_the_registry_resolves():

@@ -22,9 +22,9 @@ class Analysis:
     Parameters
     ----------
     type : str
-        ``'assembly'``, ``'quasi_static'``, ``'kinematic'`` or ``'kinetostatic'``
-        (``pam2exu.registry.ANALYSES``); PAM's Catalan names (``'ensamblatge'``,
-        ``'quasi_estatica'``, ``'cinematica'``, ``'cinetostatica'``) are read as these.
+        The name of an analysis of ``pam2exu.registry.ANALYSES`` (``'assembly'``,
+        ``'quasi_static'``, ``'kinematic'``, ``'kinetostatic'``, …); its Catalan alias
+        (PAM's ``'ensamblatge'``, ``'cinematica'``, …) is read as it.
     t_end : float
         End of the interval [0, t_end] [s], > 0 (not used by an assembly, which solves
         t = 0 only).
@@ -36,11 +36,6 @@ class Analysis:
     backend : str
         What solves the positions: ``'exudyn'`` (the default; ``pam2exu.registry.BACKENDS``
         lists the backends).
-    tolerance : float
-        An option (``registry.OPTIONS``): the accuracy required of the ``dynamic``
-        analysis's time integration: its error at most tolerance · (1 + |value|) on every
-        coordinate and rate, SI units; 0 < tolerance ≤ 1e-2 [-], default 1e-8. Other
-        analyses ignore it.
 
     Examples
     --------

@@ -16,6 +16,7 @@ import pytest
 import pam2exu
 from pam2exu import ELEMENTS, Model, ModelError, Solid, loads
 from pam2exu.elements import ALIASES
+from pam2exu import registry
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -597,15 +598,20 @@ def test_bad_analysis(body, match):
         loads(SOLIDS + f"\n[analysis]\n{body}\n")
 
 
+#: the analysis options' defaults (``registry.OPTIONS``): every [analysis] table has them
+OPTION_DEFAULTS = {o.name: o.default for o in registry.OPTIONS.values()}
+
+
 def test_analysis_defaults_and_values():
     assert vars(loads(SOLIDS).analysis) == {"type": "kinematic", "t_end": 1.0, "steps": 100,
                                             "outputs": None, "backend": "exudyn",
-                                            "tolerance": 1e-8}
+                                            **OPTION_DEFAULTS}
+    assert OPTION_DEFAULTS["tolerance"] == 1e-8
     model = loads(SOLIDS + '\n[analysis]\ntype = "assembly"\nt_end = 2\nsteps = 7\n'
                            'outputs = ["crank.*", "Fx"]\nbackend = "exudyn"\n')
     assert vars(model.analysis) == {"type": "assembly", "t_end": 2, "steps": 7,
                                     "outputs": ["crank.*", "Fx"], "backend": "exudyn",
-                                    "tolerance": 1e-8}
+                                    **OPTION_DEFAULTS}
 
 
 # ---- files and sources -------------------------------------------------------------------
@@ -734,7 +740,7 @@ def test_shipped_example_loads():
     assert model["motor"].time_law() == pam2exu.Law("polynomial", (0.0, 10.0, 0.0, 0.0))
     assert vars(model.analysis) == {"type": "kinetostatic", "t_end": 0.6283185307179586,
                                     "steps": 200, "outputs": None, "backend": "exudyn",
-                                    "tolerance": 1e-8}
+                                    **OPTION_DEFAULTS}
     assert model.problems() == []
     assert model.source == str(ROOT / "examples" / "slider_crank.toml")
 
