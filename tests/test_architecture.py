@@ -336,7 +336,8 @@ def test_an_analysis_option_is_read_from_its_declaration(monkeypatch, capsys):
         "does not use it: drop --tolerance\n")
     monkeypatch.setitem(registry.ANALYSES, "assembly", replace(
         registry.ANALYSES["assembly"], options=("tolerance",)))
-    given = argparse.Namespace(analysis="assembly", tolerance=1e-9, energy=None)
+    given = argparse.Namespace(analysis="assembly", energy=None,
+                               **{**dict.fromkeys(registry.OPTIONS), "tolerance": 1e-9})
     assert check_analysis_options(given, pam2exu.load(path)) is None    # now it reads it
 
 
