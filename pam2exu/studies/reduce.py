@@ -1,0 +1,253 @@
+"""What a study makes of one variant's run: its reduced outputs, its status and its row.
+
+A variant's result is reduced over its rows (t = 0 … t_end, each row weighted equally) to
+one value per output column and reduction, named ``<output>.<reduction>``
+(``motor.Mz.absmax``): ``REDUCTIONS`` holds the seven, one small function each. A
+clearance component (``A.jx``, ``A.jr``, ``G.jn``: the clearance analysis's clearance
+parameters, ``results.extremes.clearance_columns``) is reduced as its absolute value, so
+``A.jx.max`` is the largest |jx| the variant needs over the motion.
+
+A value that is not a number (NaN) makes every reduction of its column NaN: it is never
+dropped silently. The result of a run that succeeds has none (the analyses' last guard
+refuses values that are not finite), so a NaN reduction marks a table that is not a run's.
+
+``status`` tells "ok" from "rejected" by the requirements; ``variant_table`` lays the
+variants out as the per-variant table's NumPy columns: ``sample``, ``status``, ``error``,
+each parameter, each reduced output (a variant in error: NaN outputs).
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..errors import ModelError, Problem, closest
+from ..results.extremes import clearance_columns
+from ..results.names import select_columns
+
+
+def minimum(y: np.ndarray) -> float:
+    """min_i y_i."""
+    return float(np.min(y))
+
+
+def maximum(y: np.ndarray) -> float:
+    """max_i y_i."""
+    return float(np.max(y))
+
+
+def absmax(y: np.ndarray) -> float:
+    """max_i |y_i|."""
+    return float(np.max(np.abs(y)))
+
+
+def mean(y: np.ndarray) -> float:
+    """(1/n) Σ_i y_i."""
+    return float(np.mean(y))
+
+
+def rms(y: np.ndarray) -> float:
+    """sqrt((1/n) Σ_i y_i²)."""
+    return float(np.sqrt(np.mean(np.square(y))))
+
+
+def final(y: np.ndarray) -> float:
+    """y_n: the last row (t = t_end)."""
+    return float(y[-1])
+
+
+def spread(y: np.ndarray) -> float:
+    """max_i y_i − min_i y_i."""
+    return float(np.max(y) - np.min(y))
+
+
+#: the reductions of a variant's output column, by the name a study file gives them, in
+#: the contract's order
+REDUCTIONS = {"min": minimum, "max": maximum, "absmax": absmax, "mean": mean, "rms": rms,
+              "final": final, "range": spread}
+
+STATUSES = ("ok", "rejected", "error")
+OK, REJECTED, ERROR = STATUSES
+
+
+def reduced_name(column: str, reduction: str) -> str:
+    """'<output>.<reduction>': ``reduced_name("motor.Mz", "absmax")`` is 'motor.Mz.absmax'."""
+    return f"{column}.{reduction}"
+
+
+def output_columns(columns: list[str], outputs=None) -> list[str]:
+    """The columns the ``outputs`` patterns choose, in the patterns' order (each column
+    once, where its first pattern chooses it; a pattern's columns in the table's order).
+
+    The patterns are those of ``[analysis] outputs`` (``results.names.select_columns``:
+    full names, ``B.F*``, ``*.Fx``, a bare ``Fx``, PAM's spellings); None chooses every
+    column. A pattern that matches nothing is a ``ModelError`` (one problem per pattern,
+    with the nearest name).
+
+    Examples
+    --------
+    >>> output_columns(["crank.fi", "B.Fx", "B.Fy", "motor.Mz"], ["motor.Mz", "B.F*"])
+    ['motor.Mz', 'B.Fx', 'B.Fy']
+    """
+    if outputs is None:
+        return list(columns)
+    if isinstance(outputs, str):
+        outputs = [outputs]
+    select_columns(columns, outputs)                  # every pattern's problem at once
+    chosen = {}
+    for pattern in outputs:
+        chosen.update(dict.fromkeys(select_columns(columns, [pattern])))
+    return list(chosen)
+
+
+def check_reductions(reductions) -> list[str]:
+    """The reductions' names as a list; ``ModelError`` naming each unknown one (with the
+    closest name and the seven allowed)."""
+    reductions = [reductions] if isinstance(reductions, str) else list(reductions)
+    problems = [Problem("reduce", f"unknown reduction '{r}'{closest(r, REDUCTIONS)}: one of "
+                                  f"{', '.join(REDUCTIONS)}")
+                for r in reductions if r not in REDUCTIONS]
+    if problems:
+        raise ModelError(problems)
+    return reductions
+
+
+def reduce_run(results, outputs=None, reductions=tuple(REDUCTIONS)) -> dict[str, float]:
+    """A variant's run reduced: ``<output>.<reduction>`` → value.
+
+    Parameters
+    ----------
+    results : Results
+        The variant's result table (its rows weighted equally).
+    outputs : str or list of str, optional
+        Output names and patterns as in ``[analysis] outputs`` (``output_columns``); None:
+        every column of ``results``.
+    reductions : str or sequence of str
+        Names from ``REDUCTIONS``; default all seven.
+
+    Returns
+    -------
+    dict
+        ``'<column>.<reduction>'`` → float, in the outputs' order, then the reductions'
+        (``motor.Mz.absmax``, ``motor.Mz.rms``, ``B.Fx.absmax``, …). A clearance
+        component is reduced as its absolute value; a column with a NaN row has NaN
+        for every reduction.
+
+    Raises
+    ------
+    ModelError
+        An output pattern matches no column, or a reduction is unknown.
+
+    Examples
+    --------
+    >>> from pam2exu.results import Results
+    >>> res = Results([0.0, 0.5, 1.0], {"motor.Mz": [1.0, -3.0, 2.0]})
+    >>> reduce_run(res, ["Mz"], ["absmax", "final"])
+    {'motor.Mz.absmax': 3.0, 'motor.Mz.final': 2.0}
+    """
+    reductions = check_reductions(reductions)
+    columns = output_columns(results.columns, outputs)
+    absolute = set(clearance_columns(results))
+    out = {}
+    for column in columns:
+        y = np.asarray(results[column], dtype=float)
+        if column in absolute:
+            y = np.abs(y)
+        unknown = bool(np.isnan(y).any())          # never dropped: every reduction NaN
+        for r in reductions:
+            out[reduced_name(column, r)] = np.nan if unknown else REDUCTIONS[r](y)
+    return out
+
+
+class Requirement(NamedTuple):
+    """A reduced output's bounds: min ≤ value ≤ max (None: that side is free)."""
+
+    output: str
+    min: float | None = None
+    max: float | None = None
+
+
+def meets(value: float, low: float | None, high: float | None) -> bool:
+    """low ≤ value ≤ high, a bound of None left out; a NaN value meets no bound.
+
+    A value exactly at a bound meets it: a limit is inclusive, as a tolerance's limits are
+    (a part at its upper limit is in tolerance).
+    """
+    return (low is None or value >= low) and (high is None or value <= high)
+
+
+def status(reduced: dict[str, float], requirements=()) -> str:
+    """'ok' when the reduced outputs meet every requirement (``meets``), else 'rejected'.
+
+    Parameters
+    ----------
+    reduced : dict
+        ``reduce_run``'s values of a variant that ran.
+    requirements : iterable of (output, min, max)
+        A reduced output's name (``motor.Mz.absmax``) and its bounds, None for an absent one.
+
+    Raises
+    ------
+    ModelError
+        A requirement names an output that is not reduced (with the closest name).
+
+    Examples
+    --------
+    >>> status({"motor.Mz.absmax": 12.0}, [("motor.Mz.absmax", None, 12.0)])
+    'ok'
+    >>> status({"motor.Mz.absmax": 12.5}, [("motor.Mz.absmax", None, 12.0)])
+    'rejected'
+    """
+    requirements = [Requirement(*r) for r in requirements]
+    missing = [Problem("[[requirement]]", f"'{r.output}' is not a reduced output"
+                                          f"{closest(r.output, reduced)}")
+               for r in requirements if r.output not in reduced]
+    if missing:
+        raise ModelError(missing)
+    ok = all(meets(reduced[r.output], r.min, r.max) for r in requirements)
+    return OK if ok else REJECTED
+
+
+class Variant(NamedTuple):
+    """One variant's row: its index, status, error ('' unless status is 'error': the
+    error's class and message), its parameters' values and its reduced outputs (None for
+    a variant in error)."""
+
+    sample: int
+    status: str
+    error: str
+    values: tuple[float, ...]
+    reduced: dict[str, float] | None
+
+
+def variant_table(parameters: list[str], outputs: list[str], variants) -> dict[str, np.ndarray]:
+    """The per-variant table as NumPy columns: ``sample`` (int64), ``status``, ``error``
+    (str), each parameter, each reduced output (float64; NaN for a variant in error).
+
+    Parameters
+    ----------
+    parameters : list of str
+        The parameters' names, in the study's order (the order of ``Variant.values``).
+    outputs : list of str
+        The reduced outputs' names (``reduce_run``'s keys, in its order).
+    variants : iterable of Variant (or tuples in its order)
+        The rows, in variant order.
+
+    Examples
+    --------
+    >>> t = variant_table(["crank.A.x"], ["motor.Mz.absmax"],
+    ...                   [(0, "ok", "", (0.1,), {"motor.Mz.absmax": 2.5}),
+    ...                    (1, "error", "AssemblyError: no closure", (0.3,), None)])
+    >>> list(t), t["motor.Mz.absmax"].tolist(), t["error"].tolist()
+    (['sample', 'status', 'error', 'crank.A.x', 'motor.Mz.absmax'], [2.5, nan], ['', 'AssemblyError: no closure'])
+    """
+    rows = [Variant(*v) for v in variants]
+    table = {"sample": np.array([v.sample for v in rows], dtype=np.int64),
+             "status": np.array([v.status for v in rows], dtype=str),
+             "error": np.array([v.error for v in rows], dtype=str)}
+    values = np.array([v.values for v in rows], dtype=float).reshape(len(rows), len(parameters))
+    table.update({name: values[:, j].copy() for j, name in enumerate(parameters)})
+    for name in outputs:
+        table[name] = np.array([np.nan if v.reduced is None else v.reduced[name]
+                                for v in rows], dtype=float)
+    return table

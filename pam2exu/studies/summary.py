@@ -1,0 +1,143 @@
+"""The statistics of a study over its variants and its yield: ``OUT.summary.csv``.
+
+One row per reduced output over the variants that ran (status ok or rejected; a variant in
+error has no values): ``count``, ``mean``, ``std`` (the sample standard deviation, ddof =
+1), ``min``, ``max``, the quantiles ``q01`` … ``q99`` (numpy's default, the linear method:
+the order statistics interpolated at (n − 1) p) and ``linear_std`` (the first-order σ the
+study gives for a ``final`` or a ``mean`` reduction; empty for the others). Then the row
+``yield``: ``count`` = every variant, ``mean`` = the share with status ok, ``min`` and
+``max`` = its 95 % Wilson score interval (scipy's ``binomtest(...).proportion_ci``).
+
+A value that does not exist (a std of fewer than two values, the statistics of no value,
+the yield row's other fields, ``linear_std`` of another reduction) is NaN in Python and an
+empty field in the file.
+"""
+from __future__ import annotations
+
+from dataclasses import astuple, dataclass, fields
+from pathlib import Path
+
+import numpy as np
+
+from ..results.table_csv import csv_block, csv_field
+from .reduce import ERROR, OK
+
+#: the quantiles' columns and their probabilities
+QUANTILES = {"q01": 0.01, "q05": 0.05, "q50": 0.50, "q95": 0.95, "q99": 0.99}
+#: the confidence level of the yield's interval
+CONFIDENCE = 0.95
+YIELD = "yield"
+
+
+@dataclass(frozen=True)
+class SummaryRow:
+    """One row of the summary (NaN: no value; the file leaves it empty)."""
+
+    output: str
+    count: int
+    mean: float = np.nan
+    std: float = np.nan
+    min: float = np.nan
+    max: float = np.nan
+    q01: float = np.nan
+    q05: float = np.nan
+    q50: float = np.nan
+    q95: float = np.nan
+    q99: float = np.nan
+    linear_std: float = np.nan
+
+
+#: the summary's header, in the file's order
+SUMMARY_COLUMNS = tuple(f.name for f in fields(SummaryRow))
+
+
+def statistics(output: str, y: np.ndarray, linear_std: float = np.nan) -> SummaryRow:
+    """The summary row of one reduced output's values ``y`` over the variants that ran."""
+    y = np.asarray(y, dtype=float)
+    if y.size == 0:
+        return SummaryRow(output, 0, linear_std=linear_std)
+    std = float(np.std(y, ddof=1)) if y.size > 1 else np.nan
+    q = np.quantile(y, list(QUANTILES.values()))
+    return SummaryRow(output, int(y.size), float(np.mean(y)), std, float(np.min(y)),
+                      float(np.max(y)), *map(float, q), linear_std=linear_std)
+
+
+def wilson_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[float, float]:
+    """The Wilson score interval of a share k/n at ``confidence`` (scipy's
+    ``binomtest(k, n).proportion_ci(method="wilson")``); (NaN, NaN) for n = 0."""
+    if n == 0:
+        return np.nan, np.nan
+    from scipy.stats import binomtest
+    ci = binomtest(k, n).proportion_ci(confidence_level=confidence, method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+def yield_row(statuses) -> SummaryRow:
+    """The row ``yield``: count = the variants, mean = the share with status ok, min, max =
+    its 95 % Wilson interval (``wilson_interval``)."""
+    statuses = np.asarray(statuses, dtype=str)
+    n, k = statuses.size, int(np.count_nonzero(statuses == OK))
+    low, high = wilson_interval(k, n)
+    return SummaryRow(YIELD, n, k / n if n else np.nan, min=low, max=high)
+
+
+def summary(columns: dict[str, np.ndarray], statuses, linear_std=None) -> list[SummaryRow]:
+    """The summary of a study: one row per reduced output, then the yield.
+
+    Parameters
+    ----------
+    columns : dict
+        Reduced output name (``motor.Mz.absmax``) → its values over every variant, in
+        variant order (NaN for a variant in error: ``reduce.variant_table``'s columns).
+    statuses : sequence of str
+        Every variant's status ('ok', 'rejected' or 'error'), in the same order.
+    linear_std : dict, optional
+        Reduced output name → its first-order σ (for the ``final`` and ``mean``
+        reductions); the others' ``linear_std`` is NaN.
+
+    Returns
+    -------
+    list of SummaryRow
+        The outputs' rows over the variants with status ok or rejected, in the order of
+        ``columns``, then the row ``yield``.
+
+    Examples
+    --------
+    >>> rows = summary({"B.Fx.max": np.array([1.0, 3.0, np.nan])}, ["ok", "rejected", "error"])
+    >>> rows[0].count, rows[0].mean, rows[0].q50, rows[1].output, rows[1].count, rows[1].mean
+    (2, 2.0, 2.0, 'yield', 3, 0.3333333333333333)
+    """
+    statuses = np.asarray(statuses, dtype=str)
+    ran = statuses != ERROR
+    linear_std = linear_std or {}
+    rows = [statistics(name, np.asarray(y, dtype=float)[ran], linear_std.get(name, np.nan))
+            for name, y in columns.items()]
+    return rows + [yield_row(statuses)]
+
+
+def summary_lines(rows: list[SummaryRow]) -> list[str]:
+    """The summary's CSV lines (no line ends): the header, then one line per row, each
+    number in the shortest digits that read back bit for bit (``table_csv.csv_block``), a
+    NaN as an empty field."""
+    lines = [",".join(SUMMARY_COLUMNS)]
+    if not rows:
+        return lines
+    numbers = np.array([astuple(r)[1:] for r in rows], dtype=float)
+    text = csv_block(numbers).tobytes().decode("ascii").splitlines()
+    for row, line in zip(rows, text):
+        cells = ["" if c == "nan" else c for c in line.split(",")]
+        lines.append(",".join([csv_field(row.output), *cells]))
+    return lines
+
+
+def write_summary(rows: list[SummaryRow], path: str | Path) -> Path:
+    """Write the summary as CSV at ``path`` (``summary_lines``), under a temporary name
+    then renamed: a failure leaves neither half a file nor the temporary one."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".part")
+    try:
+        tmp.write_text("\n".join(summary_lines(rows)) + "\n", encoding="utf-8")
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path
