@@ -112,6 +112,20 @@ def check_reductions(reductions) -> list[str]:
     return reductions
 
 
+def reduced_names(columns: list[str], outputs=None, reductions=tuple(REDUCTIONS)) -> list[str]:
+    """The names ``reduce_run`` gives a result with these ``columns``, in its order: the
+    per-variant table's output columns, known before any variant has run (from the
+    columns the analysis gives).
+
+    Examples
+    --------
+    >>> reduced_names(["crank.fi", "B.Fx", "B.Fy", "motor.Mz"], ["Mz", "B.F*"], ["absmax", "rms"])
+    ['motor.Mz.absmax', 'motor.Mz.rms', 'B.Fx.absmax', 'B.Fx.rms', 'B.Fy.absmax', 'B.Fy.rms']
+    """
+    reductions = check_reductions(reductions)
+    return [reduced_name(c, r) for c in output_columns(columns, outputs) for r in reductions]
+
+
 def reduce_run(results, outputs=None, reductions=tuple(REDUCTIONS)) -> dict[str, float]:
     """A variant's run reduced: ``<output>.<reduction>`` → value.
 
@@ -238,8 +252,10 @@ def variant_table(parameters: list[str], outputs: list[str], variants) -> dict[s
     >>> t = variant_table(["crank.A.x"], ["motor.Mz.absmax"],
     ...                   [(0, "ok", "", (0.1,), {"motor.Mz.absmax": 2.5}),
     ...                    (1, "error", "AssemblyError: no closure", (0.3,), None)])
-    >>> list(t), t["motor.Mz.absmax"].tolist(), t["error"].tolist()
-    (['sample', 'status', 'error', 'crank.A.x', 'motor.Mz.absmax'], [2.5, nan], ['', 'AssemblyError: no closure'])
+    >>> list(t)
+    ['sample', 'status', 'error', 'crank.A.x', 'motor.Mz.absmax']
+    >>> t["motor.Mz.absmax"].tolist(), t["error"].tolist()
+    ([2.5, nan], ['', 'AssemblyError: no closure'])
     """
     rows = [Variant(*v) for v in variants]
     table = {"sample": np.array([v.sample for v in rows], dtype=np.int64),

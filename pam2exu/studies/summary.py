@@ -141,3 +141,19 @@ def write_summary(rows: list[SummaryRow], path: str | Path) -> Path:
     finally:
         tmp.unlink(missing_ok=True)
     return path
+
+
+def error_groups(statuses, errors, samples) -> list[tuple[str, list[int]]]:
+    """The variants in error grouped by their error: (error, its samples), the most
+    frequent error first (ties: the one met first), samples in variant order.
+
+    Examples
+    --------
+    >>> error_groups(["ok", "error", "error", "error"], ["", "E: b", "E: a", "E: a"], [0, 1, 2, 3])
+    [('E: a', [2, 3]), ('E: b', [1])]
+    """
+    groups: dict[str, list[int]] = {}
+    for s, e, i in zip(statuses, errors, samples):
+        if s == ERROR:
+            groups.setdefault(str(e), []).append(int(i))
+    return sorted(groups.items(), key=lambda item: -len(item[1]))

@@ -17,7 +17,8 @@ import pam2exu
 from pam2exu.errors import ModelError
 from pam2exu.results import Results
 from pam2exu.studies import reduce
-from pam2exu.studies.reduce import REDUCTIONS, Variant, reduce_run, status, variant_table
+from pam2exu.studies.reduce import (REDUCTIONS, Variant, reduce_run, reduced_names, status,
+                                    variant_table)
 
 
 def _by_hand(y: list[float]) -> dict[str, float]:
@@ -84,6 +85,7 @@ def test_patterns_choose_the_columns_run_outputs_chooses_in_the_patterns_order(
     assert columns == ["motor.Mz", "B.Fx", "B.Fy", "base.Fy", "O2.Fy", "A.Fy", "O4.Fy",
                        "motor.f(t)"]
     assert list(reduced) == [f"{c}.{r}" for c in columns for r in ("absmax", "final")]
+    assert reduced_names(four_bar.columns, PATTERNS, ["absmax", "final"]) == list(reduced)
     for c in columns:                 # the same numbers as the run that chose them
         assert reduced[f"{c}.absmax"] == np.max(np.abs(chosen[c]))
         assert reduced[f"{c}.final"] == chosen[c][-1]

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from pam2exu.studies import summary as summary_module
-from pam2exu.studies.summary import (SUMMARY_COLUMNS, summary, summary_lines, wilson_interval,
-                                     write_summary)
+from pam2exu.studies.summary import (SUMMARY_COLUMNS, error_groups, summary, summary_lines,
+                                     wilson_interval, write_summary)
 
 
 def _wilson(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
@@ -44,8 +44,8 @@ def study():
     rng = np.random.default_rng(2024)
     statuses = np.array(["ok"] * 31 + ["rejected"] * 5 + ["error"] * 4)
     rng.shuffle(statuses)
-    columns = {"motor.Mz.absmax": rng.normal(10.0, 0.7, 40), "B.Fx.final": rng.normal(-3.0, 2.0, 40),
-               "B.Fx.mean": rng.uniform(-1.0, 1.0, 40)}
+    columns = {"motor.Mz.absmax": rng.normal(10.0, 0.7, 40),
+               "B.Fx.final": rng.normal(-3.0, 2.0, 40), "B.Fx.mean": rng.uniform(-1.0, 1.0, 40)}
     for y in columns.values():
         y[statuses == "error"] = np.nan
     linear = {"B.Fx.final": 1.9375, "B.Fx.mean": 0.5}
@@ -120,3 +120,13 @@ def test_a_failed_write_leaves_no_file(tmp_path, monkeypatch):
 def test_the_examples_in_the_docstrings_run():
     assert doctest.testmod(summary_module, optionflags=doctest.ELLIPSIS).failed == 0
     assert summary_lines([]) == [",".join(SUMMARY_COLUMNS)]
+
+
+def test_the_variants_in_error_are_grouped_by_their_error():
+    statuses = ["error", "ok", "error", "rejected", "error", "error", "error"]
+    errors = ["AssemblyError: x", "", "SingularPosition: y", "", "SingularPosition: y",
+              "AssemblyError: x", "ClearanceError: z"]
+    assert error_groups(statuses, errors, range(10, 17)) == [
+        ("AssemblyError: x", [10, 15]), ("SingularPosition: y", [12, 14]),
+        ("ClearanceError: z", [16])]
+    assert error_groups(["ok"], [""], [0]) == []
