@@ -52,7 +52,9 @@ SUMMARY_COLUMNS = tuple(f.name for f in fields(SummaryRow))
 
 
 def statistics(output: str, y: np.ndarray, linear_std: float = np.nan) -> SummaryRow:
-    """The summary row of one reduced output's values ``y`` over the variants that ran."""
+    """The summary row of one reduced output's values ``y`` over the variants that ran:
+    std with ddof = 1 (NaN for fewer than two values), quantiles by ``numpy.quantile``'s
+    default linear method, every statistic NaN for no value."""
     y = np.asarray(y, dtype=float)
     if y.size == 0:
         return SummaryRow(output, 0, linear_std=linear_std)
