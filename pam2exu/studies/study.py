@@ -423,6 +423,7 @@ def _requirements(entries: list[dict], outputs, reduce: list[str],
 def _reduced_problem(name: str, outputs, reduce: list[str]) -> str | None:
     """Why ``name`` is no ``<output>.<reduction>`` of the study's outputs and reductions."""
     output, _, reduction = name.rpartition(".")
+    reduce = [r for r in reduce if r in REDUCTIONS]
     if reduction not in reduce:
         return (f"'{shown(name)}' is not a reduced output: it must end in one of the study's "
                 f"reductions ({', '.join(reduce) or 'none'}), as 'motor.Mz.absmax'"
