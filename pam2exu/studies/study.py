@@ -375,6 +375,9 @@ def _distribution_problems(kind: str, entry: dict, method: str) -> list[str]:
             out.append(f"low = {entry['low']!r} must be less than high = {entry['high']!r}")
         if "std" in entry:
             out.append(f"a {kind} distribution takes no std: give low and high, or tol")
+        if kind == "uniform" and "mean" in entry and bounds == 2:
+            out.append("a uniform distribution between low and high takes no mean (mean ± "
+                       "tol is the other way to give it)")
     if kind == "values" and values is None:
         out.append("a values distribution needs values = [...]")
     if kind == "values" and any(k in entry for k in ("tol", "std", "low", "high", "mean")):
@@ -429,8 +432,8 @@ def _reduced_problem(name: str, outputs, reduce: list[str]) -> str | None:
                 f"reductions ({', '.join(reduce) or 'none'}), as 'motor.Mz.absmax'"
                 + ("" if reduction not in REDUCTIONS else
                    f"; or add '{reduction}' to [study] reduce"))
-    if outputs is None:
-        return None
+    if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
+        return None                          # every output, or a bad list already reported
     for pattern in outputs:
         try:
             if select_columns([spelled(output)], [pattern]):

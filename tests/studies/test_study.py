@@ -178,3 +178,17 @@ def test_sobol_warns_when_samples_is_not_a_power_of_two():
     with pytest.warns(InputWarning, match=r"samples = 20 is not a power of 2: .*use 16 or 32"):
         study = loads_study(text.replace("samples = 16", "samples = 20"), folder=EXAMPLES)
     assert study.variants().shape == (20, 1)       # the first 20 points of the sequence
+
+
+def test_zero_tol_a_uniform_with_low_high_and_mean_and_outputs_not_a_list():
+    found = problems('[study]\nmodel = "four_bar.toml"\nsamples = 4\noutputs = "motor.*"\n'
+                     '[[parameter]]\nname = "crank.mass"\ntol = 0.0\ndistribution = "normal"\n'
+                     '[[parameter]]\nname = "rocker.mass"\ndistribution = "uniform"\n'
+                     'low = 0.5\nhigh = 0.7\nmean = 0.6\n'
+                     '[[requirement]]\noutput = "motor.Mz.absmax"\nmax = 1.0\n')
+    assert found == [
+        "[study]: outputs must be a list of names or patterns, e.g. [\"crank.*\", \"Fx\"]",
+        "[[parameter]] #1 'crank.mass': tol = 0.0 must be > 0 (a parameter that does not vary "
+        "needs no [[parameter]])",
+        "[[parameter]] #2 'rocker.mass': a uniform distribution between low and high takes no "
+        "mean (mean ± tol is the other way to give it)"]
