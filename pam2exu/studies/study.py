@@ -182,8 +182,9 @@ def loads_study(text: str, source: str = "<string>", folder: str | Path = ".") -
     problems: list[Problem] = []
     for key in data:
         if key not in _TABLES:
-            problems.append(Problem(f"[{echo(key)[1:-1]}]", f"unknown table{closest(key, _TABLES)}; "
-                                                            f"a study has {', '.join(_TABLES)}"))
+            problems.append(Problem(f"[{echo(key)[1:-1]}]",
+                                    f"unknown table{closest(key, _TABLES)}; a study has "
+                                    f"{', '.join(_TABLES)}"))
     head = data.get("study", {})
     if not isinstance(head, dict):
         problems.append(Problem("[study]", "must be a table [study]"))
