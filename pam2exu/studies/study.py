@@ -16,10 +16,9 @@ from ..model import Analysis, Model, load
 from ..model.loader import decode
 from ..results.names import select_columns, spelled
 from .parameters import Target, targets
+from .reduce import REDUCTIONS, Requirement
 from .sampling import DISTRIBUTIONS, METHODS, Parameter, design, grid_size
 
-#: the reductions of a variant's rows (contract "Per variant")
-REDUCTIONS = ("min", "max", "absmax", "mean", "rms", "final", "range")
 #: the methods that draw ``samples`` variants from a ``seed``
 SAMPLED = ("monte_carlo", "latin_hypercube", "sobol")
 
@@ -28,23 +27,6 @@ _STUDY_KEYS = ("model", "analysis", "t_end", "steps", "method", "samples", "seed
                "reduce", "series")
 _PARAMETER_KEYS = ("name", "distribution", "mean", "tol", "std", "low", "high", "values")
 _REQUIREMENT_KEYS = ("output", "min", "max")
-
-
-@dataclass(frozen=True)
-class Requirement:
-    """A ``[[requirement]]``: a reduced output (``motor.Mz.absmax``) kept within [min, max].
-
-    Parameters
-    ----------
-    output : str
-        ``<output>.<reduction>``, a column of the per-variant table.
-    min, max : float or None
-        The bounds; None: unbounded on that side (at least one is given).
-    """
-
-    output: str
-    min: float | None = None
-    max: float | None = None
 
 
 @dataclass
@@ -72,11 +54,12 @@ class Study:
     outputs : list of str or None
         Output names and patterns (default the model's; None: every output).
     reduce : list of str
-        Reductions (default all of ``REDUCTIONS``).
+        Reductions (``reduce.REDUCTIONS``; default all seven).
     series : bool
         Keep every variant's time series.
     parameters : list of Parameter
     requirements : list of Requirement
+        ``reduce.Requirement`` (output, min, max), what ``reduce.status`` reads.
     """
 
     source: str

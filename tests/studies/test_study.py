@@ -8,7 +8,8 @@ import pytest
 
 import pam2exu
 from pam2exu.errors import InputWarning
-from pam2exu.studies import Requirement, load_study, loads_study
+from pam2exu.studies import load_study, loads_study
+from pam2exu.studies.reduce import Requirement
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
