@@ -100,6 +100,9 @@ class ModelError(Pam2ExuError):
         Every problem found; a str is a problem without a place.
     source : str, optional
         The model file (or ``"<string>"``), put in front of the message.
+    kind : str
+        What the file is, as the message's head names it (``"3 problems in the study"``):
+        ``"model"`` (the default) or ``"study"`` (a study file, ``pam2exu.studies``).
 
     Attributes
     ----------
@@ -119,18 +122,20 @@ class ModelError(Pam2ExuError):
     ['[model]', '']
     """
 
-    def __init__(self, problems: list[Problem] | Problem | str, source: str | None = None):
+    def __init__(self, problems: list[Problem] | Problem | str, source: str | None = None,
+                 kind: str = "model"):
         if isinstance(problems, (Problem, str)):
             problems = [problems]
         self.problems = [p if isinstance(p, Problem) else Problem("", p) for p in problems]
         self.source = source
+        self.kind = kind
         super().__init__(self._text())
 
     def _text(self) -> str:
         head = f"{self.source}: " if self.source else ""
         if len(self.problems) == 1:
             return head + str(self.problems[0])
-        lines = [f"{head}{len(self.problems)} problems in the model:"]
+        lines = [f"{head}{len(self.problems)} problems in the {self.kind}:"]
         lines += [f"  - {p}" for p in self.problems[:LISTED]]
         if len(self.problems) > LISTED:
             lines.append(f"  … and {len(self.problems) - LISTED} more (error.problems lists "
@@ -153,6 +158,8 @@ class MobilityError(ModelError):
         As for ``ModelError``.
     source : str, optional
         The model file.
+    kind : str
+        As for ``ModelError`` (``"model"``).
     """
 
 

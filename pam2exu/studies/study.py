@@ -175,7 +175,7 @@ def loads_study(text: str, source: str = "<string>", folder: str | Path = ".") -
     _unknown_keys(head, _STUDY_KEYS, "[study]", problems)
     model_path, model_text, model = _model(head, Path(folder), problems)
     if model is None:
-        raise ModelError(problems, source)
+        raise ModelError(problems, source, kind="study")
     settings = _settings(head, model, problems)
     found = targets(model)
     parameters = _parameters(_array(data, "parameter", problems), found, settings["method"],
@@ -189,7 +189,7 @@ def loads_study(text: str, source: str = "<string>", folder: str | Path = ".") -
     elif method == "linear":
         samples = 1
     if problems:
-        raise ModelError(problems, source)
+        raise ModelError(problems, source, kind="study")
     if method == "sobol" and samples & (samples - 1):
         below = 1 << (samples.bit_length() - 1)
         warn_outside(f"{source}: [study]: samples = {samples} is not a power of 2: scrambled "
