@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 
 #: characters of the bar itself
 WIDTH = 30
@@ -42,15 +43,24 @@ class Progress:
         Where to write (default: ``sys.stderr`` at construction time).
     min_total : int
         Below this many units the bar stays silent (the work is over in a blink).
+    rate : bool
+        Also show the units done, their rate and the time left (``1,200/10,000 label
+        35.2/s 0:04:10 left``), from the units done since the first update (a resumed study's
+        earlier work does not count in its rate); redrawn at every update.
+    clock : callable
+        Seconds of a monotonic clock (``time.monotonic``; a test's own).
 
     The line is erased when the bar closes, so what is printed next starts clean.
     """
 
-    def __init__(self, total: int, label: str, stream=None, min_total: int = 2):
+    def __init__(self, total: int, label: str, stream=None, min_total: int = 2,
+                 rate: bool = False, clock=time.monotonic):
         self.stream = sys.stderr if stream is None else stream
         self.total = max(int(total), 0)
         self.label = label
         self.enabled = self.total >= min_total and interactive(self.stream)
+        self.rate, self.clock = rate, clock
+        self._first = None               # (time, done) of the first update
         self._shown = -1
         self._length = 0
 
@@ -63,13 +73,28 @@ class Progress:
             return
         total = self.total if total is None or total <= 0 else total
         percent = min(100, max(0, int(100 * done / max(total, 1))))
-        if percent == self._shown:
+        if percent == self._shown and not self.rate:
             return
         self._shown = percent
         filled = WIDTH * percent // 100
         line = f"{self.label} [{'#' * filled}{'.' * (WIDTH - filled)}] {percent:3d}%"
+        if self.rate:
+            line += self._rate(done, total)
         self._length = max(self._length, len(line))
-        self._write("\r" + line)
+        self._write("\r" + line.ljust(self._length))
+
+    def _rate(self, done: int, total: int) -> str:
+        """'  1,200/10,000 label  35.2/s  0:04:10 left' (rate and time once units were done)."""
+        now = self.clock()
+        if self._first is None:
+            self._first = (now, done)
+        text = f"  {done:,}/{total:,} {self.label}"
+        seconds, units = now - self._first[0], done - self._first[1]
+        if seconds > 0 and units > 0:
+            speed = units / seconds
+            left = int(round(max(total - done, 0) / speed))
+            text += f"  {speed:.3g}/s  {left // 3600}:{left // 60 % 60:02d}:{left % 60:02d} left"
+        return text
 
     def close(self) -> None:
         """Erase the bar's line."""

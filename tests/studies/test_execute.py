@@ -1,0 +1,237 @@
+"""The engine that runs a study's chunks (pam2exu/studies/execute.py, parts.py).
+
+References: the rows computed in one call of the task, in this process (row i depends only
+on the seed and i: tests/studies/chunk_tasks.py), against which every executor, chunking
+and resume must give the same bytes; the contract's "Results" and "Running"
+(shared/spec/studies.md): each chunk written whole, --resume runs only the missing chunks,
+a lost worker costs that chunk's retry. The Dask cluster is a real scheduler and two
+worker processes over TCP on 127.0.0.1, started once for the module.
+"""
+import doctest
+import sys
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from multiprocessing import get_context
+
+import chunk_tasks
+import numpy as np
+import pytest
+
+from pam2exu.errors import OutputError
+from pam2exu.studies import execute, parts
+from pam2exu.studies.execute import ChunkError, open_executor, run_chunks
+from pam2exu.studies.parts import part_files, part_path, plan_chunks
+
+ROWS = 23
+CHUNKS = [(0, 5), (5, 10), (10, 15), (15, 20), (20, 23)]
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A Dask LocalCluster of two single-threaded worker processes on 127.0.0.1."""
+    distributed = __import__("distributed")
+    local = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                     host="127.0.0.1", dashboard_address=None)
+    yield local
+    local.close()
+
+
+@pytest.fixture
+def payload(tmp_path):
+    calls = tmp_path / "calls"
+    calls.mkdir()
+    return {"seed": 7, "calls": str(calls), "marker": str(tmp_path / "died"), "die_at": 12,
+            "bad": 7}
+
+
+def calls(payload) -> list[tuple[int, int]]:
+    """The chunks the task was called for (one file per call)."""
+    from pathlib import Path
+    return sorted(tuple(int(x) for x in p.name.split("-")[:2])
+                  for p in Path(payload["calls"]).iterdir())
+
+
+def forget_calls(payload) -> None:
+    from pathlib import Path
+    for p in Path(payload["calls"]).iterdir():
+        p.unlink()
+
+
+def expected(payload) -> dict:
+    """Every row in one call, in this process."""
+    columns = chunk_tasks.rows(payload, 0, ROWS)
+    forget_calls(payload)
+    return columns
+
+
+def assert_same_bytes(columns: dict, reference: dict) -> None:
+    assert list(columns) == list(reference)
+    for name, values in reference.items():
+        assert columns[name].dtype == values.dtype and columns[name].shape == values.shape
+        assert columns[name].tobytes() == values.tobytes(), name
+
+
+def test_the_docstring_examples():
+    for module in (parts, execute):
+        assert doctest.testmod(module).failed == 0
+
+
+@pytest.mark.parametrize("variants, seconds, workers", [(1, 0.01, 1), (23, 0.3, 2),
+                                                        (10_000, 0.01, 2), (10_000, 2.0, 8),
+                                                        (999_983, 1e-4, 64)])
+def test_the_chunks_tile_the_rows_with_a_second_or_more_of_work(variants, seconds, workers):
+    chunks = plan_chunks(variants, seconds, workers)
+    assert chunks == plan_chunks(variants, seconds, workers)
+    assert chunks[0][0] == 0 and chunks[-1][1] == variants
+    assert all(a[1] == b[0] for a, b in zip(chunks, chunks[1:]))
+    sizes = [stop - start for start, stop in chunks]
+    assert max(sizes) - min(sizes) <= 1                      # near-equal
+    assert all(size * seconds >= parts.MIN_SECONDS for size in sizes) or len(chunks) == 1
+    assert all((size - 1) * seconds <= parts.MAX_SECONDS for size in sizes)
+
+
+def test_in_process_a_pool_and_dask_give_the_same_bytes(tmp_path, payload, cluster):
+    reference = expected(payload)
+    runs = {}
+    runs["in-process"] = run_chunks(chunk_tasks.rows, payload, CHUNKS, tmp_path / "a.parts")
+    with ProcessPoolExecutor(2, mp_context=get_context(execute.START_METHOD)) as pool:
+        runs["pool"] = run_chunks(chunk_tasks.rows, payload, CHUNKS, tmp_path / "b.parts",
+                                  executor=pool)
+    with open_executor(dask=cluster.scheduler_address) as client:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        runs["dask"] = run_chunks(chunk_tasks.rows, payload, CHUNKS, tmp_path / "c.parts",
+                                  executor=client)
+    other = [(0, 1), (1, 23)]                  # another chunking: the same table
+    runs["chunked otherwise"] = run_chunks(chunk_tasks.rows, payload, other,
+                                           tmp_path / "d.parts")
+    for name, run in runs.items():
+        assert_same_bytes(run.columns, reference)
+        assert run.reused == ()
+    for folder in ("b.parts", "c.parts"):      # every part the same bytes, too
+        for start, stop in CHUNKS:
+            assert (part_path(tmp_path / folder, start, stop).read_bytes()
+                    == part_path(tmp_path / "a.parts", start, stop).read_bytes())
+    assert len(calls(payload)) == 3 * len(CHUNKS) + 2
+
+
+def test_resume_computes_only_the_missing_and_unreadable_parts(tmp_path, payload):
+    reference = expected(payload)
+    folder = tmp_path / "OUT.parts"
+    first = run_chunks(chunk_tasks.rows, payload, CHUNKS, folder)
+    saved = {p.name: p.read_bytes() for p in part_files(folder)}
+    assert sorted(saved) == sorted(part_path(folder, *c).name for c in CHUNKS)
+    part_path(folder, 5, 10).unlink()
+    broken = part_path(folder, 15, 20)
+    broken.write_bytes(saved[broken.name][:100])          # cut short: rerun
+    forget_calls(payload)
+    resumed = run_chunks(chunk_tasks.rows, payload, CHUNKS, folder, resume=True)
+    assert calls(payload) == [(5, 10), (15, 20)]
+    assert resumed.computed == ((5, 10), (15, 20))
+    assert resumed.reused == ((0, 5), (10, 15), (20, 23))
+    assert_same_bytes(resumed.columns, reference)
+    assert_same_bytes(first.columns, reference)
+    assert {p.name: p.read_bytes() for p in part_files(folder)} == saved
+
+    # chunked otherwise on resume: nothing to compute; without resume: everything
+    forget_calls(payload)
+    again = run_chunks(chunk_tasks.rows, payload, [(0, 11), (11, 23)], folder, resume=True)
+    assert calls(payload) == [] and again.computed == ()
+    assert_same_bytes(again.columns, reference)
+    fresh = run_chunks(chunk_tasks.rows, payload, [(0, 11), (11, 23)], folder)
+    assert calls(payload) == [(0, 11), (11, 23)] and fresh.reused == ()
+    assert [p.name for p in part_files(folder)] == [part_path(folder, 0, 11).name,
+                                                     part_path(folder, 11, 23).name]
+
+    # another study (another key) reuses nothing
+    forget_calls(payload)
+    other = run_chunks(chunk_tasks.rows, dict(payload, seed=8), [(0, 11), (11, 23)], folder,
+                       resume=True)
+    assert calls(payload) == [(0, 11), (11, 23)]
+    assert other.columns["x"].tobytes() != reference["x"].tobytes()
+
+
+def test_a_worker_lost_mid_chunk_is_retried_on_the_pool(tmp_path, payload):
+    reference = expected(payload)
+    folder = tmp_path / "OUT.parts"
+    with ProcessPoolExecutor(2, mp_context=get_context(execute.START_METHOD)) as pool:
+        run = run_chunks(chunk_tasks.dies_once, payload, CHUNKS, folder, executor=pool)
+    assert (tmp_path / "died").exists()                 # the first attempt did die
+    assert_same_bytes(run.columns, reference)
+    assert len(part_files(folder)) == len(CHUNKS)
+
+
+def test_a_worker_lost_too_often_is_an_error_naming_its_chunk(tmp_path, payload):
+    """The chunks in flight beside the one that kills its worker are not blamed: they are
+    run again one at a time, and only the culprit is charged its retries."""
+    folder = tmp_path / "OUT.parts"
+    with ProcessPoolExecutor(2, mp_context=get_context(execute.START_METHOD)) as pool:
+        with pytest.raises(ChunkError, match=r"chunk of variants 15 … 19: its worker process "
+                                             r"was lost 2 times .*--resume") as error:
+            run_chunks(chunk_tasks.always_dies, dict(payload, die_at=17), CHUNKS, folder,
+                       executor=pool, retries=1)
+    assert (error.value.start, error.value.stop) == (15, 20)
+    assert [p.name for p in part_files(folder)][:3] == [part_path(folder, *c).name
+                                                        for c in CHUNKS[:3]]
+    assert not part_path(folder, 15, 20).exists()
+
+
+def test_a_worker_lost_mid_chunk_is_retried_on_dask(tmp_path, payload, cluster):
+    reference = expected(payload)
+    with open_executor(dask=cluster.scheduler_address) as client:
+        run = run_chunks(chunk_tasks.dies_once, payload, CHUNKS, tmp_path / "OUT.parts",
+                         executor=client)
+        assert (tmp_path / "died").exists()
+        assert_same_bytes(run.columns, reference)
+
+        with pytest.raises(ChunkError, match=r"chunk of variants 5 … 9 failed: "
+                                             r"ZeroDivisionError: a bug in the task"):
+            run_chunks(chunk_tasks.raises, payload, CHUNKS, tmp_path / "bug.parts",
+                       executor=client)
+
+
+@pytest.mark.parametrize("pooled", [False, True])
+def test_a_task_that_raises_stops_the_run_and_keeps_the_finished_chunks(tmp_path, payload,
+                                                                        pooled):
+    """In-process, and on an executor (one thread: the chunks in order, as in-process)."""
+    reference = expected(payload)
+    folder = tmp_path / "OUT.parts"
+    pool = ThreadPoolExecutor(1) if pooled else None
+    try:
+        with pytest.raises(ChunkError, match=r"chunk of variants 5 … 9 failed: "
+                                             r"ZeroDivisionError: a bug in the task; the "
+                                             r"finished chunks are kept under") as error:
+            run_chunks(chunk_tasks.raises, payload, CHUNKS, folder, executor=pool, key="k")
+    finally:
+        if pool:
+            pool.shutdown()
+    assert isinstance(error.value.__cause__, ZeroDivisionError)
+    assert [p.name for p in part_files(folder)] == [part_path(folder, 0, 5).name]
+    forget_calls(payload)
+    run = run_chunks(chunk_tasks.rows, payload, CHUNKS, folder, resume=True, key="k")
+    assert calls(payload) == CHUNKS[1:]
+    assert_same_bytes(run.columns, reference)
+
+
+def test_columns_that_are_not_the_chunks_rows_are_an_error(tmp_path, payload):
+    with pytest.raises(ChunkError, match=r"chunk of variants 0 … 4 returned column 'x' of "
+                                         r"shape \(4,\) .*not 5 rows"):
+        run_chunks(chunk_tasks.short, payload, CHUNKS, tmp_path / "OUT.parts")
+    with pytest.raises(ValueError, match="chunks must tile the rows from 0"):
+        run_chunks(chunk_tasks.rows, payload, [(0, 5), (6, 9)], tmp_path / "OUT.parts")
+
+
+def test_dask_missing_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    for options in ({"dask": "tcp://127.0.0.1:8786"}, {"dask_local": 2}):
+        with pytest.raises(OutputError, match=r'pip install "pam2exu\[dask\]"'):
+            with open_executor(**options):
+                pass
+
+
+@pytest.mark.long
+def test_a_local_cluster_is_started_and_stopped_by_the_run(tmp_path, payload):
+    reference = expected(payload)
+    with open_executor(dask_local=2) as client:
+        run = run_chunks(chunk_tasks.rows, payload, CHUNKS, tmp_path / "OUT.parts",
+                         executor=client)
+    assert client.status == "closed"
+    assert_same_bytes(run.columns, reference)
