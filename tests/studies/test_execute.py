@@ -229,9 +229,14 @@ def test_dask_missing_names_the_extra(monkeypatch):
 
 @pytest.mark.long
 def test_a_local_cluster_is_started_and_stopped_by_the_run(tmp_path, payload):
+    """``--dask-local 2``; with no retries, the first lost worker is a ChunkError."""
     reference = expected(payload)
-    with open_executor(dask_local=2) as client:
+    with open_executor(dask_local=2, retries=0) as client:
         run = run_chunks(chunk_tasks.rows, payload, CHUNKS, tmp_path / "OUT.parts",
                          executor=client)
+        assert_same_bytes(run.columns, reference)
+        with pytest.raises(ChunkError, match=r"chunk of variants 10 … 14: its worker process "
+                                             r"was lost more often than the scheduler allows"):
+            run_chunks(chunk_tasks.always_dies, payload, CHUNKS, tmp_path / "lost.parts",
+                       executor=client)
     assert client.status == "closed"
-    assert_same_bytes(run.columns, reference)
