@@ -7,9 +7,9 @@ in row order): first to a temporary name in the same folder, then renamed
 (``os.replace``), so a part on disk is always complete and an interrupted study loses no
 finished chunk. A part is an uncompressed NumPy ``.npz`` archive as ``numpy.savez`` writes
 it, but with fixed time stamps, so the same chunk is the same bytes (no pickles: bit-exact
-numbers and fixed-width strings; ``numpy.load`` reads it): ``__key__`` the study's fingerprint, ``__names__`` the
-column names in order, and ``c0``, ``c1``, … the columns, each with one entry per row along
-its first axis.
+numbers and fixed-width strings; ``numpy.load`` reads it): ``__key__`` the study's
+fingerprint, ``__names__`` the column names in order, and ``c0``, ``c1``, … the columns,
+each with one entry per row along its first axis.
 
 ``plan_chunks`` chooses the chunk boundaries from the number of variants, an estimate of
 the seconds one variant takes and the number of workers, deterministically: the same inputs

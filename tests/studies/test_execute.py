@@ -11,9 +11,10 @@ import doctest
 import sys
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from multiprocessing import get_context
+from pathlib import Path
 
 import chunk_tasks
-import numpy as np
+import distributed
 import pytest
 
 from pam2exu.errors import OutputError
@@ -28,7 +29,6 @@ CHUNKS = [(0, 5), (5, 10), (10, 15), (15, 20), (20, 23)]
 @pytest.fixture(scope="module")
 def cluster():
     """A Dask LocalCluster of two single-threaded worker processes on 127.0.0.1."""
-    distributed = __import__("distributed")
     local = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                      host="127.0.0.1", dashboard_address=None)
     yield local
@@ -45,13 +45,11 @@ def payload(tmp_path):
 
 def calls(payload) -> list[tuple[int, int]]:
     """The chunks the task was called for (one file per call)."""
-    from pathlib import Path
     return sorted(tuple(int(x) for x in p.name.split("-")[:2])
                   for p in Path(payload["calls"]).iterdir())
 
 
 def forget_calls(payload) -> None:
-    from pathlib import Path
     for p in Path(payload["calls"]).iterdir():
         p.unlink()
 
