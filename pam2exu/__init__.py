@@ -188,7 +188,61 @@ def energy(model, analysis=None, **settings):
     return _energy(model, analysis, **settings)
 
 
-__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "Results", "read_csv",
+def study(study_or_path, executor=None, out=None, resume=False, samples=None, workers=None,
+          progress=False):
+    """Run a study: one analysis of one model for many variants of its values
+    (docs/studies.md); returns a ``StudyResult`` with ``.table``, ``.summary``, ``.yield_``.
+
+    Every check comes before any variant runs; a variant that fails is a row with status
+    ``error`` and its message, never a stopped study. The same as
+    ``pam2exu.studies.runner.study``.
+
+    Parameters
+    ----------
+    study_or_path : Study, str or Path
+        A study (``pam2exu.studies.load_study``) or the path of a study file.
+    executor : concurrent.futures.Executor, optional
+        Runs the chunks of variants (default: this process, or ``workers`` processes).
+    out : str or Path, optional
+        Write the per-variant table (``.parquet`` or ``.csv``) and ``OUT.summary.csv``.
+    resume : bool
+        Run only the chunks missing under ``OUT.parts/`` (with the chunk engine).
+    samples : int, optional
+        The number of variants, instead of the study's (sampled methods).
+    workers : int, optional
+        Local worker processes (default 1).
+    progress : bool
+        A progress bar on a terminal (with the chunk engine).
+
+    Returns
+    -------
+    StudyResult
+        ``.table`` (NumPy columns ``sample``, ``status``, ``error``, the parameters, the
+        reduced outputs), ``.summary`` (rows), ``.yield_`` (share ok, Wilson interval),
+        ``.to_pandas()``, ``.to_parquet(path)``, ``.to_csv(path)``, ``.report()``.
+
+    Raises
+    ------
+    ModelError
+        The study file has problems (every one listed, each naming its entry), asks what a
+        study cannot do yet (``method = "linear"``, ``analysis = "clearance"``), or its
+        nominal model does not run; nothing is written.
+    OutputError
+        ``out`` has an unknown suffix or needs a library that is not installed.
+
+    Examples
+    --------
+    >>> result = pam2exu.study("examples/studies/slider_crank_tolerance.toml",
+    ...                        samples=4)                                # doctest: +SKIP
+    >>> result.table["status"].tolist()                                  # doctest: +SKIP
+    ['ok', 'ok', 'ok', 'ok']
+    """
+    from .studies.runner import study as _study
+    return _study(study_or_path, executor=executor, out=out, resume=resume, samples=samples,
+                  workers=workers, progress=progress)
+
+
+__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "study", "Results", "read_csv",
            "compare", "Comparison", "verify", "Verification", "export", "plot", "draw", "animate",
            "ELEMENTS", *(cls.__name__ for cls in ELEMENTS.values()), "Pam2ExuError",
            "ModelError", "MobilityError", "SolverError", "TranslationError",

@@ -1,0 +1,191 @@
+"""A study's result: the per-variant table, the summary and the yield, their files
+(``OUT.parquet`` or ``OUT.csv``, ``OUT.summary.csv`` beside it) and the printed report.
+
+The per-variant table has one row per variant in variant order: ``sample`` (int64),
+``status`` (ok, rejected, error), ``error`` (the error's class and message, '' unless in
+error), each parameter's value, each reduced output (float64; NaN for a variant in error).
+Its files read back bit for bit: Parquet's float64 columns as they are, CSV's numbers in
+the shortest digits that read back exactly (``results.table_csv.csv_block``), a NaN as an
+empty field. Each file is written under a temporary name then renamed.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from ..errors import OutputError
+from ..results.table_csv import csv_block, csv_field
+from ..results.writers import _replace, optional
+from .reduce import ERROR, OK
+from .summary import error_groups, summary, write_summary
+
+#: the per-variant table's file formats, by suffix
+STUDY_FORMATS = {".parquet": "Parquet", ".csv": "CSV"}
+#: the summary's columns the printed report shows
+SHOWN = ("count", "mean", "std", "min", "q05", "q50", "q95", "max")
+#: the error groups the printed report lists (the others are counted)
+GROUPS_SHOWN = 10
+
+
+class Yield(NamedTuple):
+    """The share of the variants with status ok and its 95 % Wilson interval."""
+
+    share: float
+    low: float
+    high: float
+    ok: int
+    count: int
+
+
+def summary_path(out: str | Path) -> Path:
+    """``OUT.summary.csv`` beside ``OUT.parquet`` (or ``OUT.csv``)."""
+    out = Path(out)
+    return out.with_name(out.stem + ".summary.csv")
+
+
+def check_out(out: str | Path) -> Path:
+    """The per-variant table's path, checked before anything runs: a known suffix, its
+    library installed (``OutputError`` otherwise)."""
+    out = Path(out)
+    suffix = out.suffix.lower()
+    if suffix not in STUDY_FORMATS:
+        raise OutputError(f"{out}: a study writes its table as "
+                          f"{' or '.join(STUDY_FORMATS)} (the format from the suffix), not "
+                          f"'{out.suffix or 'no suffix'}'")
+    if suffix == ".parquet":
+        optional("pyarrow.parquet", "a Parquet file")
+    if not out.parent.is_dir():
+        raise OutputError(f"{out}: the folder '{out.parent}' does not exist")
+    return out
+
+
+class StudyResult:
+    """The result of ``pam2exu.study``.
+
+    Attributes
+    ----------
+    study : Study
+        The study as it ran.
+    table : dict of str to numpy.ndarray
+        The per-variant columns: ``sample``, ``status``, ``error``, each parameter, each
+        reduced output, in variant order.
+    parameters, outputs : list of str
+        The parameters' and the reduced outputs' column names.
+    units : dict of str to str
+        Each parameter's and reduced output's unit (SI; a parameter's in the model's).
+    summary : list of SummaryRow
+        One row per reduced output over the variants that ran, then the row ``yield``.
+    """
+
+    def __init__(self, study, table: dict, outputs: list[str], units: dict[str, str]):
+        self.study = study
+        self.table = table
+        self.parameters = list(study.names)
+        self.outputs = list(outputs)
+        self.units = {**{p.name: p.unit for p in study.parameters}, **units}
+        self.summary = summary({n: table[n] for n in self.outputs}, table["status"])
+
+    def __len__(self) -> int:
+        return len(self.table["sample"])
+
+    def __repr__(self) -> str:
+        return (f"<StudyResult {self.study.analysis} of '{self.study.model_path}': "
+                f"{len(self)} variants, yield {self.yield_.share:.4g}>")
+
+    @property
+    def yield_(self) -> Yield:
+        """The share of the variants with status ok, with its 95 % Wilson interval."""
+        row = self.summary[-1]
+        ok = int(np.count_nonzero(self.table["status"] == OK))
+        return Yield(row.mean, row.min, row.max, ok, row.count)
+
+    def errors(self) -> list[tuple[str, list[int]]]:
+        """The variants in error grouped by their error (``summary.error_groups``)."""
+        t = self.table
+        return error_groups(t["status"], t["error"], t["sample"])
+
+    def to_pandas(self):
+        """The per-variant table as a pandas DataFrame (copies, bit for bit); ``attrs``
+        holds ``units``. Needs pandas (``pip install "pam2exu[pandas]"``)."""
+        pd = optional("pandas", "a DataFrame")
+        df = pd.DataFrame({n: np.array(c, copy=True) for n, c in self.table.items()})
+        df.attrs["units"] = dict(self.units)
+        return df
+
+    def to_parquet(self, path: str | Path) -> Path:
+        """Write the per-variant table as Parquet (float64 columns bit for bit, each
+        column's unit in its field's metadata), under a temporary name then renamed.
+        Needs pyarrow (``pip install "pam2exu[parquet]"``)."""
+        pa = optional("pyarrow", "a Parquet file")
+        parquet = optional("pyarrow.parquet", "a Parquet file")
+        arrays, fields = [], []
+        for name, column in self.table.items():
+            kind = {"sample": pa.int64()}.get(name, pa.string() if column.dtype.kind == "U"
+                                               else pa.float64())
+            arrays.append(pa.array(column.tolist() if column.dtype.kind == "U" else column,
+                                   type=kind))
+            fields.append(pa.field(name, kind, metadata={"unit": self.units.get(name, "")}))
+        table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
+        return _replace(Path(path), lambda tmp: parquet.write_table(table, tmp))
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the per-variant table as CSV: a header of the column names, then one line
+        per variant; numbers in the shortest digits that read back exactly, NaN empty, an
+        error quoted when it holds a separator, a quote or a line break."""
+        path = Path(path)
+        names = list(self.table)
+        numbers = np.column_stack([self.table[n] for n in names[3:]]).astype(float)
+        text = csv_block(numbers).tobytes().decode("ascii").splitlines()
+        lines = [",".join(csv_field(n) for n in names)]
+        t = self.table
+        for k, line in enumerate(text):
+            cells = ["" if c == "nan" else c for c in line.split(",")]
+            lines.append(",".join([str(int(t["sample"][k])), str(t["status"][k]),
+                                   csv_field(str(t["error"][k])), *cells]))
+        body = ("\n".join(lines) + "\n").encode("utf-8")
+        return _replace(path, lambda tmp: tmp.write_bytes(body))
+
+    def write(self, out: str | Path) -> tuple[Path, Path]:
+        """Write ``OUT.parquet`` or ``OUT.csv`` (by suffix) and ``OUT.summary.csv``."""
+        out = check_out(out)
+        written = self.to_parquet(out) if out.suffix.lower() == ".parquet" else self.to_csv(out)
+        return written, write_summary(self.summary, summary_path(out))
+
+    def report(self) -> str:
+        """The printed form: the summary table, the yield, the variants in error grouped by
+        their error."""
+        s = self.study
+        lines = [f"study of {os.path.normpath(s.model_path)}: {s.analysis}, {len(self)} variants "
+                 f"({s.method}{f', seed {s.seed}' if s.method != 'grid' else ''}), "
+                 f"{s.steps} steps to t = {s.t_end:.6g} s"]
+        width = max([len("output"), *(len(r.output) for r in self.summary[:-1])])
+        lines.append("  ".join([f"{'output':<{width}}", *(f"{c:>11}" for c in SHOWN)]))
+        for row in self.summary[:-1]:
+            cells = [f"{row.count:>11d}", *(_number(getattr(row, c)) for c in SHOWN[1:])]
+            lines.append("  ".join([f"{row.output:<{width}}", *cells]))
+        y = self.yield_
+        lines.append(f"yield: {y.share:.4g} ({y.ok} of {y.count} variants ok), 95 % Wilson "
+                     f"interval {y.low:.4g} … {y.high:.4g}")
+        rejected = int(np.count_nonzero(self.table["status"] == "rejected"))
+        failed = int(np.count_nonzero(self.table["status"] == ERROR))
+        lines.append(f"rejected by the requirements: {rejected}; in error: {failed}")
+        groups = self.errors()
+        for error, samples in groups[:GROUPS_SHOWN]:
+            shown = ", ".join(map(str, samples[:10])) + (", …" if len(samples) > 10 else "")
+            lines.append(f"  {len(samples)} × {error.splitlines()[0] if error else ''}")
+            lines.append(f"      samples {shown}")
+        if len(groups) > GROUPS_SHOWN:
+            lines.append(f"  … and {len(groups) - GROUPS_SHOWN} other errors")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.report()
+
+
+def _number(x: float) -> str:
+    """A statistic in 11 characters (an empty field for NaN)."""
+    return f"{'':>11}" if np.isnan(x) else f"{x:>11.5g}"
+

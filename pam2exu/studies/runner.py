@@ -1,0 +1,218 @@
+"""Running a study: every check before any variant runs, each variant built and run in a
+worker from the model's text and its values, the chunks of variants run and merged in
+variant order, the result (``result.StudyResult``).
+
+A worker receives a payload of plain data (``payload``: the model's text, the analysis
+settings, the reductions, the requirements, the parameters' names and every variant's
+values), never solver objects, and runs rows ``start … stop − 1`` (``run_variants``). A
+variant that fails is a row with status ``error``: a pam2exu error with its class and
+message, any other exception named as a fault of pam2exu. It never stops the study.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ModelError, Pam2ExuError, Problem
+from .parameters import varied
+from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_table
+from .result import StudyResult, check_out
+from .study import SAMPLED, Study, load_study
+
+#: the analyses a study runs today (a clearance study follows its own dimension path:
+#: not available yet)
+STUDY_ANALYSES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
+#: the methods a study runs today (``linear``, first-order propagation: not available yet)
+STUDY_METHODS = SAMPLED + ("grid",)
+#: what an error row's message says of an exception that is not a pam2exu error
+FAULT = "fault of pam2exu (please report it with the study)"
+#: chunks per worker of the in-process chunk loop
+PER_WORKER = 4
+
+
+def error_text(exc: BaseException) -> str:
+    """An error row's ``error``: '<class>: <message>' of a pam2exu error, else the fault's."""
+    head = type(exc).__name__ if isinstance(exc, Pam2ExuError) else \
+        f"{FAULT}: {type(exc).__name__}"
+    return f"{head}: {exc}"
+
+
+def run_variant(payload: dict, values: np.ndarray):
+    """One variant's reduced outputs and status, or (None, error text); never raises a
+    ``Exception`` (KeyboardInterrupt and SystemExit pass)."""
+    from ..analyses import run
+    try:
+        model = varied(payload["model_text"], dict(zip(payload["names"], values)),
+                       payload["source"])
+        with warnings.catch_warnings():              # each variant's: not the study's
+            warnings.simplefilter("ignore")
+            res = run(model, payload["analysis"], t_end=payload["t_end"],
+                      steps=payload["steps"], outputs=payload["outputs"])
+        reduced = reduce_run(res, payload["outputs"], payload["reduce"])
+        return reduced, status(reduced, payload["requirements"])
+    except Exception as exc:                          # noqa: BLE001 (a failure is data)
+        return None, error_text(exc)
+
+
+def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
+    """The per-variant columns of rows ``start … stop − 1`` (``reduce.variant_table``):
+    the worker's task, a top-level function of plain data.
+
+    Parameters
+    ----------
+    payload : dict
+        ``payload(study, outputs)``: model text and source, analysis, t_end, steps,
+        outputs, reduce, requirements, the parameters' names, every variant's values.
+    start, stop : int
+        The rows.
+    """
+    rows = []
+    for i in range(start, stop):
+        values = payload["values"][i]
+        reduced, outcome = run_variant(payload, values)
+        rows.append(Variant(i, ERROR, outcome, tuple(values), None) if reduced is None
+                    else Variant(i, outcome, "", tuple(values), reduced))
+    return variant_table(payload["names"], payload["reduced"], rows)
+
+
+def payload(study: Study, reduced: list[str]) -> dict:
+    """What every worker receives: plain data, no solver objects."""
+    return {"model_text": study.model_text, "source": str(study.model_path),
+            "analysis": study.analysis, "t_end": study.t_end, "steps": study.steps,
+            "outputs": study.outputs, "reduce": list(study.reduce),
+            "requirements": [tuple(r) for r in study.requirements], "names": study.names,
+            "reduced": reduced, "values": study.variants()}
+
+
+def prepared(study: Study, samples: int | None = None) -> Study:
+    """The study as it will run (``samples`` overriding its own); ``ModelError`` naming the
+    entry for what a study cannot do today (a linear method, a clearance analysis)."""
+    problems = []
+    if study.method not in STUDY_METHODS:
+        problems.append(Problem("[study]", f"method = '{study.method}' is not available yet: "
+                                           f"a study runs {', '.join(STUDY_METHODS)} today"))
+    if study.analysis not in STUDY_ANALYSES:
+        problems.append(Problem("[study]", f"analysis = '{study.analysis}' is not available in "
+                                           f"a study yet: a study runs "
+                                           f"{', '.join(STUDY_ANALYSES)} analyses today"))
+    if samples is not None:
+        if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+            problems.append(Problem("samples", f"must be a whole number ≥ 1, got {samples!r}"))
+        elif study.method not in SAMPLED:
+            problems.append(Problem("samples", f"a {study.method} study takes no samples: it "
+                                               "runs every combination of the values lists"))
+        else:
+            study = dataclasses.replace(study, samples=samples)
+    if problems:
+        raise ModelError(problems, study.source, kind="study")
+    return study
+
+
+def nominal(study: Study):
+    """The nominal model's run (its warnings issued): the reduced outputs' names and units;
+    ``ModelError`` when it fails (a study varies a model that runs)."""
+    from ..analyses import run
+    try:
+        res = run(study.model, study.analysis, t_end=study.t_end, steps=study.steps,
+                  outputs=study.outputs)
+    except ModelError as exc:
+        raise ModelError([Problem(f"[study] model '{study.model_path}'", str(exc))],
+                         study.source, kind="study") from None
+    except Pam2ExuError as exc:
+        raise ModelError([Problem("[study]", f"the nominal model fails ({type(exc).__name__}: "
+                                             f"{exc}): a study varies a model that runs")],
+                         study.source, kind="study") from None
+    names = reduced_names(res.columns, study.outputs, study.reduce)
+    missing = [Problem(f"[[requirement]] '{r.output}'", f"'{r.output}' is not among the "
+                                                        f"reduced outputs of the {study.analysis} "
+                                                        "analysis")
+               for r in study.requirements if r.output not in names]
+    if missing:
+        raise ModelError(missing, study.source, kind="study")
+    units = {n: res.units.get(n.rpartition(".")[0], "") for n in names}
+    return names, units
+
+
+def in_process(task, work: dict, chunks: list[tuple[int, int]], executor=None) -> dict:
+    """The chunks run in order in this process (or submitted to ``executor``) and merged in
+    chunk order (the chunk engine's shape, without parts on disk)."""
+    if executor is None:
+        done = [task(work, a, b) for a, b in chunks]
+    else:
+        done = [f.result() for f in [executor.submit(task, work, a, b) for a, b in chunks]]
+    return {name: np.concatenate([d[name] for d in done]) for name in done[0]}
+
+
+def chunks_of(samples: int, workers: int) -> list[tuple[int, int]]:
+    """(start, stop) of ``PER_WORKER`` chunks per worker, in order."""
+    size = max(1, math.ceil(samples / (PER_WORKER * workers)))
+    return [(a, min(a + size, samples)) for a in range(0, samples, size)]
+
+
+def study(study_or_path, executor=None, out=None, resume: bool = False,
+          samples: int | None = None, workers: int | None = None,
+          progress: bool = False) -> StudyResult:
+    """Run a study: every variant of it, reduced, with the summary and the yield.
+
+    Parameters
+    ----------
+    study_or_path : Study, str or Path
+        A study (``load_study``) or its file.
+    executor : concurrent.futures.Executor, optional
+        Runs the chunks of variants (default: this process, or a process pool of
+        ``workers``).
+    out : str or Path, optional
+        The per-variant table's file, ``.parquet`` or ``.csv`` (the summary beside it,
+        ``OUT.summary.csv``); checked before any variant runs. None: nothing written.
+    resume : bool
+        Run only the chunks missing under ``OUT.parts/`` (with the chunk engine).
+    samples : int, optional
+        The number of variants, instead of the study's (sampled methods).
+    workers : int, optional
+        Local worker processes (default 1: this process).
+    progress : bool
+        A progress bar on a terminal (with the chunk engine).
+
+    Returns
+    -------
+    StudyResult
+
+    Raises
+    ------
+    ModelError
+        The study file has problems, asks what a study cannot do yet (``linear``,
+        ``clearance``), or its nominal model does not run; nothing is written.
+    OutputError
+        ``out`` has an unknown suffix or needs a library that is not installed.
+
+    Examples
+    --------
+    >>> import pam2exu
+    >>> result = pam2exu.study("examples/studies/slider_crank_tolerance.toml",
+    ...                        samples=3)                                # doctest: +SKIP
+    >>> result.yield_.share                                              # doctest: +SKIP
+    1.0
+    """
+    given = study_or_path if isinstance(study_or_path, Study) else load_study(study_or_path)
+    run_as = prepared(given, samples)
+    if out is not None:
+        out = check_out(out)
+    names, units = nominal(run_as)
+    work = payload(run_as, names)
+    workers = max(1, workers or 1)
+    chunks = chunks_of(run_as.samples, workers)
+    if executor is None and workers > 1:
+        from concurrent.futures import ProcessPoolExecutor
+        with ProcessPoolExecutor(workers) as pool:
+            table = in_process(run_variants, work, chunks, pool)
+    else:
+        table = in_process(run_variants, work, chunks, executor)
+    result = StudyResult(run_as, table, names, units)
+    if out is not None:
+        result.write(out)
+    return result
+
