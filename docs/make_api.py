@@ -72,6 +72,11 @@ SECTIONS: list[tuple[str, str, list[tuple[str, str]]]] = [
     ("Exporting to Exudyn",
      "A standalone Exudyn script of a model; the user guide is [export.md](export.md).",
      [("pam2exu", "export"), ("pam2exu.export", "script")]),
+    ("Studies",
+     ("One analysis of one model run for many variants of its values (tolerances, sweeps); "
+      "the user guide is [studies.md](studies.md)."),
+     [("pam2exu", "study"), ("pam2exu.studies.result", "StudyResult"),
+      ("pam2exu.studies", "load_study")]),
     ("Pictures",
      ("Plots of variables against time, drawings and animations of the mechanism. Figures "
       "use matplotlib's Agg canvas (no window); the user guide is [pictures.md](pictures.md)."),

@@ -65,6 +65,17 @@ def check_out(out: str | Path) -> Path:
 class StudyResult:
     """The result of ``pam2exu.study``.
 
+    Parameters
+    ----------
+    study : Study
+        The study as it ran.
+    table : dict of str to numpy.ndarray
+        The per-variant columns (``runner.run_variants``, merged in variant order).
+    outputs : list of str
+        The reduced outputs' names, in the table's order.
+    units : dict of str to str
+        Each reduced output's unit.
+
     Attributes
     ----------
     study : Study
@@ -118,7 +129,13 @@ class StudyResult:
     def to_parquet(self, path: str | Path) -> Path:
         """Write the per-variant table as Parquet (float64 columns bit for bit, each
         column's unit in its field's metadata), under a temporary name then renamed.
-        Needs pyarrow (``pip install "pam2exu[parquet]"``)."""
+        Needs pyarrow (``pip install "pam2exu[parquet]"``).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (replaced if it exists).
+        """
         pa = optional("pyarrow", "a Parquet file")
         parquet = optional("pyarrow.parquet", "a Parquet file")
         arrays, fields = [], []
@@ -134,7 +151,14 @@ class StudyResult:
     def to_csv(self, path: str | Path) -> Path:
         """Write the per-variant table as CSV: a header of the column names, then one line
         per variant; numbers in the shortest digits that read back exactly, NaN empty, an
-        error quoted when it holds a separator, a quote or a line break."""
+        error quoted when it holds a separator, a quote or a line break; under a temporary
+        name then renamed.
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (replaced if it exists).
+        """
         path = Path(path)
         names = list(self.table)
         numbers = np.column_stack([self.table[n] for n in names[3:]]).astype(float)
@@ -149,7 +173,13 @@ class StudyResult:
         return _replace(path, lambda tmp: tmp.write_bytes(body))
 
     def write(self, out: str | Path) -> tuple[Path, Path]:
-        """Write ``OUT.parquet`` or ``OUT.csv`` (by suffix) and ``OUT.summary.csv``."""
+        """Write ``OUT.parquet`` or ``OUT.csv`` (by suffix) and ``OUT.summary.csv``.
+
+        Parameters
+        ----------
+        out : str or Path
+            The per-variant table's file (``check_out``).
+        """
         out = check_out(out)
         written = self.to_parquet(out) if out.suffix.lower() == ".parquet" else self.to_csv(out)
         return written, write_summary(self.summary, summary_path(out))

@@ -90,7 +90,8 @@ def payload(study: Study, reduced: list[str]) -> dict:
 
 def prepared(study: Study, samples: int | None = None) -> Study:
     """The study as it will run (``samples`` overriding its own); ``ModelError`` naming the
-    entry for what a study cannot do today (a linear method, a clearance analysis)."""
+    entry for what a study cannot do today (a linear method, a clearance analysis, the
+    series table)."""
     problems = []
     if study.method not in STUDY_METHODS:
         problems.append(Problem("[study]", f"method = '{study.method}' is not available yet: "
@@ -99,6 +100,9 @@ def prepared(study: Study, samples: int | None = None) -> Study:
         problems.append(Problem("[study]", f"analysis = '{study.analysis}' is not available in "
                                            f"a study yet: a study runs "
                                            f"{', '.join(STUDY_ANALYSES)} analyses today"))
+    if study.series:
+        problems.append(Problem("[study]", "series = true is not available yet: a study keeps "
+                                           "the reduced outputs of each variant today"))
     if samples is not None:
         if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
             problems.append(Problem("samples", f"must be a whole number ≥ 1, got {samples!r}"))

@@ -235,6 +235,7 @@ BAD = {  # (what to change in SLIDER_STUDY, a piece of the message that names th
                "method = 'linear' is not available yet"),
     "clearance": (('analysis = "kinetostatic"', 'analysis = "clearance"'),
                   "analysis = 'clearance' is not available in a study yet"),
+    "series": (("seed = 7", "seed = 7\nseries = true"), "series = true is not available yet"),
 }
 
 
