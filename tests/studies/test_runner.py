@@ -273,3 +273,13 @@ def test_the_files_read_back_bit_for_bit(tmp_path):
     assert summary[-1].startswith("yield,4,2.5e-1,,")
     df = result.to_pandas()
     assert df["status"].tolist() == ["rejected", "error", "ok", "error"]
+
+
+def test_two_worker_processes_give_the_same_table_bit_for_bit(slider):
+    again = study(loads_study(SLIDER_STUDY, folder=EXAMPLES), workers=2)
+    assert list(again.table) == list(slider.table)
+    for name, column in slider.table.items():
+        other = again.table[name]
+        same = np.array_equal(other.view(np.int64), column.view(np.int64)) \
+            if column.dtype.kind == "f" else np.array_equal(other, column)
+        assert same, name
