@@ -42,8 +42,8 @@ def error_text(exc: BaseException) -> str:
 
 
 def run_variant(payload: dict, values: np.ndarray):
-    """One variant's reduced outputs and status, or (None, error text); never raises a
-    ``Exception`` (KeyboardInterrupt and SystemExit pass)."""
+    """One variant's (reduced outputs, status), or (None, error text): an ``Exception`` of
+    the variant is never raised (KeyboardInterrupt and SystemExit pass)."""
     from ..analyses import run
     try:
         model = varied(payload["model_text"], dict(zip(payload["names"], values)),
