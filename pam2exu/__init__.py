@@ -201,18 +201,19 @@ def study(study_or_path, executor=None, out=None, resume=False, samples=None, wo
     ----------
     study_or_path : Study, str or Path
         A study (``pam2exu.studies.load_study``) or the path of a study file.
-    executor : concurrent.futures.Executor, optional
-        Runs the chunks of variants (default: this process, or ``workers`` processes).
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Runs the chunks of variants (default: this process, or ``workers`` processes); the
+        table is the same, bit for bit, whatever runs it.
     out : str or Path, optional
         Write the per-variant table (``.parquet`` or ``.csv``) and ``OUT.summary.csv``.
     resume : bool
-        Run only the chunks missing under ``OUT.parts/`` (with the chunk engine).
+        Run only the chunks missing under ``OUT.parts/`` (those of an interrupted study).
     samples : int, optional
         The number of variants, instead of the study's (sampled methods).
     workers : int, optional
         Local worker processes (default 1).
     progress : bool
-        A progress bar on a terminal (with the chunk engine).
+        A progress bar on a terminal (variants done, rate, time left).
 
     Returns
     -------

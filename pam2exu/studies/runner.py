@@ -10,15 +10,19 @@ message, any other exception named as a fault of pam2exu. It never stops the stu
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
-import math
+import os
+import tempfile
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, Pam2ExuError, Problem
+from ..errors import ModelError, OutputError, Pam2ExuError, Problem
+from .execute import open_executor, run_chunks
 from .parameters import varied
+from .parts import clear_parts, plan_chunks
 from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_table
 from .result import StudyResult, check_out
 from .study import SAMPLED, Study, load_study
@@ -30,8 +34,9 @@ STUDY_ANALYSES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
 STUDY_METHODS = SAMPLED + ("grid",)
 #: what an error row's message says of an exception that is not a pam2exu error
 FAULT = "fault of pam2exu (please report it with the study)"
-#: chunks per worker of the in-process chunk loop
-PER_WORKER = 4
+#: the estimate of a variant's work per row of its result [s] (for the chunks' size; no
+#: result depends on it): 1.3 ms measured for the slider-crank's kinetostatic analysis
+SECONDS_PER_ROW = 1.5e-3
 
 
 def error_text(exc: BaseException) -> str:
@@ -141,20 +146,39 @@ def nominal(study: Study):
     return names, units
 
 
-def in_process(task, work: dict, chunks: list[tuple[int, int]], executor=None) -> dict:
-    """The chunks run in order in this process (or submitted to ``executor``) and merged in
-    chunk order (the chunk engine's shape, without parts on disk)."""
-    if executor is None:
-        done = [task(work, a, b) for a, b in chunks]
-    else:
-        done = [f.result() for f in [executor.submit(task, work, a, b) for a, b in chunks]]
-    return {name: np.concatenate([d[name] for d in done]) for name in done[0]}
+def chunks_of(study: Study, workers: int) -> list[tuple[int, int]]:
+    """The chunks of the study's variants (``parts.plan_chunks``), from an estimate of a
+    variant's work that does not depend on timing (its rows × ``SECONDS_PER_ROW``)."""
+    return plan_chunks(study.samples, (study.steps + 1) * SECONDS_PER_ROW, workers)
 
 
-def chunks_of(samples: int, workers: int) -> list[tuple[int, int]]:
-    """(start, stop) of ``PER_WORKER`` chunks per worker, in order."""
-    size = max(1, math.ceil(samples / (PER_WORKER * workers)))
-    return [(a, min(a + size, samples)) for a in range(0, samples, size)]
+def checked(study_or_path, out=None, resume: bool = False, samples: int | None = None):
+    """Every check before any variant runs: (the study as it runs, its reduced outputs'
+    names and units, ``out`` checked); ``ModelError`` or ``OutputError`` otherwise."""
+    given = study_or_path if isinstance(study_or_path, Study) else load_study(study_or_path)
+    run_as = prepared(given, samples)
+    if out is not None:
+        out = check_out(out)
+    elif resume:
+        raise OutputError("resume needs out: the finished chunks are under OUT.parts/")
+    names, units = nominal(run_as)
+    return run_as, names, units, out
+
+
+def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor=None,
+                resume: bool = False, workers: int = 1, progress: bool = False) -> StudyResult:
+    """Run a checked study's chunks on ``executor`` (``execute.run_chunks``; parts under
+    ``OUT.parts/``, removed once the files are written) and build its result."""
+    with contextlib.ExitStack() as stack:
+        parts = Path(f"{out}.parts") if out is not None else \
+            Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="pam2exu-study-")))
+        done = run_chunks(run_variants, payload(run_as, names), chunks_of(run_as, workers),
+                          parts, executor, resume=resume, progress=progress)
+    result = StudyResult(run_as, done.columns, names, units)
+    if out is not None:
+        result.write(out)
+        clear_parts(parts)
+    return result
 
 
 def study(study_or_path, executor=None, out=None, resume: bool = False,
@@ -166,20 +190,21 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
     ----------
     study_or_path : Study, str or Path
         A study (``load_study``) or its file.
-    executor : concurrent.futures.Executor, optional
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Runs the chunks of variants (default: this process, or a process pool of
-        ``workers``).
+        ``workers``); the table is the same, bit for bit, whatever runs it.
     out : str or Path, optional
         The per-variant table's file, ``.parquet`` or ``.csv`` (the summary beside it,
         ``OUT.summary.csv``); checked before any variant runs. None: nothing written.
     resume : bool
-        Run only the chunks missing under ``OUT.parts/`` (with the chunk engine).
+        Run only the chunks missing under ``OUT.parts/`` (a study interrupted keeps every
+        finished chunk there; the parts are removed once the files are written).
     samples : int, optional
         The number of variants, instead of the study's (sampled methods).
     workers : int, optional
         Local worker processes (default 1: this process).
     progress : bool
-        A progress bar on a terminal (with the chunk engine).
+        A progress bar on a terminal (variants done, rate, time left).
 
     Returns
     -------
@@ -191,7 +216,11 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
         The study file has problems, asks what a study cannot do yet (``linear``,
         ``clearance``), or its nominal model does not run; nothing is written.
     OutputError
-        ``out`` has an unknown suffix or needs a library that is not installed.
+        ``out`` has an unknown suffix or needs a library that is not installed; ``resume``
+        without ``out``.
+    ChunkError
+        A chunk's worker was lost more often than it is retried (the finished chunks are
+        kept under ``OUT.parts/`` for ``resume``).
 
     Examples
     --------
@@ -201,22 +230,9 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
     >>> result.yield_.share                                              # doctest: +SKIP
     1.0
     """
-    given = study_or_path if isinstance(study_or_path, Study) else load_study(study_or_path)
-    run_as = prepared(given, samples)
-    if out is not None:
-        out = check_out(out)
-    names, units = nominal(run_as)
-    work = payload(run_as, names)
-    workers = max(1, workers or 1)
-    chunks = chunks_of(run_as.samples, workers)
-    if executor is None and workers > 1:
-        from concurrent.futures import ProcessPoolExecutor
-        with ProcessPoolExecutor(workers) as pool:
-            table = in_process(run_variants, work, chunks, pool)
-    else:
-        table = in_process(run_variants, work, chunks, executor)
-    result = StudyResult(run_as, table, names, units)
-    if out is not None:
-        result.write(out)
-    return result
-
+    run_as, names, units, out = checked(study_or_path, out, resume, samples)
+    if executor is not None:
+        return run_checked(run_as, names, units, out, executor, resume,
+                           workers or os.cpu_count() or 1, progress)
+    with open_executor(workers or 1) as pool:
+        return run_checked(run_as, names, units, out, pool, resume, workers or 1, progress)

@@ -179,7 +179,7 @@ def test_unassemblable_variants_are_error_rows_and_the_study_exits_0(tmp_path, c
     (tmp_path / "four_bar.toml").write_text((EXAMPLES / "four_bar.toml").read_text())
     (tmp_path / "s.toml").write_text(GRID_STUDY)
     out = tmp_path / "out.csv"
-    assert main(["study", str(tmp_path / "s.toml"), "-o", str(out)]) == 0
+    assert main(["study", str(tmp_path / "s.toml"), "-o", str(out), "--workers", "1"]) == 0
     printed = capsys.readouterr().out
     table = study(tmp_path / "s.toml").table
     assert table["status"].tolist() == ["rejected", "error", "ok", "error"]
@@ -275,6 +275,7 @@ def test_the_files_read_back_bit_for_bit(tmp_path):
     assert df["status"].tolist() == ["rejected", "error", "ok", "error"]
 
 
+@pytest.mark.long                      # 2.5 s: two worker processes start and import pam2exu
 def test_two_worker_processes_give_the_same_table_bit_for_bit(slider):
     again = study(loads_study(SLIDER_STUDY, folder=EXAMPLES), workers=2)
     assert list(again.table) == list(slider.table)
