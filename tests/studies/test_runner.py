@@ -284,3 +284,42 @@ def test_two_worker_processes_give_the_same_table_bit_for_bit(slider):
         same = np.array_equal(other.view(np.int64), column.view(np.int64)) \
             if column.dtype.kind == "f" else np.array_equal(other, column)
         assert same, name
+
+
+def test_a_deleted_part_and_resume_give_the_same_files(tmp_path, monkeypatch):
+    (tmp_path / "four_bar.toml").write_text((EXAMPLES / "four_bar.toml").read_text())
+    (tmp_path / "s.toml").write_text(GRID_STUDY)
+    whole = study(tmp_path / "s.toml", out=tmp_path / "whole.csv")
+    from pam2exu.studies import runner
+    monkeypatch.setattr(runner, "chunks_of", lambda s, w: [(0, 1), (1, 2), (2, 4)])
+
+    def interrupted(self, out):
+        raise KeyboardInterrupt
+    with monkeypatch.context() as m:
+        m.setattr(runner.StudyResult, "write", interrupted)
+        with pytest.raises(KeyboardInterrupt):
+            study(tmp_path / "s.toml", out=tmp_path / "o.csv")
+    parts = sorted((tmp_path / "o.csv.parts").iterdir())
+    assert len(parts) == 3 and not (tmp_path / "o.csv").exists()
+    parts[1].unlink()
+    ran = []
+    engine = runner.run_chunks
+    monkeypatch.setattr(runner, "run_chunks",
+                        lambda *a, **k: ran.append(engine(*a, **k)) or ran[-1])
+    study(tmp_path / "s.toml", out=tmp_path / "o.csv", resume=True)
+    assert [tuple(c) for c in ran[0].computed] == [(1, 2)]   # only the missing chunk
+    assert (tmp_path / "o.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    assert not (tmp_path / "o.csv.parts").exists()
+    assert whole.table["status"].tolist() == ["rejected", "error", "ok", "error"]
+
+
+@pytest.mark.long                      # 5 s: a Dask LocalCluster starts and stops
+def test_a_dask_local_cluster_writes_the_same_bytes(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    (tmp_path / "four_bar.toml").write_text((EXAMPLES / "four_bar.toml").read_text())
+    (tmp_path / "s.toml").write_text(GRID_STUDY)
+    assert main(["study", str(tmp_path / "s.toml"), "-o", str(tmp_path / "a.csv"),
+                 "--workers", "1"]) == 0
+    assert main(["study", str(tmp_path / "s.toml"), "-o", str(tmp_path / "b.csv"),
+                 "--dask-local", "2"]) == 0
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
