@@ -243,7 +243,8 @@ def study(study_or_path, executor=None, out=None, resume=False, samples=None, wo
                   workers=workers, progress=progress)
 
 
-__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "study", "Results", "read_csv",
+__all__ = ["Model", "Solid", "Law", "load", "loads", "run", "energy", "study", "Results",
+           "read_csv",
            "compare", "Comparison", "verify", "Verification", "export", "plot", "draw", "animate",
            "ELEMENTS", *(cls.__name__ for cls in ELEMENTS.values()), "Pam2ExuError",
            "ModelError", "MobilityError", "SolverError", "TranslationError",

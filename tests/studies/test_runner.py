@@ -114,7 +114,8 @@ def test_kinetostatic_variants_equal_single_runs_by_hand(slider):
     for i in range(3):
         a, b, m, g = (float(t[n][i]) for n in ("crank.A.x", "rod.B.x", "rod.mass",
                                                "model.gravity"))
-        edits = [("A = [0.1, 0.0] }", f"A = [{a!r}, 0.0] }}"), ("B = [0.3, 0.0]", f"B = [{b!r}, 0.0]"),
+        edits = [("A = [0.1, 0.0] }", f"A = [{a!r}, 0.0] }}"),
+                 ("B = [0.3, 0.0]", f"B = [{b!r}, 0.0]"),
                  ("mass = 2.0", f"mass = {m!r}"),
                  ('name = "slider-crank"', f'name = "slider-crank"\ngravity = {g!r}')]
         want = _by_hand(text, edits, "kinetostatic", 6, 0.3, ["motor.Mz", "B.F*", "slider.x"],
