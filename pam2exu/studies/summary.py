@@ -120,7 +120,7 @@ def summary(columns: dict[str, np.ndarray], statuses, linear_std=None) -> list[S
 def summary_lines(rows: list[SummaryRow]) -> list[str]:
     """The summary's CSV lines (no line ends): the header, then one line per row, each
     number in the shortest digits that read back bit for bit (``table_csv.csv_block``), a
-    NaN as an empty field."""
+    NaN as an empty field, the count as a whole number."""
     lines = [",".join(SUMMARY_COLUMNS)]
     if not rows:
         return lines
@@ -128,6 +128,7 @@ def summary_lines(rows: list[SummaryRow]) -> list[str]:
     text = csv_block(numbers).tobytes().decode("ascii").splitlines()
     for row, line in zip(rows, text):
         cells = ["" if c == "nan" else c for c in line.split(",")]
+        cells[0] = str(int(row.count))                   # a count, written as one
         lines.append(",".join([csv_field(row.output), *cells]))
     return lines
 

@@ -106,6 +106,9 @@ def test_the_file_reads_back_bit_for_bit(study, tmp_path):
                 assert back == value and math.copysign(1, back) == math.copysign(1, value)
     assert lines[-2][0] == "odd,name.max"                     # quoted in the file
     assert (lines[-2][1], lines[-2][4], lines[-2][5]) == ("3", "-0", "3.0000000000000004e-1")
+    assert all(line[1].isdigit() for line in lines)           # a count is written as one
+    many = summary_lines(summary({"y.max": np.arange(16.0)}, ["ok"] * 16))
+    assert many[1].split(",")[1] == "16"                      # not the shortest float 1.6e1
 
 
 def test_a_failed_write_leaves_no_file(tmp_path, monkeypatch):
