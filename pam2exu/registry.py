@@ -167,6 +167,8 @@ class AnalysisType:
     options : tuple of str
         The ``OPTIONS`` it reads (the others are refused on the command line and ignored
         by ``run``).
+    in_studies : bool
+        A study (``pam2exu.studies``) runs it for its variants.
     """
 
     name: str
@@ -179,6 +181,7 @@ class AnalysisType:
     element_outputs: bool = True
     integrates: bool = False
     options: tuple = ()
+    in_studies: bool = False
 
     def run(self, job):
         """Run the analysis on a prepared ``Job``."""
@@ -215,17 +218,18 @@ _ALL = frozenset({POSITION, VELOCITY, ACCELERATION, FORCE})
 ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("assembly", "ensamblatge", frozenset({POSITION}), driven=False,
                  at_start=True, summary="the constraints solved at t = 0 from the guess",
-                 function="pam2exu.analyses.assembly:assembly", element_outputs=False),
+                 function="pam2exu.analyses.assembly:assembly", element_outputs=False,
+                 in_studies=True),
     AnalysisType("quasi_static", "quasi_estatica", frozenset({POSITION, FORCE}), driven=True,
                  at_start=False, summary="positions and static equilibrium, no rates",
-                 function="pam2exu.analyses.quasi_static:quasi_static"),
+                 function="pam2exu.analyses.quasi_static:quasi_static", in_studies=True),
     AnalysisType("kinematic", "cinematica", frozenset({POSITION, VELOCITY, ACCELERATION}),
                  driven=True, at_start=False,
                  summary="positions, velocities and accelerations",
-                 function="pam2exu.analyses.kinematic:kinematic"),
+                 function="pam2exu.analyses.kinematic:kinematic", in_studies=True),
     AnalysisType("kinetostatic", "cinetostatica", _ALL, driven=True, at_start=False,
                  summary="the kinematic analysis, then every force (inverse dynamics)",
-                 function="pam2exu.analyses.kinetostatic:kinetostatic"),
+                 function="pam2exu.analyses.kinetostatic:kinetostatic", in_studies=True),
     AnalysisType("clearance", "joc", frozenset({POSITION, CLEARANCE}), driven=False,
                  at_start=False,
                  summary="the clearance of least norm of an over-constrained mechanism as "

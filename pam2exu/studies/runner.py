@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, OutputError, Pam2ExuError, Problem
+from ..registry import ANALYSES, analysis_type
 from .execute import open_executor, run_chunks
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
@@ -27,9 +28,9 @@ from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_t
 from .result import StudyResult, check_out
 from .study import SAMPLED, Study, load_study
 
-#: the analyses a study runs today (a clearance study follows its own dimension path:
-#: not available yet)
-STUDY_ANALYSES = ("assembly", "quasi_static", "kinematic", "kinetostatic")
+#: the analyses a study runs today, as the registry declares them (``in_studies``; a
+#: clearance study follows its own dimension path: not available yet)
+STUDY_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.in_studies)
 #: the methods a study runs today (``linear``, first-order propagation: not available yet)
 STUDY_METHODS = SAMPLED + ("grid",)
 #: what an error row's message says of an exception that is not a pam2exu error
@@ -101,7 +102,8 @@ def prepared(study: Study, samples: int | None = None) -> Study:
     if study.method not in STUDY_METHODS:
         problems.append(Problem("[study]", f"method = '{study.method}' is not available yet: "
                                            f"a study runs {', '.join(STUDY_METHODS)} today"))
-    if study.analysis not in STUDY_ANALYSES:
+    kind = analysis_type(study.analysis)
+    if kind is not None and not kind.in_studies:
         problems.append(Problem("[study]", f"analysis = '{study.analysis}' is not available in "
                                            f"a study yet: a study runs "
                                            f"{', '.join(STUDY_ANALYSES)} analyses today"))

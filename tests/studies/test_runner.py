@@ -15,7 +15,8 @@ import pytest
 import pam2exu
 from pam2exu.cli import main
 from pam2exu.studies import loads_study
-from pam2exu.studies.runner import FAULT, run_variants, study
+from pam2exu.registry import ANALYSES
+from pam2exu.studies.runner import FAULT, STUDY_ANALYSES, prepared, run_variants, study
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -325,3 +326,18 @@ def test_a_dask_local_cluster_writes_the_same_bytes(tmp_path, capsys):
     assert main(["study", str(tmp_path / "s.toml"), "-o", str(tmp_path / "b.csv"),
                  "--dask-local", "2"]) == 0
     assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+
+
+def test_the_analyses_a_study_runs_are_the_registrys_declaration():
+    """``AnalysisType.in_studies`` decides, by the type, not by its name: PAM's Catalan name
+    of the kinematic analysis is run (it was refused when the runner listed names), the
+    dynamic analysis is refused with the declared list."""
+    assert STUDY_ANALYSES == tuple(a.name for a in ANALYSES.values() if a.in_studies)
+    text = ('[study]\nmodel = "slider_crank.toml"\nanalysis = "{}"\nsamples = 2\n'
+            '[[parameter]]\nname = "crank.A.x"\ndistribution = "normal"\ntol = 1e-4\n')
+    folder = Path(__file__).resolve().parents[2] / "examples"
+    assert prepared(loads_study(text.format("cinematica"), folder=folder)).samples == 2
+    with pytest.raises(pam2exu.ModelError, match="analysis = 'dynamic' is not available in a "
+                       "study yet: a study runs assembly, quasi_static, kinematic, "
+                       "kinetostatic analyses today"):
+        prepared(loads_study(text.format("dynamic"), folder=folder))
