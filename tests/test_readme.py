@@ -66,7 +66,7 @@ def _workspace(tmp_path: Path) -> Path:
 #: compare.md 17 s, verify.md 13 s): run
 #: with --long, so that the test command stays within 8 minutes
 LONG_PAGES = ("performance.md", "pictures.md", "clearance.md", "getting-started.md",
-              "compare.md", "verify.md")
+              "compare.md", "verify.md", "studies.md")
 SHELL_PAGES = [pytest.param(p, marks=pytest.mark.long) if p.name in LONG_PAGES else p
                for p in PAGES if _commands(p)]
 
