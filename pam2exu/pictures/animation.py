@@ -17,6 +17,7 @@ from ..errors import ModelError, Problem
 from ..kinematics import State
 from ..progress import Progress
 from ..results.plot import DPI, PictureError, figure
+from ..results.writers import write_whole
 from .poses import _model, configurations, motion
 from .scene import Scene, fit_title
 
@@ -214,7 +215,6 @@ def _write_gif(fig, path: Path, fps: float, frames: int, show, dynamic, bar) -> 
         sample.paste(images[k], (0, j * size[1]))
     palette = sample.quantize(colors=255, method=Image.Quantize.FASTOCTREE)
     frames_p = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
-    tmp = path.with_name(path.name + ".part")
-    frames_p[0].save(tmp, format="GIF", save_all=True, append_images=frames_p[1:],
-                     duration=round(1000.0 / fps), loop=0, optimize=False)
-    tmp.replace(path)
+    write_whole(path, lambda tmp: frames_p[0].save(
+        tmp, format="GIF", save_all=True, append_images=frames_p[1:],
+        duration=round(1000.0 / fps), loop=0, optimize=False))

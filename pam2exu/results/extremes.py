@@ -15,6 +15,7 @@ import numpy as np
 
 from ..elements import CLEARANCE, ELEMENTS
 from .table_csv import csv_field
+from .writers import write_whole
 
 #: the variables of the joints' clearance parameters and of what derives from them
 CLEARANCE_VARIABLES = frozenset(v.name for cls in ELEMENTS.values()
@@ -69,13 +70,8 @@ def write_extremes(res, path: str | Path) -> Path:
     for e in extremes(res):
         lines.append(",".join([csv_field(e.column),
                                *(repr(v) for v in (e.min, e.t_min, e.max, e.t_max))]))
-    tmp = path.with_name(path.name + ".part")
-    try:
-        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return write_whole(path, lambda tmp: tmp.write_text("\n".join(lines) + "\n",
+                                                       encoding="utf-8"))
 
 
 def extremes_table(res) -> str:

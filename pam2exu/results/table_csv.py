@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .units import units_line
-from .writers import BOM, csv_translation
+from .writers import BOM, csv_translation, write_whole
 
 
 def write_csv(path: Path, names: list[str], values: np.ndarray, units: dict[str, str],
@@ -20,18 +20,15 @@ def write_csv(path: Path, names: list[str], values: np.ndarray, units: dict[str,
     ``Results.to_csv`` says, under a temporary name then renamed: a failure leaves
     neither half a file nor the temporary one."""
     translate = csv_translation(sep, decimal)
-    tmp = path.with_name(path.name + ".part")
-    try:
+
+    def write_to(tmp: Path) -> None:
         with open(tmp, "wb") as fh:
             fh.write((BOM if bom else b"") + (csv_header(names, sep) + "\n").encode())
             fh.write(units_line(names, units, sep).encode())   # degrees only
             for lines in csv_lines(values):
                 fh.write(lines if translate is None else translate[lines])
-        tmp.replace(path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return path
+
+    return write_whole(path, write_to)
 
 
 #: values the CSV writer formats at once: ~20 bytes each, so its memory stays bounded
@@ -100,6 +97,17 @@ def csv_block(values: np.ndarray) -> np.ndarray:
     text[ends[values.shape[1] - 1::values.shape[1]]] = _NEWLINE
     return text
 
+
+
+def csv_cells(values: np.ndarray) -> list[list[str]]:
+    """The cells of a (rows, columns) float block (``csv_block``'s digits), NaN as an empty
+    field: the numbers of a table whose other cells are text.
+
+    >>> csv_cells(np.array([[0.5, np.nan], [16.0, -0.0]]))
+    [['5e-1', ''], ['1.6e1', '-0']]
+    """
+    return [["" if c == "nan" else c for c in line.split(",")]
+            for line in csv_block(values).tobytes().decode("ascii").splitlines()]
 
 def csv_lines(values: np.ndarray):
     """``csv_block`` of a (rows, columns) array, ``BLOCK`` values at a time (uint8 text)."""

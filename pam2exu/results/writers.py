@@ -146,8 +146,9 @@ def write(res, path: str | Path, sep: str = ",", decimal: str = ".", bom: bool =
     return res.to_csv(path, sep=sep, decimal=decimal, bom=bom)
 
 
-def _replace(path: Path, write_to) -> Path:
-    """Call ``write_to(temporary path)`` then rename it to ``path`` (never half a file)."""
+def write_whole(path: Path, write_to) -> Path:
+    """Call ``write_to(temporary path)`` then rename it to ``path``: a failure leaves neither
+    half a file nor the temporary one."""
     tmp = path.with_name(path.name + ".part")
     try:
         write_to(tmp)
@@ -233,7 +234,7 @@ class Exports:
         facts = book.create_sheet("model")
         for name, value in _facts(self):
             facts.append([name, value])
-        return _replace(path, book.save)
+        return write_whole(path, book.save)
 
     def to_parquet(self, path: str | Path) -> Path:
         """Write a Parquet file: one float64 column per variable, ``t`` first, with units.
@@ -277,7 +278,7 @@ class Exports:
         data = self.to_numpy().T
         table = pa.Table.from_arrays([pa.array(data[j]) for j in range(len(names))],
                                      schema=schema)
-        return _replace(Path(path), lambda tmp: parquet.write_table(table, tmp))
+        return write_whole(Path(path), lambda tmp: parquet.write_table(table, tmp))
 
     def to_pandas(self):
         """The table as a pandas DataFrame: column ``t`` first, then every variable.

@@ -17,9 +17,9 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import OutputError
-from ..results.table_csv import csv_block, csv_field
-from ..results.writers import _replace, optional
-from .reduce import ERROR, OK
+from ..results.table_csv import csv_cells, csv_field
+from ..results.writers import optional, write_whole
+from .reduce import ERROR, OK, REJECTED
 from .summary import error_groups, summary, write_summary
 
 #: the per-variant table's file formats, by suffix
@@ -146,7 +146,7 @@ class StudyResult:
                                    type=kind))
             fields.append(pa.field(name, kind, metadata={"unit": self.units.get(name, "")}))
         table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
-        return _replace(Path(path), lambda tmp: parquet.write_table(table, tmp))
+        return write_whole(Path(path), lambda tmp: parquet.write_table(table, tmp))
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the per-variant table as CSV: a header of the column names, then one line
@@ -162,15 +162,13 @@ class StudyResult:
         path = Path(path)
         names = list(self.table)
         numbers = np.column_stack([self.table[n] for n in names[3:]]).astype(float)
-        text = csv_block(numbers).tobytes().decode("ascii").splitlines()
         lines = [",".join(csv_field(n) for n in names)]
         t = self.table
-        for k, line in enumerate(text):
-            cells = ["" if c == "nan" else c for c in line.split(",")]
+        for k, cells in enumerate(csv_cells(numbers)):
             lines.append(",".join([str(int(t["sample"][k])), str(t["status"][k]),
                                    csv_field(str(t["error"][k])), *cells]))
         body = ("\n".join(lines) + "\n").encode("utf-8")
-        return _replace(path, lambda tmp: tmp.write_bytes(body))
+        return write_whole(path, lambda tmp: tmp.write_bytes(body))
 
     def write(self, out: str | Path) -> tuple[Path, Path]:
         """Write ``OUT.parquet`` or ``OUT.csv`` (by suffix) and ``OUT.summary.csv``.
@@ -199,7 +197,7 @@ class StudyResult:
         y = self.yield_
         lines.append(f"yield: {y.share:.4g} ({y.ok} of {y.count} variants ok), 95 % Wilson "
                      f"interval {y.low:.4g} … {y.high:.4g}")
-        rejected = int(np.count_nonzero(self.table["status"] == "rejected"))
+        rejected = int(np.count_nonzero(self.table["status"] == REJECTED))
         failed = int(np.count_nonzero(self.table["status"] == ERROR))
         lines.append(f"rejected by the requirements: {rejected}; in error: {failed}")
         groups = self.errors()

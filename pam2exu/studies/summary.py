@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..results.table_csv import csv_block, csv_field
+from ..results.table_csv import csv_cells, csv_field
+from ..results.writers import write_whole
 from .reduce import ERROR, OK
 
 #: the quantiles' columns and their probabilities
@@ -125,9 +126,7 @@ def summary_lines(rows: list[SummaryRow]) -> list[str]:
     if not rows:
         return lines
     numbers = np.array([astuple(r)[1:] for r in rows], dtype=float)
-    text = csv_block(numbers).tobytes().decode("ascii").splitlines()
-    for row, line in zip(rows, text):
-        cells = ["" if c == "nan" else c for c in line.split(",")]
+    for row, cells in zip(rows, csv_cells(numbers)):
         cells[0] = str(int(row.count))                   # a count, written as one
         lines.append(",".join([csv_field(row.output), *cells]))
     return lines
@@ -136,14 +135,8 @@ def summary_lines(rows: list[SummaryRow]) -> list[str]:
 def write_summary(rows: list[SummaryRow], path: str | Path) -> Path:
     """Write the summary as CSV at ``path`` (``summary_lines``), under a temporary name
     then renamed: a failure leaves neither half a file nor the temporary one."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".part")
-    try:
-        tmp.write_text("\n".join(summary_lines(rows)) + "\n", encoding="utf-8")
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return write_whole(Path(path), lambda tmp: tmp.write_text(
+        "\n".join(summary_lines(rows)) + "\n", encoding="utf-8"))
 
 
 def error_groups(statuses, errors, samples) -> list[tuple[str, list[int]]]:
