@@ -19,6 +19,7 @@ import os
 import pickle
 import sys
 import time
+import tomllib
 import warnings
 
 #: the checkout whose models and package are run
@@ -30,10 +31,17 @@ SKIP = {  # (model, analysis) pairs too slow for a snapshot: clearance over all_
 
 
 def models(root):
+    """The model files of examples/ and tests/data (study files, with their [study] table,
+    are not models)."""
     out = []
     for pattern in ("examples/**/*.toml", "tests/data/**/*.toml"):
         out += sorted(glob.glob(os.path.join(root, pattern), recursive=True))
-    return [os.path.relpath(p, root) for p in out]
+    return [os.path.relpath(p, root) for p in out if not _is_study(p)]
+
+
+def _is_study(path) -> bool:
+    with open(path, "rb") as f:
+        return "study" in tomllib.load(f)
 
 
 def table(res):
