@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .complex_step import as_array
+
 
 # ---- the layout of q: (x, y, fi) of each solid in order -----------------------------------
 
@@ -181,12 +183,13 @@ def stack(*quantities: Quantity) -> Quantity:
     """The rows of several quantities, one after the other."""
     n = quantities[0].value.shape[0]
     dims = [q.value.shape[1] for q in quantities]
+    dtype = np.result_type(*(q.value for q in quantities))   # complex in the complex step
     jac: dict[int, np.ndarray] = {}
     offset = 0
     for q, d in zip(quantities, dims):
         for solid, block in q.jac.items():
             if solid not in jac:
-                jac[solid] = np.zeros((n, sum(dims), 3))
+                jac[solid] = np.zeros((n, sum(dims), 3), dtype)
             jac[solid][:, offset:offset + d] += block
         offset += d
     hess = None
@@ -196,7 +199,7 @@ def stack(*quantities: Quantity) -> Quantity:
         for q, d in zip(quantities, dims):
             for pair, block in q.hess.items():
                 if pair not in hess:
-                    hess[pair] = np.zeros((n, sum(dims), 3, 3))
+                    hess[pair] = np.zeros((n, sum(dims), 3, 3), dtype)
                 hess[pair][:, offset:offset + d] += block
             offset += d
     cat = lambda xs: None if xs[0] is None else np.concatenate(xs, axis=1)  # noqa: E731
@@ -215,8 +218,8 @@ class State:
 
     def __init__(self, t, q, qd=None, jacobians: bool = True, hessians: bool = False):
         self.t = np.atleast_1d(np.asarray(t, dtype=float))
-        self.q = np.atleast_2d(np.asarray(q, dtype=float))
-        self.qd = None if qd is None else np.atleast_2d(np.asarray(qd, dtype=float))
+        self.q = np.atleast_2d(as_array(q))
+        self.qd = None if qd is None else np.atleast_2d(as_array(qd))
         self.n = self.q.shape[0]
         self.jacobians = jacobians or hessians
         self.hessians = hessians
@@ -250,7 +253,7 @@ class State:
     def _rotated(self, solid: int, local, translate: bool) -> Quantity:
         """A point (``translate``) or a direction of a solid, built once per State (the
         Quantity is shared: never changed in place)."""
-        local = np.asarray(local, dtype=float)
+        local = as_array(local)
         key = (solid, local.tobytes(), translate)
         if key not in self._rotated_memo:
             self._rotated_memo[key] = self._build_rotated(solid, local, translate)
@@ -261,7 +264,7 @@ class State:
         As = _rotate(*self.trig(solid), local)
         jac = {}
         if self.jacobians:
-            block = jac[solid] = np.zeros((self.n, 2, 3))
+            block = jac[solid] = np.zeros((self.n, 2, 3), dtype=As.dtype)
             if translate:
                 block[:, 0, 0] = block[:, 1, 1] = 1.0
             block[:, :, 2] = perp(As)
@@ -275,7 +278,7 @@ class State:
             conv = -(w * w) * As
         hess = None
         if self.hessians:                      # ∂²(A s)/∂fi² = −A s, the rest 0
-            hess = {(solid, solid): np.zeros((self.n, 2, 3, 3))}
+            hess = {(solid, solid): np.zeros((self.n, 2, 3, 3), dtype=As.dtype)}
             hess[solid, solid][:, :, 2, 2] = -As
         return Quantity(value, jac, rate, conv, hess)
 
@@ -304,15 +307,15 @@ def generalized_force(point: Quantity, force) -> dict[int, np.ndarray]:
 
 def torque(solid: int, moment) -> dict[int, np.ndarray]:
     """Q = (0, 0, M): a pure moment M (n,) on a solid."""
-    moment = np.asarray(moment, dtype=float)
-    out = np.zeros((moment.shape[0], 3))
+    moment = as_array(moment)
+    out = np.zeros((moment.shape[0], 3), moment.dtype)
     out[:, 2] = moment
     return {solid: out}
 
 
 def move_wrench(wrench, origin, point):
     """(F, M_p) with M_p = M_O − (p − O) × F: a wrench (n, 3) about O moved to the point p."""
-    out = np.array(wrench, dtype=float, copy=True)
+    out = np.array(wrench, dtype=np.result_type(float, wrench, origin, point), copy=True)
     out[:, 2] -= cross(point - origin, wrench[:, :2])
     return out
 
@@ -320,7 +323,7 @@ def move_wrench(wrench, origin, point):
 def to_basis(wrench, direction):
     """The wrench (n, 3) with its force in the basis whose x axis is the unit vector ``direction``."""
     ex, ey = direction[:, 0], direction[:, 1]
-    out = np.empty_like(wrench)
+    out = np.empty_like(wrench, dtype=np.result_type(wrench, direction))
     out[:, 0] = ex * wrench[:, 0] + ey * wrench[:, 1]
     out[:, 1] = -ey * wrench[:, 0] + ex * wrench[:, 1]
     out[:, 2] = wrench[:, 2]

@@ -18,6 +18,8 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
+from .complex_step import scalar
+
 __all__ = ["Law", "LawForm", "LAWS", "LAW_ALIASES", "F_ORDERS", "VALUES_OF_F", "law_names"]
 
 
@@ -225,7 +227,7 @@ class Law:
         object.__setattr__(self, "name", LAW_ALIASES.get(self.name, self.name))
         if self.name not in LAWS:
             raise ValueError(f"unknown law '{self.name}'; known laws: {', '.join(law_names())}")
-        C = tuple(float(c) for c in (self.C if np.ndim(self.C) else [self.C]))
+        C = tuple(scalar(c) for c in (self.C if np.ndim(self.C) else [self.C]))
         if len(C) > 4:
             raise ValueError(f"a law has at most four constants C1 … C4, got {len(C)}")
         object.__setattr__(self, "C", C + (0.0,) * (4 - len(C)))

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .complex_step import absolute, as_array, atan2, hypot, number_type
 from .elements.base import ACCELERATION, POSITION, VELOCITY, Var
 from .kinematics import State, perp, pose, rotate
 
@@ -95,15 +96,15 @@ def point_motion(r, v, a, fi, dfi, ddfi, p):
     >>> [(np.round(u, 12) + 0.0).tolist() for u in (x, v, a)]
     [[[1.0, 0.5]], [[-1.0, 0.0]], [[0.0, -2.0]]]
     """
-    Rp = rotate(np.asarray(fi, dtype=float), np.asarray(p, dtype=float))
-    x = np.asarray(r, dtype=float) + Rp
+    Rp = rotate(as_array(fi), as_array(p))
+    x = as_array(r) + Rp
     vel = acc = None
     if v is not None:
-        dfi = np.asarray(dfi, dtype=float)[:, None]
-        vel = np.asarray(v, dtype=float) + dfi * perp(Rp)
+        dfi = as_array(dfi)[:, None]
+        vel = as_array(v) + dfi * perp(Rp)
         if a is not None:
-            ddfi = np.asarray(ddfi, dtype=float)[:, None]
-            acc = np.asarray(a, dtype=float) + ddfi * perp(Rp) - dfi * dfi * Rp
+            ddfi = as_array(ddfi)[:, None]
+            acc = as_array(a) + ddfi * perp(Rp) - dfi * dfi * Rp
     return x, vel, acc
 
 
@@ -134,11 +135,11 @@ def instantaneous_centre(r, v, dfi, length: float = 1.0) -> np.ndarray:
     array([[ 0.,  0.],
            [nan, nan]])
     """
-    r, v = np.asarray(r, dtype=float), np.asarray(v, dtype=float)
-    dfi = np.asarray(dfi, dtype=float)
-    speed = np.hypot(v[:, 0], v[:, 1])
-    defined = (dfi != 0.0) & (speed <= FAR * length * np.abs(dfi))
-    out = np.full(r.shape, np.nan)
+    r, v, dfi = as_array(r), as_array(v), as_array(dfi)
+    speed = hypot(v[:, 0], v[:, 1])
+    # (decided on the real parts: complex in the complex step)
+    defined = (np.real(dfi) != 0.0) & (np.real(speed) <= FAR * length * np.abs(np.real(dfi)))
+    out = np.full(r.shape, np.nan, dtype=number_type(r, v, dfi))
     out[defined] = r[defined] + perp(v[defined]) / dfi[defined, None]
     return out
 
@@ -156,10 +157,10 @@ def transmission_angle(a, b, normal) -> np.ndarray:
     >>> transmission_angle([[0.0, 0.0]], [[1.0, 1.0]], [[0.0, 1.0]]) * 4 / np.pi
     array([1.])
     """
-    c = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
-    n = np.asarray(normal, dtype=float)
-    return np.arctan2(np.abs(c[:, 0] * n[:, 1] - c[:, 1] * n[:, 0]),
-                      np.abs(c[:, 0] * n[:, 0] + c[:, 1] * n[:, 1]))
+    c = as_array(b) - as_array(a)
+    n = as_array(normal)
+    return atan2(absolute(c[:, 0] * n[:, 1] - c[:, 1] * n[:, 0]),
+                 absolute(c[:, 0] * n[:, 0] + c[:, 1] * n[:, 1]))
 
 
 @dataclass(frozen=True)
@@ -284,6 +285,6 @@ def columns(mech, t, q, qd, qdd, wanted) -> tuple[dict[str, np.ndarray], list[st
             for (along_x, along_y, size), vector in zip(_POINT_PARTS, motion):
                 if vector is not None:
                     found[along_x], found[along_y] = vector[:, 0], vector[:, 1]
-                    found[size] = np.hypot(vector[:, 0], vector[:, 1])
+                    found[size] = hypot(vector[:, 0], vector[:, 1])
             out.update({prefix + name: found[name] for name in names})
     return out, notes

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..elements.base import Load
 from ..errors import TranslationError
+from ..complex_step import scalar
 from ..kinematics import State, column, generalized_force, move_wrench, pose, to_basis
 from . import native
 
@@ -35,11 +36,11 @@ CHUNK_STEPS = 4096
 
 def gravity(mech, st: State) -> Load:
     """Weight (0, −m g) at each solid's G; V = Σ m g y_G."""
-    force, potential = {}, np.zeros(st.n)
+    force, potential = {}, np.zeros(st.n, st.q.dtype)     # complex in the complex step
     for i, s in enumerate(mech.solids):
-        m = float(s.mass)
-        if m > 0 and mech.gravity:
-            G = st.point(i, [float(c) for c in s.cog])
+        m = scalar(s.mass)
+        if m.real > 0 and mech.gravity:
+            G = st.point(i, [scalar(c) for c in s.cog])
             weight = np.broadcast_to([0.0, -m * mech.gravity], (st.n, 2))
             force.update(generalized_force(G, weight))
             potential += m * mech.gravity * G.value[:, 1]
@@ -66,8 +67,9 @@ class Applied:
 
 def applied_forces(mech, st: State, damping: bool) -> Applied:
     """Sum the loads of gravity and of every force element (dampers only if ``damping``)."""
-    n = st.n
-    out = Applied(np.zeros((n, mech.nq)), {}, np.zeros(n), np.zeros(n), np.zeros((n, mech.nq)))
+    n, dtype = st.n, st.q.dtype                              # complex in the complex step
+    out = Applied(np.zeros((n, mech.nq), dtype), {}, np.zeros(n, dtype), np.zeros(n, dtype),
+                  np.zeros((n, mech.nq), dtype))
     loads = [(None, gravity(mech, st))] + [(el, el.loads(st, damping)) for el in mech.elements]
     for el, load in loads:
         if load is None:
@@ -89,13 +91,14 @@ def inertia_forces(mech, st: State, qdd: np.ndarray) -> tuple[np.ndarray, np.nda
 
     a_G = R̈ + α Ω(A c) − ω² A c,  Q = Jᵀ(m a_G) + (0, 0, J_G α),  T = ½ m v_G² + ½ J_G ω².
     """
-    Q, T = np.zeros((st.n, mech.nq)), np.zeros(st.n)
+    dtype = np.result_type(st.q, qdd)                        # complex in the complex step
+    Q, T = np.zeros((st.n, mech.nq), dtype), np.zeros(st.n, dtype)
     for i, s in enumerate(mech.solids):
-        m, J = float(s.mass), float(s.inertia)
+        m, J = scalar(s.mass), scalar(s.inertia)
         if m == 0 and J == 0:
             continue
         cols = pose(i)
-        G = st.point(i, [float(c) for c in s.cog])
+        G = st.point(i, [scalar(c) for c in s.cog])
         block = G.jac[i]
         a_G = np.einsum("ndk,nk->nd", block, qdd[:, cols]) + G.conv
         Q[:, cols] += np.einsum("nd,ndk->nk", m * a_G, block)
@@ -166,7 +169,7 @@ def _report_matrix(mech, st: State, parts) -> np.ndarray:
     Block-diagonal, one square block per element (each reports as many components as it
     has equations).
     """
-    B = np.zeros((st.n, mech.n_equations, mech.n_equations))
+    B = np.zeros((st.n, mech.n_equations, mech.n_equations), st.q.dtype)
     for el, rows, v in zip(mech.constraints, mech.rows, parts):
         jac = v.jac
         keep = reported(el)
@@ -196,8 +199,17 @@ def multipliers(mech, st: State, rhs: np.ndarray, redundant: bool,
     A = np.swapaxes(eq.jacobian, 1, 2)                                  # Cqᵀ, (n, nq, m)
     B = _report_matrix(mech, st, eq.parts)
     AB = np.swapaxes(np.linalg.solve(np.swapaxes(B, 1, 2), np.swapaxes(A, 1, 2)), 1, 2)
-    R = np.einsum("nmq,nq->nm", np.linalg.pinv(AB, rcond=rcond), rhs)
+    R = np.einsum("nmq,nq->nm", least_norm_inverse(AB, rcond), rhs)
     return np.linalg.solve(B, R[..., None])[..., 0]
+
+
+def least_norm_inverse(A: np.ndarray, rcond: float) -> np.ndarray:
+    """A⁺ per step (A (n, r, c)): ``numpy.linalg.pinv``; in the complex step, where A has
+    full row rank, A⁺ = Aᵀ(A Aᵀ)⁻¹ with plain transposes (analytic: pinv conjugates)."""
+    if not np.iscomplexobj(A):
+        return np.linalg.pinv(A, rcond=rcond)
+    At = np.swapaxes(A, 1, 2)
+    return np.swapaxes(np.linalg.solve(A @ At, np.swapaxes(At, 1, 2)), 1, 2)
 
 
 def _solve_transposed(mech, J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -213,7 +225,7 @@ def _solve_transposed(mech, J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     held = [h for _, h in fixed]
     if len(rows) != len(cols) or len(set(held)) != len(held):
         return np.linalg.solve(np.swapaxes(J, 1, 2), rhs[..., None])[..., 0]
-    lam = np.empty(rhs.shape[:1] + J.shape[1:2])
+    lam = np.empty(rhs.shape[:1] + J.shape[1:2], np.result_type(J, rhs))
     A = np.swapaxes(J[:, rows[:, None], cols], 1, 2)
     lam[:, rows] = np.linalg.solve(A, rhs[:, cols, None])[..., 0] if len(rows) else 0.0
     if fixed:
@@ -241,7 +253,8 @@ def over_time(mech, t, q, redundant: bool, qd=None, qdd=None):
     n = len(t)
     dynamic = qdd is not None
     out: dict[str, np.ndarray] = {}
-    energies = Energies(np.zeros(n), np.zeros(n), np.zeros(n)) if dynamic else None
+    dtype = np.result_type(q, qd, qdd)                       # complex in the complex step
+    energies = Energies(*(np.zeros(n, dtype) for _ in range(3))) if dynamic else None
     sparse = mech.n_equations >= native.SPARSE_FROM
     for s in native.chunks(mech, n, sparse, most=None if sparse else CHUNK_STEPS):
         st = State(t[s], q[s], qd[s] if dynamic else None)
@@ -259,7 +272,7 @@ def over_time(mech, t, q, redundant: bool, qd=None, qdd=None):
                               or mech.n_equations < native.SPARSE_FROM)
         lam = multipliers(mech, st, rhs, redundant, eq=eq)
         for name, v in {**reactions(mech, st, lam, eq.parts), **applied.outputs}.items():
-            out.setdefault(name, np.empty(n))[s] = v
+            out.setdefault(name, np.empty(n, dtype))[s] = v
     return out, energies
 
 
@@ -336,7 +349,7 @@ def power_balance(mech, t: np.ndarray, actuator_power: np.ndarray, energy: np.nd
 
 def actuator_power(mech, st: State, outputs: dict[str, np.ndarray]) -> np.ndarray:
     """Σ (actuator force or torque) × Df(t): Mz·Df of angular, Força·Df of linear actuators."""
-    power = np.zeros(st.n)
+    power = np.zeros(st.n, st.q.dtype)
     for el in mech.drivers:
         name = next(n for n in el.wrench if n is not None)
         power += outputs[f"{el.name}.{name}"] * el.time_law()(st.t)[1]

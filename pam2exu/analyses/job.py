@@ -195,7 +195,28 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
     t = job.times[rows]
     q, qd, qdd = (None if a is None else a[rows] for a in (q, qd, qdd))
     extra = {k: v[rows] for k, v in (extra or {}).items()}
+    values, notes = column_values(job, t, q, qd, qdd, extra)
+    if notes:
+        job.info["undefined"] = "; ".join(notes)
+    res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis_type,
+                  mech.name, job.warnings, job.info, job.backend.label)
+    table = res.to_numpy()[:, 1:]        # a view of the table's storage: no copies
+    np.add(table, 0.0, out=table)        # no negative zeros in tables
     wanted = set(job.columns)
+    if not (np.isfinite(table).all()
+            and all(np.isfinite(v).all() for k, v in values.items() if k not in wanted)):
+        # an instantaneous centre is NaN by definition where the solid translates
+        check_finite(job, t, {k: v for k, v in values.items()
+                              if k.rpartition(".")[2] not in ("ICx", "ICy")})
+    return res
+
+
+def column_values(job: Job, t, q, qd=None, qdd=None, extra: dict | None = None):
+    """(column → values at the rows given, one note per solid whose centre is undefined
+    somewhere): every column of ``job.columns`` (and the derived ones computed with them)
+    from the solids' coordinates and rates and the analysis' own columns ``extra``.
+    Complex in, complex out: the complex step of ``sensitivity``."""
+    mech, wanted = job.mech, set(job.columns)
     values: dict[str, np.ndarray] = {}
     for i, s in enumerate(mech.solids):
         for k, var in enumerate(SOLID_OUTPUTS):
@@ -212,19 +233,8 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
                     values[f"{el.name}.{var}"] = v
     derived, notes = points.columns(mech, t, q, qd, qdd, wanted)
     values.update(derived)
-    if notes:
-        job.info["undefined"] = "; ".join(notes)
-    values.update(extra)
-    res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis_type,
-                  mech.name, job.warnings, job.info, job.backend.label)
-    table = res.to_numpy()[:, 1:]        # a view of the table's storage: no copies
-    np.add(table, 0.0, out=table)        # no negative zeros in tables
-    if not (np.isfinite(table).all()
-            and all(np.isfinite(v).all() for k, v in values.items() if k not in wanted)):
-        # an instantaneous centre is NaN by definition where the solid translates
-        check_finite(job, t, {k: v for k, v in values.items()
-                              if k.rpartition(".")[2] not in ("ICx", "ICy")})
-    return res
+    values.update(extra or {})
+    return values, notes
 
 
 def check_finite(job: Job, t: np.ndarray, values: dict[str, np.ndarray]) -> None:

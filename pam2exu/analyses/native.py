@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..complex_step import as_array
 from ..kinematics import PER_SOLID, State, column
 from ..laws import Law
 from ..progress import Progress
@@ -49,16 +50,16 @@ def target_values(target, t, m):
     if isinstance(target, Law):
         f, df, ddf = target(t)
         return f[:, None], df[:, None], ddf[:, None]
-    return np.broadcast_to(np.asarray(target, dtype=float), (m,)), 0.0, 0.0
+    return np.broadcast_to(as_array(target), (m,)), 0.0, 0.0
 
 
 def equations(mech, st: State, jacobian: bool = True) -> Equations:
     """All constraint equations of a mechanism at the states ``st`` (without ``jacobian``,
     Cq is not assembled: ``Equations.jacobian`` is None)."""
-    n, m = st.n, mech.n_equations
-    residual, c_t = np.zeros((n, m)), np.zeros((n, m))
-    jac = np.zeros((n, m, mech.nq)) if jacobian else None
-    gamma = np.zeros((n, m)) if st.qd is not None else None
+    n, m, dtype = st.n, mech.n_equations, st.q.dtype    # complex in the complex step
+    residual, c_t = np.zeros((n, m), dtype), np.zeros((n, m), dtype)
+    jac = np.zeros((n, m, mech.nq), dtype) if jacobian else None
+    gamma = np.zeros((n, m), dtype) if st.qd is not None else None
     parts = []
     for el, rows in zip(mech.constraints, mech.rows):
         v, target = el.constraint(st)

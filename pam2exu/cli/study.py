@@ -49,6 +49,6 @@ def command(args, warnings) -> int:
                              progress=True)
     print(result.report())
     if args.output:
-        print(f"wrote {len(result)} variants to {args.output} and the summary to "
+        print(f"wrote {len(result)} {result.ROWS} to {args.output} and the summary to "
               f"{summary_path(args.output)}")
     return 0

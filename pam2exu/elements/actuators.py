@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from ..complex_step import row_norm
 from ..laws import Law
 from .base import FORCE, POSITION, VELOCITY, Actuator, Param, Var
 
@@ -87,7 +88,7 @@ class LinearActuator(Actuator):
         """At Q, x from P to Q (so that a positive force pushes Q away from P)."""
         P, Q = (st.point(r.solid, r.local).value for r in self.refs)
         d = Q - P
-        return Q, d / np.linalg.norm(d, axis=1, keepdims=True)
+        return Q, d / row_norm(d)
 
     def constraint(self, st):
         """|Q − P| − f(t) = 0 (Exudyn's ObjectConnectorDistance)."""

@@ -15,6 +15,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..complex_step import scalar
 from ..errors import closest, echo
 from ..limits import VALUE, is_number, one_form, shown
 from ..kinematics import Quantity, State, pose
@@ -124,14 +125,14 @@ class Param:
 def constants(value, size: int = 4) -> tuple[float, ...]:
     """C as a tuple of floats, missing entries 0."""
     values = list(value) if isinstance(value, (list, tuple, np.ndarray)) else [value]
-    values = [float(v) for v in values]
+    values = [scalar(v) for v in values]
     return tuple(values + [0.0] * (size - len(values)))
 
 
 def number(value) -> float:
     if isinstance(value, (list, tuple)):
         value = value[0]
-    return float(value)
+    return scalar(value)
 
 
 @dataclass

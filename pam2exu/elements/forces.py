@@ -6,6 +6,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..complex_step import hypot
 from ..errors import SolverError
 from ..kinematics import Quantity, column, generalized_force, rotate, torque
 from .base import FORCE, POSITION, VELOCITY, Element, Load, Param, Var, constants
@@ -151,12 +152,13 @@ class Spring(_SpringDamper):
         """ro = |Q − P| (F > 0 attracts P and Q); SolverError where the points coincide."""
         P, Q = (st.point(r.solid, r.local) for r in self.refs)
         gap = Q - P
-        self.require_apart(st.t, np.hypot(gap.value[:, 0], gap.value[:, 1]), P.value)
+        self.require_apart(st.t, hypot(gap.value[:, 0], gap.value[:, 1]), P.value)
         return gap.norm()
 
     def require_apart(self, t, length, P) -> None:
         """SolverError at the first time where ro ≤ 1e-12 max(1, |P|): a spring of length 0
         has no direction for its force."""
+        length = np.real(length)                       # (complex in the complex step)
         if not len(length) or np.min(length) > 1e-12 * max(1.0, float(np.max(np.abs(P)))):
             return
         k = int(np.argmin(length))
@@ -191,7 +193,7 @@ class Spring(_SpringDamper):
         c1, c2, c3, c4 = constants(self.C)
         P, Q = (nl.point(r.solid, r.local) for r in self.refs)
         gap = Q - P
-        ro = np.hypot(gap[:, 0], gap[:, 1])
+        ro = hypot(gap[:, 0], gap[:, 1])
         self.require_apart(nl.t, ro, P)
         rate = nl.point_rate(self.ref2.solid, self.ref2.local) - \
             nl.point_rate(self.ref1.solid, self.ref1.local)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Protocol
 
+from ..complex_step import scalar
 from ..elements import Element
 from ..kinematics import PER_SOLID
 from .angles import si_inputs
@@ -123,7 +124,7 @@ class Mechanism:
     @property
     def gravity(self) -> float:
         """Magnitude of the gravitational acceleration, along −y [m/s²]."""
-        return float(self.model.gravity)
+        return scalar(self.model.gravity)
 
     @property
     def nq(self) -> int:
@@ -198,6 +199,8 @@ class Mechanism:
             max(1e-3, |x|, |y| of every solid, |coordinates| of every point) [m]; the
             scale of the solver tolerances and self-checks.
         """
+        # (the real part: a point at p + ih in the complex step has the nominal's scale)
         values = [abs(float(v)) for s in self.solids for v in (s.x, s.y)]
-        values += [abs(float(c)) for s in self.solids for p in s.points.values() for c in p]
+        values += [abs(complex(c).real) for s in self.solids for p in s.points.values()
+                   for c in p]
         return max([1e-3, *values])

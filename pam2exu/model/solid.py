@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 from ..elements.base import ACCELERATION, POSITION, VELOCITY, Var
 from .. import limits
 from ..errors import closest, echo
+from ..complex_step import cos, scalar, sin
 from ..limits import is_number, shown
 
 
@@ -147,12 +148,12 @@ class LineRef:
     @property
     def direction(self) -> tuple[float, float]:
         """Unit vector along the line, local frame: (cos a, sin a)."""
-        return (math.cos(self.angle), math.sin(self.angle))
+        return (cos(self.angle), sin(self.angle))
 
     @property
     def normal(self) -> tuple[float, float]:
         """Unit normal, the direction turned 90° counter-clockwise: (−sin a, cos a)."""
-        return (-math.sin(self.angle), math.cos(self.angle))
+        return (-sin(self.angle), cos(self.angle))
 
 
 def _table(value) -> dict:
@@ -207,7 +208,7 @@ class Scope:
             return PointRef(i, (0.0, 0.0), str(text))
         try:
             x, y = value
-            return PointRef(i, (float(x), float(y)), str(text))
+            return PointRef(i, (scalar(x), scalar(y)), str(text))
         except (TypeError, ValueError, OverflowError):
             raise LookupError(f"point '{item}' of solid '{solid.name}' is not [x, y]") from None
 
@@ -217,7 +218,8 @@ class Scope:
             return LineRef(i, (0.0, 0.0), 0.0, str(text))
         try:
             px, py = value.get("point", (0.0, 0.0))
-            return LineRef(i, (float(px), float(py)), float(value.get("angle", 0.0)), str(text))
+            return LineRef(i, (scalar(px), scalar(py)), scalar(value.get("angle", 0.0)),
+                           str(text))
         except (AttributeError, TypeError, ValueError, OverflowError):
             raise LookupError(f"line '{item}' of solid '{solid.name}' is not "
                               "{ point = [x, y], angle = a }") from None

@@ -66,6 +66,55 @@ def spread(y: np.ndarray) -> float:
 REDUCTIONS = {"min": minimum, "max": maximum, "absmax": absmax, "mean": mean, "rms": rms,
               "final": final, "range": spread}
 
+
+
+# ---- first order: ∂(reduction)/∂p from the series' ∂y/∂p (the linear method) -------------
+# Each takes y (n,) and dy = ∂y/∂p (n, P) and gives the reduction's derivative (P,). On the
+# rows of a run a max is a max over finitely many values: where it is attained at one row
+# k its derivative is ∂y_k/∂p exactly (Danskin), as for min, absmax and range.
+
+def d_minimum(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """∂ min_i y_i = ∂y_k, k = argmin y."""
+    return dy[int(np.argmin(y))]
+
+
+def d_maximum(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """∂ max_i y_i = ∂y_k, k = argmax y."""
+    return dy[int(np.argmax(y))]
+
+
+def d_absmax(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """∂ max_i |y_i| = sign(y_k) ∂y_k, k = argmax |y|."""
+    k = int(np.argmax(np.abs(y)))
+    return np.sign(y[k]) * dy[k]
+
+
+def d_mean(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """∂ (1/n) Σ y_i = (1/n) Σ ∂y_i."""
+    return np.mean(dy, axis=0)
+
+
+def d_rms(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """∂ sqrt(mean y²) = mean(y ∂y) / rms."""
+    return np.mean(y[:, None] * dy, axis=0) / np.sqrt(np.mean(np.square(y)))
+
+
+def d_final(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """∂ y_n = ∂y_n."""
+    return dy[-1]
+
+
+def d_spread(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """∂ (max y − min y) = ∂y_argmax − ∂y_argmin."""
+    return dy[int(np.argmax(y))] - dy[int(np.argmin(y))]
+
+
+#: the first-order derivative of each reduction, by the same names as ``REDUCTIONS``
+FIRST_ORDER = {"min": d_minimum, "max": d_maximum, "absmax": d_absmax, "mean": d_mean,
+               "rms": d_rms, "final": d_final, "range": d_spread}
+#: the reductions whose first-order σ is the summary's ``linear_std`` (the contract's)
+LINEAR_STD = ("final", "mean")
+
 STATUSES = ("ok", "rejected", "error")
 OK, REJECTED, ERROR = STATUSES
 

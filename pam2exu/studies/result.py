@@ -75,6 +75,11 @@ class StudyResult:
         The reduced outputs' names, in the table's order.
     units : dict of str to str
         Each reduced output's unit.
+    linear_std : dict of str to float, optional
+        The first-order σ of the ``final`` and ``mean`` reductions (``linear.py``), for the
+        summary's ``linear_std`` [the reduced output's unit].
+    note : str
+        Why the linear σ is not given, when it is not ('' otherwise), for the report.
 
     Attributes
     ----------
@@ -91,13 +96,18 @@ class StudyResult:
         One row per reduced output over the variants that ran, then the row ``yield``.
     """
 
-    def __init__(self, study, table: dict, outputs: list[str], units: dict[str, str]):
-        self.study = study
+    #: what a row of the table is, for messages
+    ROWS = "variants"
+
+    def __init__(self, study, table: dict, outputs: list[str], units: dict[str, str],
+                 linear_std: dict | None = None, note: str = ""):
+        self.study, self.note = study, note
         self.table = table
         self.parameters = list(study.names)
         self.outputs = list(outputs)
         self.units = {**{p.name: p.unit for p in study.parameters}, **units}
-        self.summary = summary({n: table[n] for n in self.outputs}, table["status"])
+        self.summary = summary({n: table[n] for n in self.outputs}, table["status"],
+                               linear_std)
 
     def __len__(self) -> int:
         return len(self.table["sample"])
@@ -190,10 +200,14 @@ class StudyResult:
                  f"({s.method}{f', seed {s.seed}' if s.method != 'grid' else ''}), "
                  f"{s.steps} steps to t = {s.t_end:.6g} s"]
         width = max([len("output"), *(len(r.output) for r in self.summary[:-1])])
-        lines.append("  ".join([f"{'output':<{width}}", *(f"{c:>11}" for c in SHOWN)]))
+        shown = SHOWN + (("linear_std",) if any(not np.isnan(r.linear_std)
+                                                for r in self.summary[:-1]) else ())
+        lines.append("  ".join([f"{'output':<{width}}", *(f"{c:>11}" for c in shown)]))
         for row in self.summary[:-1]:
-            cells = [f"{row.count:>11d}", *(_number(getattr(row, c)) for c in SHOWN[1:])]
+            cells = [f"{row.count:>11d}", *(_number(getattr(row, c)) for c in shown[1:])]
             lines.append("  ".join([f"{row.output:<{width}}", *cells]))
+        if self.note:
+            lines.append(self.note)
         y = self.yield_
         lines.append(f"yield: {y.share:.4g} ({y.ok} of {y.count} variants ok), 95 % Wilson "
                      f"interval {y.low:.4g} … {y.high:.4g}")

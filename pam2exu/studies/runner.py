@@ -25,14 +25,18 @@ from .execute import open_executor, run_chunks
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
 from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_table
+from .linear import LinearResult, sensitivities
+from .reduce import LINEAR_STD
 from .result import StudyResult, check_out
 from .study import SAMPLED, Study, load_study
 
 #: the analyses a study runs today, as the registry declares them (``in_studies``; a
 #: clearance study follows its own dimension path: not available yet)
 STUDY_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.in_studies)
-#: the methods a study runs today (``linear``, first-order propagation: not available yet)
-STUDY_METHODS = SAMPLED + ("grid",)
+#: the analyses the first-order method differentiates (``AnalysisType.first_order``)
+FIRST_ORDER_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.first_order)
+#: the methods a study runs: sampled, a grid, and first order (``linear.py``)
+STUDY_METHODS = SAMPLED + ("grid", "linear")
 #: what an error row's message says of an exception that is not a pam2exu error
 FAULT = "fault of pam2exu (please report it with the study)"
 #: the estimate of a variant's work per row of its result [s] (for the chunks' size; no
@@ -103,7 +107,12 @@ def prepared(study: Study, samples: int | None = None) -> Study:
         problems.append(Problem("[study]", f"method = '{study.method}' is not available yet: "
                                            f"a study runs {', '.join(STUDY_METHODS)} today"))
     kind = analysis_type(study.analysis)
-    if kind is not None and not kind.in_studies:
+    if study.method == "linear" and kind is not None and not kind.first_order:
+        problems.append(Problem("[study]", f"method = 'linear' differentiates the "
+                                           f"{', '.join(FIRST_ORDER_ANALYSES)} analyses, "
+                                           f"not {study.analysis}: sample it instead "
+                                           "(monte_carlo, latin_hypercube, sobol)"))
+    elif kind is not None and not kind.in_studies:
         problems.append(Problem("[study]", f"analysis = '{study.analysis}' is not available in "
                                            f"a study yet: a study runs "
                                            f"{', '.join(STUDY_ANALYSES)} analyses today"))
@@ -154,6 +163,21 @@ def chunks_of(study: Study, workers: int) -> list[tuple[int, int]]:
     return plan_chunks(study.samples, (study.steps + 1) * SECONDS_PER_ROW, workers)
 
 
+def linear_estimate(run_as: Study, names: list[str]) -> tuple[dict, str]:
+    """The linear σ of a sampled study's ``final`` and ``mean`` reductions (its summary's
+    ``linear_std``), and a note when it cannot be given: ({}, why)."""
+    kind = analysis_type(run_as.analysis)
+    if run_as.method not in SAMPLED or not any(r in LINEAR_STD for r in run_as.reduce):
+        return {}, ""
+    if not kind.first_order:
+        return {}, (f"linear σ: the first-order method does not differentiate the "
+                    f"{run_as.analysis} analysis")
+    try:
+        return sensitivities(run_as).linear_std(names), ""
+    except ModelError as exc:
+        return {}, f"linear σ not available: {exc}"
+
+
 def checked(study_or_path, out=None, resume: bool = False, samples: int | None = None):
     """Every check before any variant runs: (the study as it runs, its reduced outputs'
     names and units, ``out`` checked); ``ModelError`` or ``OutputError`` otherwise."""
@@ -170,13 +194,20 @@ def checked(study_or_path, out=None, resume: bool = False, samples: int | None =
 def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor=None,
                 resume: bool = False, workers: int = 1, progress: bool = False) -> StudyResult:
     """Run a checked study's chunks on ``executor`` (``execute.run_chunks``; parts under
-    ``OUT.parts/``, removed once the files are written) and build its result."""
+    ``OUT.parts/``, removed once the files are written) and build its result; a linear
+    study: its sensitivities at the nominal variant (``linear.py``), in this process."""
+    if run_as.method == "linear":
+        result = LinearResult(run_as, sensitivities(run_as), names)
+        if out is not None:
+            result.write(out)
+        return result
+    linear_std, note = linear_estimate(run_as, names)
     with contextlib.ExitStack() as stack:
         parts = Path(f"{out}.parts") if out is not None else \
             Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="pam2exu-study-")))
         done = run_chunks(run_variants, payload(run_as, names), chunks_of(run_as, workers),
                           parts, executor, resume=resume, progress=progress)
-    result = StudyResult(run_as, done.columns, names, units)
+    result = StudyResult(run_as, done.columns, names, units, linear_std, note)
     if out is not None:
         result.write(out)
         clear_parts(parts)

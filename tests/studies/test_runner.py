@@ -233,8 +233,11 @@ BAD = {  # (what to change in SLIDER_STUDY, a piece of the message that names th
                               "[[requirement]] #1 'motor.Mz.q99'"),
     "missing model": (('model = "slider_crank.toml"', 'model = "slider_crank2.toml"'),
                       "slider_crank2.toml"),
-    "linear": (('method = "monte_carlo"\nsamples = 3', 'method = "linear"'),
-               "method = 'linear' is not available yet"),
+    "linear of an analysis it cannot differentiate": (
+        ('analysis = "kinetostatic"\nsteps = 6\nt_end = 0.3\nmethod = "monte_carlo"\n'
+         'samples = 3', 'analysis = "dynamic"\nsteps = 6\nt_end = 0.3\nmethod = "linear"'),
+        "method = 'linear' differentiates the assembly, quasi_static, kinematic, "
+        "kinetostatic analyses, not dynamic"),
     "clearance": (('analysis = "kinetostatic"', 'analysis = "clearance"'),
                   "analysis = 'clearance' is not available in a study yet"),
     "series": (("seed = 7", "seed = 7\nseries = true"), "series = true is not available yet"),
