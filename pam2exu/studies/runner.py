@@ -27,7 +27,7 @@ from .parameters import varied
 from .parts import clear_parts, plan_chunks
 from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_table
 from .result import StudyResult, check_out
-from .study import SAMPLED, Study, load_study
+from .study import MAX_SAMPLES, SAMPLED, Study, load_study, too_many
 
 #: the analyses a study runs today, as the registry declares them (``in_studies``; a
 #: clearance study follows its own dimension path: not available yet)
@@ -129,6 +129,8 @@ def prepared(study: Study, samples: int | None = None) -> Study:
     if samples is not None:
         if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
             problems.append(Problem("samples", f"must be a whole number ≥ 1, got {samples!r}"))
+        elif samples > MAX_SAMPLES:
+            problems.append(Problem("samples", too_many(f"{samples:,} variants")))
         elif study.method not in SAMPLED:
             problems.append(Problem("samples", f"a {study.method} study takes no samples: it "
                                                "runs every combination of the values lists"))

@@ -267,6 +267,14 @@ BAD = {  # (what to change in SLIDER_STUDY, a piece of the message that names th
                               "[[requirement]] #1 'motor.Mz.q99'"),
     "missing model": (('model = "slider_crank.toml"', 'model = "slider_crank2.toml"'),
                       "slider_crank2.toml"),
+    "an output the analysis does not give": (
+        ("[[parameter]]\nname = \"crank.A.x\"",
+         "[[requirement]]\noutput = \"B.Fz.max\"\nmax = 1.0\n[[parameter]]\nname = \"crank.A.x\""),
+        "[[requirement]] 'B.Fz.max': 'B.Fz.max' is not among the reduced outputs of the "
+        "kinetostatic analysis"),
+    "samples absurdly large": (("samples = 3", "samples = 1000000000000"),
+                               "[study]: samples = 1,000,000,000,000: more than a study runs "
+                               "(at most 10,000,000;"),
     "linear": (('method = "monte_carlo"\nsamples = 3', 'method = "linear"'),
                "method = 'linear' is not available yet"),
     "clearance": (('analysis = "kinetostatic"', 'analysis = "clearance"'),
@@ -285,6 +293,21 @@ def test_bad_input_exits_2_naming_the_entry_and_writes_nothing(case, tmp_path, c
     err = capsys.readouterr().err
     assert err.startswith(f"pam2exu: model error: {tmp_path / 's.toml'}: ") and named in err
     assert case != "unknown parameter" or "the closest: rod.mass" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml", "slider_crank.toml"]
+
+
+@pytest.mark.parametrize("samples, named", [
+    ("0", "samples: must be a whole number ≥ 1, got 0"),
+    ("1000000000000", "samples: 1,000,000,000,000 variants: more than a study runs (at most "
+                      "10,000,000;")])
+def test_bad_samples_on_the_command_line_exit_2_and_write_nothing(samples, named, tmp_path,
+                                                                   capsys):
+    (tmp_path / "slider_crank.toml").write_text((EXAMPLES / "slider_crank.toml").read_text())
+    (tmp_path / "s.toml").write_text(SLIDER_STUDY)
+    assert main(["study", str(tmp_path / "s.toml"), "-o", str(tmp_path / "o.csv"),
+                 "--samples", samples]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pam2exu: model error: {tmp_path / 's.toml'}: {named}")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml", "slider_crank.toml"]
 
 
