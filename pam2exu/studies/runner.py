@@ -29,8 +29,9 @@ from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_t
 from .result import StudyResult, check_out
 from .study import MAX_SAMPLES, SAMPLED, Study, load_study, too_many
 
-#: the analyses a study runs today, as the registry declares them (``in_studies``; a
-#: clearance study follows its own dimension path: not available yet)
+#: the analyses a study runs today, as the registry declares them (``in_studies``: each
+#: variant runs as a single run would, the equilibrium and dynamic analyses with the model's
+#: [analysis] tolerance; a clearance study follows its own dimension path: not yet)
 STUDY_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.in_studies)
 #: the methods a study runs today (``linear``, first-order propagation: not available yet)
 STUDY_METHODS = SAMPLED + ("grid",)

@@ -387,14 +387,10 @@ def test_a_dask_local_cluster_writes_the_same_bytes(tmp_path, capsys):
 
 def test_the_analyses_a_study_runs_are_the_registrys_declaration():
     """``AnalysisType.in_studies`` decides, by the type, not by its name: PAM's Catalan name
-    of the kinematic analysis is run (it was refused when the runner listed names), the
-    dynamic analysis is refused with the declared list."""
+    of the kinematic analysis is run (it was refused when the runner listed names); the
+    analyses refused are named with the declared list (test_free_analyses.py)."""
     assert STUDY_ANALYSES == tuple(a.name for a in ANALYSES.values() if a.in_studies)
     text = ('[study]\nmodel = "slider_crank.toml"\nanalysis = "{}"\nsamples = 2\n'
             '[[parameter]]\nname = "crank.A.x"\ndistribution = "normal"\ntol = 1e-4\n')
     folder = Path(__file__).resolve().parents[2] / "examples"
     assert prepared(loads_study(text.format("cinematica"), folder=folder)).samples == 2
-    with pytest.raises(pam2exu.ModelError, match="analysis = 'dynamic' is not available in a "
-                       "study yet: a study runs assembly, quasi_static, kinematic, "
-                       "kinetostatic analyses today"):
-        prepared(loads_study(text.format("dynamic"), folder=folder))
