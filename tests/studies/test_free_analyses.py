@@ -182,3 +182,17 @@ def test_the_shipped_examples_variants_run_as_single_runs(analysis):
     result = study(loads_study(text, folder=EXAMPLES))
     assert result.study.analysis == analysis
     _check_against_single_runs(result, (EXAMPLES / model).read_text(), str(EXAMPLES / model))
+
+
+@pytest.mark.long                    # 3 s: two worker processes start and import pam2exu
+def test_a_dynamic_study_on_two_workers_gives_the_same_table_bit_for_bit(folder, monkeypatch):
+    from pam2exu.studies import runner
+    text = PENDULUM_STUDY.format(analysis="dynamic").replace("samples = 3", "samples = 5")
+    whole = study(loads_study(text, folder=folder))
+    monkeypatch.setattr(runner, "chunks_of", lambda s, w: [(0, 2), (2, 5)])
+    again = study(loads_study(text, folder=folder), workers=2)
+    assert list(again.table) == list(whole.table)
+    for name, column in whole.table.items():
+        other = again.table[name]
+        assert np.array_equal(other.view(np.int64), column.view(np.int64)) \
+            if column.dtype.kind == "f" else np.array_equal(other, column), name
