@@ -99,6 +99,8 @@ def ranged(heads: list[str]) -> str:
     """The first of ``heads`` (of one kind) with each number shown as its range over them,
     '[low … high]', or as it is where they all agree."""
     values = [[float(x) for x in NUMBER.findall(h)] for h in heads]
+    if any(len(v) != len(values[0]) for v in values):   # a '…' of its own where one has a number
+        return masked(heads[0])
     pieces = NUMBER.split(heads[0])
     texts = NUMBER.findall(heads[0])
     out = [pieces[0]]

@@ -72,6 +72,11 @@ def test_a_group_shows_its_numbers_range_its_samples_and_its_first_message():
                                    "  1 × SolverError: other", "      samples 5"]
 
 
+def test_a_head_with_an_ellipsis_of_its_own_is_shown_masked():
+    found = group([(0, "E: from 1 … 2 m"), (1, "E: from 1 5 2 m")])
+    assert [(g.head, g.samples) for g in found] == [("E: from … … … m", (0, 1))]
+
+
 def test_a_long_report_counts_what_it_does_not_list():
     found = group((i, f"E{i}: x") for i in range(13)) + group((i, "F: y") for i in range(30))
     lines = report_lines(found, "warnings")
