@@ -246,12 +246,12 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("equilibrium", "equilibri", frozenset({POSITION, FORCE}), driven=False,
                  at_start=True,
                  summary="the free degrees of freedom in stable static equilibrium at t = 0",
-                 function="pam2exu.analyses.equilibrium:equilibrium"),
+                 function="pam2exu.analyses.equilibrium:equilibrium", in_studies=True),
     AnalysisType("dynamic", "dinamica", _ALL, driven=False, at_start=False,
                  summary="forward dynamics: the free degrees of freedom move under the "
                  "loads, to [analysis] tolerance",
                  function="pam2exu.analyses.dynamic:dynamic", integrates=True,
-                 options=("tolerance",)),
+                 options=("tolerance",), in_studies=True),
 )}
 
 #: the backends; the first is the default

@@ -20,14 +20,13 @@ from ..errors import OutputError
 from ..results.table_csv import csv_cells, csv_field
 from ..results.writers import optional, write_whole
 from .reduce import ERROR, OK, REJECTED
+from .messages import WARNINGS, Group, report_lines, warning_groups
 from .summary import error_groups, summary, write_summary
 
 #: the per-variant table's file formats, by suffix
 STUDY_FORMATS = {".parquet": "Parquet", ".csv": "CSV"}
 #: the summary's columns the printed report shows
 SHOWN = ("count", "mean", "std", "min", "q05", "q50", "q95", "max")
-#: the error groups the printed report lists (the others are counted)
-GROUPS_SHOWN = 10
 
 
 class Yield(NamedTuple):
@@ -94,6 +93,10 @@ class StudyResult:
         Each parameter's and reduced output's unit (SI; a parameter's in the model's).
     summary : list of SummaryRow
         One row per reduced output over the variants that ran, then the row ``yield``.
+    warnings : numpy.ndarray of str
+        Each variant's warnings, in variant order: one line each, '<class>: <first line of
+        the message>', one per kind (``messages.kind``); '' for none. Not a column of the
+        table or its files (a chunk's ``messages.WARNINGS`` column, taken out here).
     """
 
     #: what a row of the table is, for messages
@@ -102,7 +105,10 @@ class StudyResult:
     def __init__(self, study, table: dict, outputs: list[str], units: dict[str, str],
                  linear_std: dict | None = None, note: str = ""):
         self.study, self.note = study, note
+        self.warnings = table.pop(WARNINGS, None)
         self.table = table
+        if self.warnings is None:
+            self.warnings = np.full(len(table["sample"]), "")
         self.parameters = list(study.names)
         self.outputs = list(outputs)
         self.units = {**{p.name: p.unit for p in study.parameters}, **units}
@@ -123,10 +129,16 @@ class StudyResult:
         ok = int(np.count_nonzero(self.table["status"] == OK))
         return Yield(row.mean, row.min, row.max, ok, row.count)
 
-    def errors(self) -> list[tuple[str, list[int]]]:
-        """The variants in error grouped by their error (``summary.error_groups``)."""
+    def errors(self) -> list[Group]:
+        """The variants in error grouped by the kind of their error
+        (``summary.error_groups``)."""
         t = self.table
         return error_groups(t["status"], t["error"], t["sample"])
+
+    def warning_groups(self) -> list[Group]:
+        """The variants that warned grouped by the kind of their warning
+        (``messages.warning_groups``); a variant may be in several groups."""
+        return warning_groups(self.warnings, self.table["sample"])
 
     def to_pandas(self):
         """The per-variant table as a pandas DataFrame (copies, bit for bit); ``attrs``
@@ -193,8 +205,8 @@ class StudyResult:
         return written, write_summary(self.summary, summary_path(out))
 
     def report(self) -> str:
-        """The printed form: the summary table, the yield, the variants in error grouped by
-        their error."""
+        """The printed form: the summary table, the yield, the variants in error and those
+        that warned, grouped by the kind of their message (``messages.report_lines``)."""
         s = self.study
         lines = [f"study of {os.path.normpath(s.model_path)}: {s.analysis}, {len(self)} variants "
                  f"({s.method}{f', seed {s.seed}' if s.method != 'grid' else ''}), "
@@ -214,13 +226,11 @@ class StudyResult:
         rejected = int(np.count_nonzero(self.table["status"] == REJECTED))
         failed = int(np.count_nonzero(self.table["status"] == ERROR))
         lines.append(f"rejected by the requirements: {rejected}; in error: {failed}")
-        groups = self.errors()
-        for error, samples in groups[:GROUPS_SHOWN]:
-            shown = ", ".join(map(str, samples[:10])) + (", …" if len(samples) > 10 else "")
-            lines.append(f"  {len(samples)} × {error.splitlines()[0] if error else ''}")
-            lines.append(f"      samples {shown}")
-        if len(groups) > GROUPS_SHOWN:
-            lines.append(f"  … and {len(groups) - GROUPS_SHOWN} other errors")
+        lines += report_lines(self.errors(), "errors")
+        warned = int(np.count_nonzero(self.warnings != ""))
+        if warned:
+            lines.append(f"variants that warned: {warned} of {len(self)}")
+            lines += report_lines(self.warning_groups(), "warnings")
         return "\n".join(lines)
 
     def __str__(self) -> str:

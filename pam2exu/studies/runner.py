@@ -22,16 +22,18 @@ import numpy as np
 from ..errors import ModelError, OutputError, Pam2ExuError, Problem
 from ..registry import ANALYSES, analysis_type
 from .execute import open_executor, run_chunks
+from .messages import WARNINGS, kind
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
 from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_table
 from .linear import LinearResult, sensitivities
 from .reduce import LINEAR_STD
 from .result import StudyResult, check_out
-from .study import SAMPLED, Study, load_study
+from .study import MAX_SAMPLES, SAMPLED, Study, load_study, too_many
 
-#: the analyses a study runs today, as the registry declares them (``in_studies``; a
-#: clearance study follows its own dimension path: not available yet)
+#: the analyses a study runs today, as the registry declares them (``in_studies``: each
+#: variant runs as a single run would, the equilibrium and dynamic analyses with the model's
+#: [analysis] tolerance; a clearance study follows its own dimension path: not yet)
 STUDY_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.in_studies)
 #: the analyses the first-order method differentiates (``AnalysisType.first_order``)
 FIRST_ORDER_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.first_order)
@@ -52,24 +54,36 @@ def error_text(exc: BaseException) -> str:
 
 
 def run_variant(payload: dict, values: np.ndarray):
-    """One variant's (reduced outputs, status), or (None, error text): an ``Exception`` of
-    the variant is never raised (KeyboardInterrupt and SystemExit pass)."""
+    """One variant's (reduced outputs, status, warnings), or (None, error text, warnings):
+    an ``Exception`` of the variant is never raised (KeyboardInterrupt and SystemExit pass),
+    its warnings are not issued but returned (``warned``)."""
     from ..analyses import run
-    try:
-        model = varied(payload["model_text"], dict(zip(payload["names"], values)),
-                       payload["source"])
-        with warnings.catch_warnings():              # each variant's: not the study's
-            warnings.simplefilter("ignore")
+    with warnings.catch_warnings(record=True) as caught:   # each variant's: not the study's
+        warnings.simplefilter("always")
+        try:
+            model = varied(payload["model_text"], dict(zip(payload["names"], values)),
+                           payload["source"])
             res = run(model, payload["analysis"], t_end=payload["t_end"],
                       steps=payload["steps"], outputs=payload["outputs"])
-        reduced = reduce_run(res, payload["outputs"], payload["reduce"])
-        return reduced, status(reduced, payload["requirements"])
-    except Exception as exc:                          # noqa: BLE001 (a failure is data)
-        return None, error_text(exc)
+            reduced = reduce_run(res, payload["outputs"], payload["reduce"])
+            return reduced, status(reduced, payload["requirements"]), warned(caught)
+        except Exception as exc:                      # noqa: BLE001 (a failure is data)
+            return None, error_text(exc), warned(caught)
+
+
+def warned(caught: list) -> str:
+    """A variant's warnings, one line each ('<class>: <first line of the message>'), the
+    first of each kind (``messages.kind``) only, in the order issued; '' for none."""
+    lines: dict[str, str] = {}
+    for w in caught:
+        line = f"{w.category.__name__}: {str(w.message).splitlines()[0] if str(w.message) else ''}"
+        lines.setdefault(kind(line), line)
+    return "\n".join(lines.values())
 
 
 def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
-    """The per-variant columns of rows ``start … stop − 1`` (``reduce.variant_table``):
+    """The per-variant columns of rows ``start … stop − 1`` (``reduce.variant_table``),
+    and their warnings (the column ``messages.WARNINGS``, which ``StudyResult`` takes out):
     the worker's task, a top-level function of plain data.
 
     Parameters
@@ -80,13 +94,16 @@ def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
     start, stop : int
         The rows.
     """
-    rows = []
+    rows, warned_rows = [], []
     for i in range(start, stop):
         values = payload["values"][i]
-        reduced, outcome = run_variant(payload, values)
+        reduced, outcome, warned_text = run_variant(payload, values)
         rows.append(Variant(i, ERROR, outcome, tuple(values), None) if reduced is None
                     else Variant(i, outcome, "", tuple(values), reduced))
-    return variant_table(payload["names"], payload["reduced"], rows)
+        warned_rows.append(warned_text)
+    table = variant_table(payload["names"], payload["reduced"], rows)
+    table[WARNINGS] = np.array(warned_rows, dtype=str)
+    return table
 
 
 def payload(study: Study, reduced: list[str]) -> dict:
@@ -122,6 +139,8 @@ def prepared(study: Study, samples: int | None = None) -> Study:
     if samples is not None:
         if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
             problems.append(Problem("samples", f"must be a whole number ≥ 1, got {samples!r}"))
+        elif samples > MAX_SAMPLES:
+            problems.append(Problem("samples", too_many(f"{samples:,} variants")))
         elif study.method not in SAMPLED:
             problems.append(Problem("samples", f"a {study.method} study takes no samples: it "
                                                "runs every combination of the values lists"))

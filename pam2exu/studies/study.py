@@ -21,6 +21,9 @@ from .sampling import DISTRIBUTIONS, METHODS, Parameter, design, grid_size
 
 #: the methods that draw ``samples`` variants from a ``seed``
 SAMPLED = ("monte_carlo", "latin_hypercube", "sobol")
+#: the most variants a study runs: every variant's values and its row of the table are held
+#: in memory (a million already give a yield of 99 % within ± 0.02 %, its Wilson interval)
+MAX_SAMPLES = 10_000_000
 
 _TABLES = ("study", "parameter", "requirement")
 _STUDY_KEYS = ("model", "analysis", "t_end", "steps", "method", "samples", "seed", "outputs",
@@ -186,6 +189,9 @@ def loads_study(text: str, source: str = "<string>", folder: str | Path = ".") -
     method, samples = settings["method"], settings["samples"]
     if method == "grid" and parameters and all(p.values for p in parameters):
         samples = grid_size(parameters)
+        if samples > MAX_SAMPLES:
+            problems.append(Problem("[[parameter]]", too_many(
+                f"the values lists make a grid of {samples:,} variants")))
     elif method == "linear":
         samples = 1
     if problems:
@@ -251,6 +257,8 @@ def _settings(head: dict, model: Model, problems: list[Problem]) -> dict:
         elif not _whole(samples) or samples < 1:
             problems.append(Problem(where, f"samples must be a whole number ≥ 1, got "
                                            f"{echo(samples)}"))
+        elif samples > MAX_SAMPLES:
+            problems.append(Problem(where, too_many(f"samples = {samples:,}")))
     elif samples is not None and out["method"] in METHODS:
         problems.append(Problem(where, f"a {out['method']} study takes no samples (a grid runs "
                                        "every combination of the values lists, linear the "
@@ -273,6 +281,14 @@ def _settings(head: dict, model: Model, problems: list[Problem]) -> dict:
         problems.append(Problem(where, f"series must be true or false, got "
                                        f"{echo(out['series'])}"))
     return out
+
+
+def too_many(what: str) -> str:
+    """The problem of a study of more than ``MAX_SAMPLES`` variants, ``what`` saying how
+    many it asks."""
+    return (f"{what}: more than a study runs (at most {MAX_SAMPLES:,}; every variant's values "
+            "and row are held in memory): run fewer, a million give a yield of 99 % within "
+            "± 0.02 %")
 
 
 def _whole(value) -> bool:

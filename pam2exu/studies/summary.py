@@ -21,6 +21,7 @@ import numpy as np
 
 from ..results.table_csv import csv_cells, csv_field
 from ..results.writers import write_whole
+from .messages import Group, group
 from .reduce import ERROR, OK
 
 #: the quantiles' columns and their probabilities
@@ -139,17 +140,16 @@ def write_summary(rows: list[SummaryRow], path: str | Path) -> Path:
         "\n".join(summary_lines(rows)) + "\n", encoding="utf-8"))
 
 
-def error_groups(statuses, errors, samples) -> list[tuple[str, list[int]]]:
-    """The variants in error grouped by their error: (error, its samples), the most
-    frequent error first (ties: the one met first), samples in variant order.
+def error_groups(statuses, errors, samples) -> list[Group]:
+    """The variants in error grouped by the kind of their error (``messages.group``: the
+    head of the message, its numbers masked), the most frequent kind first (ties: the one
+    met first), samples in variant order.
 
     Examples
     --------
-    >>> error_groups(["ok", "error", "error", "error"], ["", "E: b", "E: a", "E: a"], [0, 1, 2, 3])
-    [('E: a', [2, 3]), ('E: b', [1])]
+    >>> found = error_groups(["ok", "error", "error", "error"],
+    ...                      ["", "E: b", "E: a at 0.1 s", "E: a at 0.3 s"], [0, 1, 2, 3])
+    >>> [(g.head, g.samples) for g in found]
+    [('E: a at [0.1 … 0.3] s', (2, 3)), ('E: b', (1,))]
     """
-    groups: dict[str, list[int]] = {}
-    for s, e, i in zip(statuses, errors, samples):
-        if s == ERROR:
-            groups.setdefault(str(e), []).append(int(i))
-    return sorted(groups.items(), key=lambda item: -len(item[1]))
+    return group((i, str(e)) for s, e, i in zip(statuses, errors, samples) if s == ERROR)

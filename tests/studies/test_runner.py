@@ -7,6 +7,7 @@ interval's closed form; the files read back with pyarrow and the csv module, bit
 """
 import csv
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -177,27 +178,60 @@ max = 2.37
 """
 
 
+#: GRID_STUDY with one more coupler length that cannot close the loop (its message lists the
+#: loop from another joint and the violated joints in another order) and one more ok
+GRID_FAILING = GRID_STUDY.replace("values = [0.35, 0.7, 0.36, 0.19]",
+                                  "values = [0.35, 0.7, 0.36, 0.19, 0.65, 0.37]")
+
+
+def _single_run_error(model_text: str, b: float) -> str:
+    """'<class>: <message>' of the error a single run raises with coupler.B.x = b."""
+    text = model_text.replace("B = [0.35, 0.0]", f"B = [{b!r}, 0.0]")
+    with pytest.raises(pam2exu.Pam2ExuError) as caught:
+        pam2exu.run(pam2exu.loads(text), "kinematic", t_end=0.5, steps=4, outputs=["rocker.fi"])
+    return f"{type(caught.value).__name__}: {caught.value}"
+
+
 def test_unassemblable_variants_are_error_rows_and_the_study_exits_0(tmp_path, capsys):
+    """The issue's acceptance: exit 0, the failing variants error rows with a single run's
+    error, every other row a single run's reductions (1e-12), the errors grouped by kind."""
     (tmp_path / "four_bar.toml").write_text((EXAMPLES / "four_bar.toml").read_text())
-    (tmp_path / "s.toml").write_text(GRID_STUDY)
+    (tmp_path / "s.toml").write_text(GRID_FAILING)
     out = tmp_path / "out.csv"
     assert main(["study", str(tmp_path / "s.toml"), "-o", str(out), "--workers", "1"]) == 0
     printed = capsys.readouterr().out
-    table = study(tmp_path / "s.toml").table
-    assert table["status"].tolist() == ["rejected", "error", "ok", "error"]
-    assert table["error"][1].startswith("SolverError: the mechanism cannot be assembled at t = 0")
-    assert table["error"][3].startswith("SolverError: between t = ") and table["error"][0] == ""
-    assert np.isnan(table["rocker.fi.max"][1]) and np.isnan(table["rocker.fi.range"][1])
-    assert "in error: 2" in printed and "  1 × SolverError: the mechanism cannot" in printed
-    assert "samples 3" in printed and "yield: 0.25 (1 of 4 variants ok)" in printed
+    rows = list(csv.reader(open(out, encoding="utf-8")))       # its numbers read back exactly
+    assert rows[0] == ["sample", "status", "error", "coupler.B.x", "rocker.fi.max",
+                       "rocker.fi.range"]
+    table = {name: np.array([float(r[j]) if r[j] else np.nan for r in rows[1:]])
+             if j > 2 else np.array([r[j] for r in rows[1:]]) for j, name in enumerate(rows[0])}
+    assert table["status"].tolist() == ["rejected", "error", "ok", "error", "error", "ok"]
     text = (EXAMPLES / "four_bar.toml").read_text()
-    for i, b in ((0, 0.35), (2, 0.36)):
+    values = [0.35, 0.7, 0.36, 0.19, 0.65, 0.37]
+    assert table["coupler.B.x"].tolist() == values
+    for i, b in enumerate(values):
+        if table["status"][i] == "error":
+            assert table["error"][i] == _single_run_error(text, b), i
+            assert np.isnan(table["rocker.fi.max"][i]) and np.isnan(table["rocker.fi.range"][i])
+            continue
         want = _by_hand(text, [("B = [0.35, 0.0]", f"B = [{b!r}, 0.0]")], "kinematic", 4,
                         0.5, ["rocker.fi"], ["max", "range"])
-        assert all(_close(float(table[n][i]), v) for n, v in want.items())
-    assert want["rocker.fi.max"] < 2.37 < float(table["rocker.fi.max"][0])   # the rejection
-    rows = list(csv.reader(open(out, encoding="utf-8")))
-    assert rows[2][1] == "error" and rows[2][2] == table["error"][1] and rows[2][4] == ""
+        assert table["error"][i] == ""
+        assert all(_close(float(table[n][i]), v) for n, v in want.items()), i
+        assert (table["status"][i] == "ok") == (want["rocker.fi.max"] <= 2.37)   # the rejection
+    unassembled = [str(e) for e in table["error"][[1, 4]]]
+    assert all(e.startswith("SolverError: the mechanism cannot be assembled at t = 0 s: ")
+               for e in unassembled)
+    masked = {re.sub(r"\d+(\.\d+)?", "#", e) for e in unassembled}
+    assert len(masked) == 2            # not the same words: numbers masked do not merge them
+    assert table["error"][3].startswith("SolverError: between t = ")
+    assert "in error: 3" in printed and "yield: 0.3333 (2 of 6 variants ok)" in printed
+    lines = printed.splitlines()
+    k = lines.index("  2 × SolverError: the mechanism cannot be assembled at t = 0 s")
+    assert lines[k + 1:k + 3] == ["      samples 1, 4", f"      sample 1: {unassembled[0]}"]
+    k = lines.index("  1 × SolverError: between t = 0.40625 s and t = 0.4375 s (between steps 3 "
+                    "and 4 of 4) the mechanism reached a singular (dead-point) position")
+    assert lines[k + 1:k + 3] == ["      samples 3", f"      sample 3: {table['error'][3]}"]
     assert (tmp_path / "out.summary.csv").exists()
 
 
@@ -238,6 +272,14 @@ BAD = {  # (what to change in SLIDER_STUDY, a piece of the message that names th
          'samples = 3', 'analysis = "dynamic"\nsteps = 6\nt_end = 0.3\nmethod = "linear"'),
         "method = 'linear' differentiates the assembly, quasi_static, kinematic, "
         "kinetostatic analyses, not dynamic"),
+    "an output the analysis does not give": (
+        ("[[parameter]]\nname = \"crank.A.x\"",
+         "[[requirement]]\noutput = \"B.Fz.max\"\nmax = 1.0\n[[parameter]]\nname = \"crank.A.x\""),
+        "[[requirement]] 'B.Fz.max': 'B.Fz.max' is not among the reduced outputs of the "
+        "kinetostatic analysis"),
+    "samples absurdly large": (("samples = 3", "samples = 1000000000000"),
+                               "[study]: samples = 1,000,000,000,000: more than a study runs "
+                               "(at most 10,000,000;"),
     "clearance": (('analysis = "kinetostatic"', 'analysis = "clearance"'),
                   "analysis = 'clearance' is not available in a study yet"),
     "series": (("seed = 7", "seed = 7\nseries = true"), "series = true is not available yet"),
@@ -254,6 +296,21 @@ def test_bad_input_exits_2_naming_the_entry_and_writes_nothing(case, tmp_path, c
     err = capsys.readouterr().err
     assert err.startswith(f"pam2exu: model error: {tmp_path / 's.toml'}: ") and named in err
     assert case != "unknown parameter" or "the closest: rod.mass" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml", "slider_crank.toml"]
+
+
+@pytest.mark.parametrize("samples, named", [
+    ("0", "samples: must be a whole number ≥ 1, got 0"),
+    ("1000000000000", "samples: 1,000,000,000,000 variants: more than a study runs (at most "
+                      "10,000,000;")])
+def test_bad_samples_on_the_command_line_exit_2_and_write_nothing(samples, named, tmp_path,
+                                                                   capsys):
+    (tmp_path / "slider_crank.toml").write_text((EXAMPLES / "slider_crank.toml").read_text())
+    (tmp_path / "s.toml").write_text(SLIDER_STUDY)
+    assert main(["study", str(tmp_path / "s.toml"), "-o", str(tmp_path / "o.csv"),
+                 "--samples", samples]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pam2exu: model error: {tmp_path / 's.toml'}: {named}")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml", "slider_crank.toml"]
 
 
@@ -333,14 +390,10 @@ def test_a_dask_local_cluster_writes_the_same_bytes(tmp_path, capsys):
 
 def test_the_analyses_a_study_runs_are_the_registrys_declaration():
     """``AnalysisType.in_studies`` decides, by the type, not by its name: PAM's Catalan name
-    of the kinematic analysis is run (it was refused when the runner listed names), the
-    dynamic analysis is refused with the declared list."""
+    of the kinematic analysis is run (it was refused when the runner listed names); the
+    analyses refused are named with the declared list (test_free_analyses.py)."""
     assert STUDY_ANALYSES == tuple(a.name for a in ANALYSES.values() if a.in_studies)
     text = ('[study]\nmodel = "slider_crank.toml"\nanalysis = "{}"\nsamples = 2\n'
             '[[parameter]]\nname = "crank.A.x"\ndistribution = "normal"\ntol = 1e-4\n')
     folder = Path(__file__).resolve().parents[2] / "examples"
     assert prepared(loads_study(text.format("cinematica"), folder=folder)).samples == 2
-    with pytest.raises(pam2exu.ModelError, match="analysis = 'dynamic' is not available in a "
-                       "study yet: a study runs assembly, quasi_static, kinematic, "
-                       "kinetostatic analyses today"):
-        prepared(loads_study(text.format("dynamic"), folder=folder))

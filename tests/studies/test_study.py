@@ -196,3 +196,27 @@ def test_zero_tol_a_uniform_with_low_high_and_mean_and_outputs_not_a_list():
         "needs no [[parameter]])",
         "[[parameter]] #2 'rocker.mass': a uniform distribution between low and high takes no "
         "mean (mean ± tol is the other way to give it)"]
+
+
+def test_a_study_of_absurdly_many_variants_is_refused_before_anything_is_drawn():
+    """10¹² variants (or a grid of 31⁵ ≈ 2.9·10⁷) would be drawn and held in memory: refused
+    naming the entry; a million, within the limit, give a yield of 99 % within ± 0.02 %."""
+    found = problems('[study]\nmodel = "four_bar.toml"\nsamples = 1000000000000\n'
+                     '[[parameter]]\nname = "crank.mass"\ntol = 0.01\n'
+                     'distribution = "normal"\n')
+    assert found == ["[study]: samples = 1,000,000,000,000: more than a study runs (at most "
+                     "10,000,000; every variant's values and row are held in memory): run "
+                     "fewer, a million give a yield of 99 % within ± 0.02 %"]
+    values = "values = [" + ", ".join(str(0.3 + k / 1000) for k in range(31)) + "]"
+    grid = '[study]\nmodel = "four_bar.toml"\nmethod = "grid"\n' + "".join(
+        f'[[parameter]]\nname = "{name}"\n{values}\n'
+        for name in ("crank.mass", "coupler.mass", "rocker.mass", "coupler.B.x", "rocker.B.x"))
+    assert problems(grid) == ["[[parameter]]: the values lists make a grid of 28,629,151 "
+                              "variants: more than a study runs (at most 10,000,000; every "
+                              "variant's values and row are held in memory): run fewer, a "
+                              "million give a yield of 99 % within ± 0.02 %"]
+    from pam2exu.studies.summary import wilson_interval
+    low, high = wilson_interval(990_000, 1_000_000)
+    assert 0.99 - 0.0002 < low < high < 0.99 + 0.0002
+    study = loads_study(grid.replace(values, "values = [0.3, 0.31]"), folder=EXAMPLES)
+    assert study.samples == 32 and study.variants().shape == (32, 5)

@@ -127,9 +127,12 @@ def test_the_examples_in_the_docstrings_run():
 
 def test_the_variants_in_error_are_grouped_by_their_error():
     statuses = ["error", "ok", "error", "rejected", "error", "error", "error"]
-    errors = ["AssemblyError: x", "", "SingularPosition: y", "", "SingularPosition: y",
-              "AssemblyError: x", "ClearanceError: z"]
-    assert error_groups(statuses, errors, range(10, 17)) == [
-        ("AssemblyError: x", [10, 15]), ("SingularPosition: y", [12, 14]),
-        ("ClearanceError: z", [16])]
+    errors = ["AssemblyError: x", "", "SingularPosition: y at 0.5 s", "",
+              "SingularPosition: y at 0.25 s", "AssemblyError: x", "ClearanceError: z"]
+    found = error_groups(statuses, errors, range(10, 17))
+    assert [(g.kind, g.head, g.samples, g.example) for g in found] == [
+        ("AssemblyError: x", "AssemblyError: x", (10, 15), "AssemblyError: x"),
+        ("SingularPosition: y at … s", "SingularPosition: y at [0.25 … 0.5] s", (12, 14),
+         "SingularPosition: y at 0.5 s"),
+        ("ClearanceError: z", "ClearanceError: z", (16,), "ClearanceError: z")]
     assert error_groups(["ok"], [""], [0]) == []
