@@ -19,13 +19,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, OutputError, Pam2ExuError, Problem
+from ..errors import (InputWarning, ModelError, OutputError, Pam2ExuError, Problem,
+                      warn_outside)
 from ..registry import ANALYSES, analysis_type
 from .execute import open_executor, run_chunks
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
-from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_table
+from .reduce import (ERROR, Variant, output_columns, reduce_run, reduced_names, status,
+                     variant_table)
 from .result import StudyResult, check_out
+from .series import (WARN_BYTES, chunk_series, long_table, memory_problem, memory_text,
+                     series_bytes, series_outputs, series_rows, split, variant_series)
 from .study import SAMPLED, Study, load_study
 
 #: the analyses a study runs today, as the registry declares them (``in_studies``; a
@@ -48,8 +52,10 @@ def error_text(exc: BaseException) -> str:
 
 
 def run_variant(payload: dict, values: np.ndarray):
-    """One variant's (reduced outputs, status), or (None, error text): an ``Exception`` of
-    the variant is never raised (KeyboardInterrupt and SystemExit pass)."""
+    """One variant's (reduced outputs, status, series), or (None, error text, None): an
+    ``Exception`` of the variant is never raised (KeyboardInterrupt and SystemExit pass).
+    The series (``series.variant_series``: t, then each output) only when the payload
+    asks for them, else None."""
     from ..analyses import run
     try:
         model = varied(payload["model_text"], dict(zip(payload["names"], values)),
@@ -59,30 +65,40 @@ def run_variant(payload: dict, values: np.ndarray):
             res = run(model, payload["analysis"], t_end=payload["t_end"],
                       steps=payload["steps"], outputs=payload["outputs"])
         reduced = reduce_run(res, payload["outputs"], payload["reduce"])
-        return reduced, status(reduced, payload["requirements"])
+        kept = None if payload.get("series") is None else \
+            variant_series(res, output_columns(res.columns, payload["outputs"]),
+                           payload.get("series"))
+        return reduced, status(reduced, payload["requirements"]), kept
     except Exception as exc:                          # noqa: BLE001 (a failure is data)
-        return None, error_text(exc)
+        return None, error_text(exc), None
 
 
 def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
-    """The per-variant columns of rows ``start … stop − 1`` (``reduce.variant_table``):
-    the worker's task, a top-level function of plain data.
+    """The per-variant columns of rows ``start … stop − 1`` (``reduce.variant_table``),
+    with a study that keeps them the series' 2-D columns (``series.chunk_series``): the
+    worker's task, a top-level function of plain data.
 
     Parameters
     ----------
     payload : dict
         ``payload(study, outputs)``: model text and source, analysis, t_end, steps,
-        outputs, reduce, requirements, the parameters' names, every variant's values.
+        outputs, reduce, requirements, the parameters' names, every variant's values,
+        the rows of a variant's series (None: no series).
     start, stop : int
         The rows.
     """
-    rows = []
+    rows, kept = [], []
     for i in range(start, stop):
         values = payload["values"][i]
-        reduced, outcome = run_variant(payload, values)
+        reduced, outcome, series = run_variant(payload, values)
         rows.append(Variant(i, ERROR, outcome, tuple(values), None) if reduced is None
                     else Variant(i, outcome, "", tuple(values), reduced))
-    return variant_table(payload["names"], payload["reduced"], rows)
+        kept.append(series)
+    table = variant_table(payload["names"], payload["reduced"], rows)
+    if payload.get("series") is not None:
+        table.update(chunk_series(kept, len(series_outputs(payload["reduced"])),
+                                  payload.get("series")))
+    return table
 
 
 def payload(study: Study, reduced: list[str]) -> dict:
@@ -91,13 +107,14 @@ def payload(study: Study, reduced: list[str]) -> dict:
             "analysis": study.analysis, "t_end": study.t_end, "steps": study.steps,
             "outputs": study.outputs, "reduce": list(study.reduce),
             "requirements": [tuple(r) for r in study.requirements], "names": study.names,
-            "reduced": reduced, "values": study.variants()}
+            "reduced": reduced, "values": study.variants(),
+            "series": series_rows(analysis_type(study.analysis).at_start, study.steps)
+            if study.series else None}
 
 
 def prepared(study: Study, samples: int | None = None) -> Study:
     """The study as it will run (``samples`` overriding its own); ``ModelError`` naming the
-    entry for what a study cannot do today (a linear method, a clearance analysis, the
-    series table)."""
+    entry for what a study cannot do today (a linear method, a clearance analysis)."""
     problems = []
     if study.method not in STUDY_METHODS:
         problems.append(Problem("[study]", f"method = '{study.method}' is not available yet: "
@@ -107,9 +124,6 @@ def prepared(study: Study, samples: int | None = None) -> Study:
         problems.append(Problem("[study]", f"analysis = '{study.analysis}' is not available in "
                                            f"a study yet: a study runs "
                                            f"{', '.join(STUDY_ANALYSES)} analyses today"))
-    if study.series:
-        problems.append(Problem("[study]", "series = true is not available yet: a study keeps "
-                                           "the reduced outputs of each variant today"))
     if samples is not None:
         if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
             problems.append(Problem("samples", f"must be a whole number ≥ 1, got {samples!r}"))
@@ -144,8 +158,24 @@ def nominal(study: Study):
                for r in study.requirements if r.output not in names]
     if missing:
         raise ModelError(missing, study.source, kind="study")
+    if study.series:
+        check_series_memory(study, len(res.t), len(series_outputs(names)))
     units = {n: res.units.get(n.rpartition(".")[0], "") for n in names}
+    units.update({c: res.units.get(c, "") for c in series_outputs(names)} if study.series
+                 else {})
     return names, units
+
+
+def check_series_memory(study: Study, rows: int, outputs: int) -> None:
+    """A study whose series would not fit in this machine's memory is a ``ModelError``
+    (``series.memory_problem``); one that would take more than ``series.WARN_BYTES``, an
+    ``InputWarning`` saying how much."""
+    problem = memory_problem(study.samples, rows, outputs)
+    if problem:
+        raise ModelError([Problem("[study] series", problem)], study.source, kind="study")
+    if series_bytes(study.samples, rows, outputs) > WARN_BYTES:
+        warn_outside(f"{study.source}: [study] {memory_text(study.samples, rows, outputs)}",
+                     InputWarning)
 
 
 def chunks_of(study: Study, workers: int) -> list[tuple[int, int]]:
@@ -176,7 +206,9 @@ def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor
             Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="pam2exu-study-")))
         done = run_chunks(run_variants, payload(run_as, names), chunks_of(run_as, workers),
                           parts, executor, resume=resume, progress=progress)
-    result = StudyResult(run_as, done.columns, names, units)
+    table, series = split(done.columns)
+    result = StudyResult(run_as, table, names, units,
+                         long_table(table, series, series_outputs(names)) if series else None)
     if out is not None:
         result.write(out)
         clear_parts(parts)
