@@ -93,7 +93,7 @@ def planned_pictures(args, study, names: list[str]) -> list[tuple]:
             plots.check_reduced(output, names, "--hist")
             planned.append((plots.hist, (output,), plots.picture_path(base, "hist", output)))
         for output in args.band:
-            plots.check_series(output, series, "--band")
+            plots.check_series(output, series, "--band", study.source)
             planned.append((plots.band, (output,), plots.picture_path(base, "band", output)))
         for output, parameter in args.scatter:
             plots.check_reduced(output, names, "--scatter")

@@ -50,12 +50,13 @@ def check_reduced(output: str, outputs: list[str], what: str = "hist") -> None:
         raise _unknown(what, output, "a reduced output", list(outputs))
 
 
-def check_series(output: str, series: list[str] | None, what: str = "band") -> None:
+def check_series(output: str, series: list[str] | None, what: str = "band",
+                 source: str = "the study file") -> None:
     """PictureError unless the study keeps its series (``series`` not None) and ``output``
-    is one of their outputs (``motor.Mz``)."""
+    is one of their outputs (``motor.Mz``); ``source`` names the study file."""
     if series is None:
         raise PictureError(f"{what} '{output}' needs the series of the variants: set "
-                           f"series = true in the study file's [study] table")
+                           f"series = true in the [study] table of {source}")
     if output not in series:
         raise _unknown(what, output, "an output whose series the study keeps", list(series))
 
@@ -168,7 +169,8 @@ def band(result, output: str, ax=None):
         (``band_curves``).
     """
     series = result.series
-    check_series(output, None if series is None else list(series)[2:], "band")
+    check_series(output, None if series is None else list(series)[2:], "band",
+                 result.study.source)
     t, curves = band_curves(series, output)
     q = dict(zip(QUANTILES, curves))
     ax = _axes(ax)

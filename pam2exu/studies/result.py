@@ -147,7 +147,7 @@ class StudyResult:
         """The series table, or PictureError naming what asked for it."""
         if self.series is None:
             raise PictureError(f"{asked} needs the series table: set series = true in "
-                                     f"the study file's [study] table")
+                               f"the [study] table of {self.study.source}")
         return self.series
 
     def hist(self, output: str, ax=None):

@@ -229,7 +229,8 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
         ``workers``); the table is the same, bit for bit, whatever runs it.
     out : str or Path, optional
         The per-variant table's file, ``.parquet`` or ``.csv`` (the summary beside it,
-        ``OUT.summary.csv``); checked before any variant runs. None: nothing written.
+        ``OUT.summary.csv``, and with ``series = true`` ``OUT.series.parquet`` or
+        ``OUT.series.csv``); checked before any variant runs. None: nothing written.
     resume : bool
         Run only the chunks missing under ``OUT.parts/`` (a study interrupted keeps every
         finished chunk there; the parts are removed once the files are written).
