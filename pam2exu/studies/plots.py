@@ -177,8 +177,10 @@ def band(result, output: str, ax=None):
     shades = [ax.fill_between(t, q[low], q[high], color="C0", alpha=alpha, linewidth=0,
                               label=f"{low[1:]} … {high[1:]} %")
               for low, high, alpha in SHADES]
-    lines = {name: ax.plot(t, curve, color="C0", linewidth=2.0 if name == "q50" else 0.6,
-                           label=name)[0] for name, curve in q.items()}
+    lines = {name: ax.plot(t, curve, color="C0", label=name,
+                           **({"linewidth": 2.0} if name == "q50" else
+                              {"linewidth": 0.5, "alpha": 0.5}))[0]
+             for name, curve in q.items()}
     ax.set_xlabel(label("t", "s"))
     ax.set_ylabel(label(output, result.units.get(output, "")))
     ax.set_title(f"{output}: percentiles over {np.unique(series['sample']).size} variants")
