@@ -134,9 +134,14 @@ class StudyResult:
         return error_groups(t["status"], t["error"], t["sample"])
 
     def to_pandas(self, series: bool = False):
-        """The per-variant table (``series=True``: the series table) as a pandas DataFrame
-        (copies, bit for bit); ``attrs`` holds ``units``. Needs pandas
-        (``pip install "pam2exu[pandas]"``)."""
+        """The per-variant table (or the series table) as a pandas DataFrame (copies, bit
+        for bit); ``attrs`` holds ``units``. Needs pandas (``pip install "pam2exu[pandas]"``).
+
+        Parameters
+        ----------
+        series : bool
+            The series table (``series = true``) instead of the per-variant table.
+        """
         pd = optional("pandas", "a DataFrame")
         columns = self._series("to_pandas(series=True)") if series else self.table
         df = pd.DataFrame({n: np.array(c, copy=True) for n, c in columns.items()})
@@ -152,17 +157,43 @@ class StudyResult:
 
     def hist(self, output: str, ax=None):
         """The histogram of a reduced output over the variants that ran, with its
-        requirements' limits (``plots.hist``); returns the matplotlib Axes."""
+        requirements' limits (``plots.hist``); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        output : str
+            A reduced output (``motor.Mz.absmax``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
         return plots.hist(self, output, ax)
 
     def band(self, output: str, ax=None):
         """The 1, 5, 50, 95 and 99 % percentiles of an output's series over t
-        (``plots.band``; needs ``series = true``); returns the matplotlib Axes."""
+        (``plots.band``; needs ``series = true``); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        output : str
+            An output whose series the study keeps (``motor.Mz``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
         return plots.band(self, output, ax)
 
     def scatter(self, output: str, parameter: str, ax=None):
         """A reduced output against a parameter, a point per variant that ran
-        (``plots.scatter``); returns the matplotlib Axes."""
+        (``plots.scatter``); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        output : str
+            A reduced output (``motor.Mz.absmax``).
+        parameter : str
+            A parameter of the study (``crank.A.x``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
         return plots.scatter(self, output, parameter, ax)
 
     def to_parquet(self, path: str | Path) -> Path:
@@ -200,11 +231,23 @@ class StudyResult:
         return write_whole(path, lambda tmp: tmp.write_bytes(body))
 
     def series_to_parquet(self, path: str | Path) -> Path:
-        """Write the series table as Parquet (as ``to_parquet``; needs ``series = true``)."""
+        """Write the series table as Parquet (as ``to_parquet``; needs ``series = true``).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (replaced if it exists).
+        """
         return write_parquet(self._series("series_to_parquet"), self.units, path)
 
     def series_to_csv(self, path: str | Path) -> Path:
-        """Write the series table as CSV (as ``to_csv``; needs ``series = true``)."""
+        """Write the series table as CSV (``series.write_csv``; needs ``series = true``).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (replaced if it exists).
+        """
         return write_csv(self._series("series_to_csv"), path)
 
     def write(self, out: str | Path) -> tuple[Path, ...]:
