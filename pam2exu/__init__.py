@@ -205,7 +205,8 @@ def study(study_or_path, executor=None, out=None, resume=False, samples=None, wo
         Runs the chunks of variants (default: this process, or ``workers`` processes); the
         table is the same, bit for bit, whatever runs it.
     out : str or Path, optional
-        Write the per-variant table (``.parquet`` or ``.csv``) and ``OUT.summary.csv``.
+        Write the per-variant table (``.parquet`` or ``.csv``) and ``OUT.summary.csv``
+        (with ``series = true`` also ``OUT.series.parquet`` or ``OUT.series.csv``).
     resume : bool
         Run only the chunks missing under ``OUT.parts/`` (those of an interrupted study).
     samples : int, optional
@@ -220,7 +221,9 @@ def study(study_or_path, executor=None, out=None, resume=False, samples=None, wo
     StudyResult
         ``.table`` (NumPy columns ``sample``, ``status``, ``error``, the parameters, the
         reduced outputs), ``.summary`` (rows), ``.yield_`` (share ok, Wilson interval),
-        ``.to_pandas()``, ``.to_parquet(path)``, ``.to_csv(path)``, ``.report()``.
+        ``.to_pandas()``, ``.to_parquet(path)``, ``.to_csv(path)``, ``.report()``; with
+        ``series = true`` ``.series`` (long format ``sample``, ``t``, each output); the
+        pictures ``.hist(output)``, ``.band(output)``, ``.scatter(output, parameter)``.
 
     Raises
     ------

@@ -1,5 +1,7 @@
-"""A study's result: the per-variant table, the summary and the yield, their files
-(``OUT.parquet`` or ``OUT.csv``, ``OUT.summary.csv`` beside it) and the printed report.
+"""A study's result: the per-variant table, the summary and the yield, the series table
+of a study that keeps it (``series.py``), their files (``OUT.parquet`` or ``OUT.csv``,
+``OUT.summary.csv`` and ``OUT.series.parquet`` or ``OUT.series.csv`` beside it), the
+printed report and the pictures (``plots.py``).
 
 The per-variant table has one row per variant in variant order: ``sample`` (int64),
 ``status`` (ok, rejected, error), ``error`` (the error's class and message, '' unless in
@@ -16,11 +18,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import OutputError
+from ..errors import OutputError, PictureError
 from ..results.table_csv import csv_cells, csv_field
 from ..results.writers import optional, write_whole
+from . import plots
 from .reduce import ERROR, OK, REJECTED
 from .messages import WARNINGS, Group, report_lines, warning_groups
+from .series import series_path, write_csv
 from .summary import error_groups, summary, write_summary
 
 #: the per-variant table's file formats, by suffix
@@ -73,7 +77,9 @@ class StudyResult:
     outputs : list of str
         The reduced outputs' names, in the table's order.
     units : dict of str to str
-        Each reduced output's unit.
+        Each reduced output's unit (and each series output's, with ``series``).
+    series : dict of str to numpy.ndarray, optional
+        The series table in long format (``series.long_table``), for ``series = true``.
     linear_std : dict of str to float, optional
         The first-order σ of the ``final`` and ``mean`` reductions (``linear.py``), for the
         summary's ``linear_std`` [the reduced output's unit].
@@ -90,20 +96,25 @@ class StudyResult:
     parameters, outputs : list of str
         The parameters' and the reduced outputs' column names.
     units : dict of str to str
-        Each parameter's and reduced output's unit (SI; a parameter's in the model's).
+        Each parameter's, reduced output's and series output's unit (SI; a parameter's in
+        the model's).
     summary : list of SummaryRow
         One row per reduced output over the variants that ran, then the row ``yield``.
     warnings : numpy.ndarray of str
         Each variant's warnings, in variant order: one line each, '<class>: <first line of
         the message>', one per kind (``messages.kind``); '' for none. Not a column of the
         table or its files (a chunk's ``messages.WARNINGS`` column, taken out here).
+    series : dict of str to numpy.ndarray or None
+        With ``series = true``: every variant's time series in long format, ``sample``,
+        ``t``, each output (``motor.Mz``), the rows of the variants that ran (status ok or
+        rejected) in variant order; a variant in error has no rows. None otherwise.
     """
 
     #: what a row of the table is, for messages
     ROWS = "variants"
 
     def __init__(self, study, table: dict, outputs: list[str], units: dict[str, str],
-                 linear_std: dict | None = None, note: str = ""):
+                 series: dict | None = None, linear_std: dict | None = None, note: str = ""):
         self.study, self.note = study, note
         self.warnings = table.pop(WARNINGS, None)
         self.table = table
@@ -112,6 +123,9 @@ class StudyResult:
         self.parameters = list(study.names)
         self.outputs = list(outputs)
         self.units = {**{p.name: p.unit for p in study.parameters}, **units}
+        if series is not None:
+            self.units["t"] = "s"
+        self.series = series
         self.summary = summary({n: table[n] for n in self.outputs}, table["status"],
                                linear_std)
 
@@ -140,13 +154,68 @@ class StudyResult:
         (``messages.warning_groups``); a variant may be in several groups."""
         return warning_groups(self.warnings, self.table["sample"])
 
-    def to_pandas(self):
-        """The per-variant table as a pandas DataFrame (copies, bit for bit); ``attrs``
-        holds ``units``. Needs pandas (``pip install "pam2exu[pandas]"``)."""
+    def to_pandas(self, series: bool = False):
+        """The per-variant table (or the series table) as a pandas DataFrame (copies, bit
+        for bit); ``attrs`` holds ``units``. Needs pandas (``pip install "pam2exu[pandas]"``).
+
+        Parameters
+        ----------
+        series : bool
+            The series table (``series = true``) instead of the per-variant table.
+        """
         pd = optional("pandas", "a DataFrame")
-        df = pd.DataFrame({n: np.array(c, copy=True) for n, c in self.table.items()})
-        df.attrs["units"] = dict(self.units)
+        columns = self._series("to_pandas(series=True)") if series else self.table
+        df = pd.DataFrame({n: np.array(c, copy=True) for n, c in columns.items()})
+        df.attrs["units"] = {n: self.units.get(n, "") for n in columns if n in self.units}
         return df
+
+    def _series(self, asked: str) -> dict:
+        """The series table, or PictureError naming what asked for it."""
+        if self.series is None:
+            raise PictureError(f"{asked} needs the series table: set series = true in "
+                               f"the [study] table of {self.study.source}")
+        return self.series
+
+    def hist(self, output: str, ax=None):
+        """The histogram of a reduced output over the variants that ran, with its
+        requirements' limits (``plots.hist``); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        output : str
+            A reduced output (``motor.Mz.absmax``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
+        return plots.hist(self, output, ax)
+
+    def band(self, output: str, ax=None):
+        """The 1, 5, 50, 95 and 99 % percentiles of an output's series over t
+        (``plots.band``; needs ``series = true``); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        output : str
+            An output whose series the study keeps (``motor.Mz``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
+        return plots.band(self, output, ax)
+
+    def scatter(self, output: str, parameter: str, ax=None):
+        """A reduced output against a parameter, a point per variant that ran
+        (``plots.scatter``); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        output : str
+            A reduced output (``motor.Mz.absmax``).
+        parameter : str
+            A parameter of the study (``crank.A.x``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
+        return plots.scatter(self, output, parameter, ax)
 
     def to_parquet(self, path: str | Path) -> Path:
         """Write the per-variant table as Parquet (float64 columns bit for bit, each
@@ -158,17 +227,7 @@ class StudyResult:
         path : str or Path
             The file to write (replaced if it exists).
         """
-        pa = optional("pyarrow", "a Parquet file")
-        parquet = optional("pyarrow.parquet", "a Parquet file")
-        arrays, fields = [], []
-        for name, column in self.table.items():
-            kind = {"sample": pa.int64()}.get(name, pa.string() if column.dtype.kind == "U"
-                                               else pa.float64())
-            arrays.append(pa.array(column.tolist() if column.dtype.kind == "U" else column,
-                                   type=kind))
-            fields.append(pa.field(name, kind, metadata={"unit": self.units.get(name, "")}))
-        table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
-        return write_whole(Path(path), lambda tmp: parquet.write_table(table, tmp))
+        return write_parquet(self.table, self.units, path)
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the per-variant table as CSV: a header of the column names, then one line
@@ -192,17 +251,48 @@ class StudyResult:
         body = ("\n".join(lines) + "\n").encode("utf-8")
         return write_whole(path, lambda tmp: tmp.write_bytes(body))
 
-    def write(self, out: str | Path) -> tuple[Path, Path]:
-        """Write ``OUT.parquet`` or ``OUT.csv`` (by suffix) and ``OUT.summary.csv``.
+    def series_to_parquet(self, path: str | Path) -> Path:
+        """Write the series table as Parquet (as ``to_parquet``; needs ``series = true``).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (replaced if it exists).
+        """
+        return write_parquet(self._series("series_to_parquet"), self.units, path)
+
+    def series_to_csv(self, path: str | Path) -> Path:
+        """Write the series table as CSV (``series.write_csv``; needs ``series = true``).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write (replaced if it exists).
+        """
+        return write_csv(self._series("series_to_csv"), path)
+
+    def write(self, out: str | Path) -> tuple[Path, ...]:
+        """Write ``OUT.parquet`` or ``OUT.csv`` (by suffix), ``OUT.summary.csv`` and, with
+        the series table, ``OUT.series.parquet`` or ``OUT.series.csv``.
 
         Parameters
         ----------
         out : str or Path
             The per-variant table's file (``check_out``).
+
+        Returns
+        -------
+        tuple of Path
+            The files written: the table, the summary (then the series).
         """
         out = check_out(out)
-        written = self.to_parquet(out) if out.suffix.lower() == ".parquet" else self.to_csv(out)
-        return written, write_summary(self.summary, summary_path(out))
+        parquet = out.suffix.lower() == ".parquet"
+        written = (self.to_parquet(out) if parquet else self.to_csv(out),
+                   write_summary(self.summary, summary_path(out)))
+        if self.series is not None:
+            path = series_path(out)
+            written += (self.series_to_parquet(path) if parquet else self.series_to_csv(path),)
+        return written
 
     def report(self) -> str:
         """The printed form: the summary table, the yield, the variants in error and those
@@ -235,6 +325,23 @@ class StudyResult:
 
     def __str__(self) -> str:
         return self.report()
+
+
+def write_parquet(columns: dict, units: dict, path: str | Path) -> Path:
+    """Write NumPy columns as Parquet: ``sample`` int64, strings as strings, the others
+    float64 bit for bit, each column's unit in its field's metadata; under a temporary name
+    then renamed. Needs pyarrow (``pip install "pam2exu[parquet]"``)."""
+    pa = optional("pyarrow", "a Parquet file")
+    parquet = optional("pyarrow.parquet", "a Parquet file")
+    arrays, fields = [], []
+    for name, column in columns.items():
+        kind = {"sample": pa.int64()}.get(name, pa.string() if column.dtype.kind == "U"
+                                           else pa.float64())
+        arrays.append(pa.array(column.tolist() if column.dtype.kind == "U" else column,
+                               type=kind))
+        fields.append(pa.field(name, kind, metadata={"unit": units.get(name, "")}))
+    table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
+    return write_whole(Path(path), lambda tmp: parquet.write_table(table, tmp))
 
 
 def _number(x: float) -> str:

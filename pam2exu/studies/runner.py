@@ -19,16 +19,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, OutputError, Pam2ExuError, Problem
+from ..errors import (InputWarning, ModelError, OutputError, Pam2ExuError, Problem,
+                      warn_outside)
 from ..registry import ANALYSES, analysis_type
 from .execute import open_executor, run_chunks
 from .messages import WARNINGS, kind
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
-from .reduce import ERROR, Variant, reduce_run, reduced_names, status, variant_table
 from .linear import LinearResult, sensitivities
-from .reduce import LINEAR_STD
+from .reduce import (ERROR, LINEAR_STD, Variant, output_columns, reduce_run, reduced_names,
+                     status, variant_table)
 from .result import StudyResult, check_out
+from .series import (WARN_BYTES, chunk_series, long_table, memory_problem, memory_text,
+                     series_bytes, series_outputs, series_rows, split, variant_series)
 from .study import MAX_SAMPLES, SAMPLED, Study, load_study, too_many
 
 #: the analyses a study runs today, as the registry declares them (``in_studies``: each
@@ -54,9 +57,11 @@ def error_text(exc: BaseException) -> str:
 
 
 def run_variant(payload: dict, values: np.ndarray):
-    """One variant's (reduced outputs, status, warnings), or (None, error text, warnings):
-    an ``Exception`` of the variant is never raised (KeyboardInterrupt and SystemExit pass),
-    its warnings are not issued but returned (``warned``)."""
+    """One variant's (reduced outputs, status, warnings, series), or (None, error text,
+    warnings, None): an ``Exception`` of the variant is never raised (KeyboardInterrupt and
+    SystemExit pass), its warnings are not issued but returned (``warned``). The series
+    (``series.variant_series``: t, then each output) only when the payload asks for them,
+    else None."""
     from ..analyses import run
     with warnings.catch_warnings(record=True) as caught:   # each variant's: not the study's
         warnings.simplefilter("always")
@@ -66,9 +71,12 @@ def run_variant(payload: dict, values: np.ndarray):
             res = run(model, payload["analysis"], t_end=payload["t_end"],
                       steps=payload["steps"], outputs=payload["outputs"])
             reduced = reduce_run(res, payload["outputs"], payload["reduce"])
-            return reduced, status(reduced, payload["requirements"]), warned(caught)
+            kept = None if payload.get("series") is None else \
+                variant_series(res, output_columns(res.columns, payload["outputs"]),
+                               payload.get("series"))
+            return reduced, status(reduced, payload["requirements"]), warned(caught), kept
         except Exception as exc:                      # noqa: BLE001 (a failure is data)
-            return None, error_text(exc), warned(caught)
+            return None, error_text(exc), warned(caught), None
 
 
 def warned(caught: list) -> str:
@@ -83,26 +91,32 @@ def warned(caught: list) -> str:
 
 def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
     """The per-variant columns of rows ``start … stop − 1`` (``reduce.variant_table``),
-    and their warnings (the column ``messages.WARNINGS``, which ``StudyResult`` takes out):
-    the worker's task, a top-level function of plain data.
+    their warnings (the column ``messages.WARNINGS``, which ``StudyResult`` takes out) and,
+    with a study that keeps them, the series' 2-D columns (``series.chunk_series``): the
+    worker's task, a top-level function of plain data.
 
     Parameters
     ----------
     payload : dict
         ``payload(study, outputs)``: model text and source, analysis, t_end, steps,
-        outputs, reduce, requirements, the parameters' names, every variant's values.
+        outputs, reduce, requirements, the parameters' names, every variant's values,
+        the rows of a variant's series (None: no series).
     start, stop : int
         The rows.
     """
-    rows, warned_rows = [], []
+    rows, warned_rows, kept = [], [], []
     for i in range(start, stop):
         values = payload["values"][i]
-        reduced, outcome, warned_text = run_variant(payload, values)
+        reduced, outcome, warned_text, series = run_variant(payload, values)
         rows.append(Variant(i, ERROR, outcome, tuple(values), None) if reduced is None
                     else Variant(i, outcome, "", tuple(values), reduced))
         warned_rows.append(warned_text)
+        kept.append(series)
     table = variant_table(payload["names"], payload["reduced"], rows)
     table[WARNINGS] = np.array(warned_rows, dtype=str)
+    if payload.get("series") is not None:
+        table.update(chunk_series(kept, len(series_outputs(payload["reduced"])),
+                                  payload.get("series")))
     return table
 
 
@@ -112,13 +126,14 @@ def payload(study: Study, reduced: list[str]) -> dict:
             "analysis": study.analysis, "t_end": study.t_end, "steps": study.steps,
             "outputs": study.outputs, "reduce": list(study.reduce),
             "requirements": [tuple(r) for r in study.requirements], "names": study.names,
-            "reduced": reduced, "values": study.variants()}
+            "reduced": reduced, "values": study.variants(),
+            "series": series_rows(analysis_type(study.analysis).at_start, study.steps)
+            if study.series else None}
 
 
 def prepared(study: Study, samples: int | None = None) -> Study:
     """The study as it will run (``samples`` overriding its own); ``ModelError`` naming the
-    entry for what a study cannot do today (a linear method, a clearance analysis, the
-    series table)."""
+    entry for what a study cannot do today (a linear method, a clearance analysis)."""
     problems = []
     if study.method not in STUDY_METHODS:
         problems.append(Problem("[study]", f"method = '{study.method}' is not available yet: "
@@ -133,9 +148,6 @@ def prepared(study: Study, samples: int | None = None) -> Study:
         problems.append(Problem("[study]", f"analysis = '{study.analysis}' is not available in "
                                            f"a study yet: a study runs "
                                            f"{', '.join(STUDY_ANALYSES)} analyses today"))
-    if study.series:
-        problems.append(Problem("[study]", "series = true is not available yet: a study keeps "
-                                           "the reduced outputs of each variant today"))
     if samples is not None:
         if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
             problems.append(Problem("samples", f"must be a whole number ≥ 1, got {samples!r}"))
@@ -172,8 +184,24 @@ def nominal(study: Study):
                for r in study.requirements if r.output not in names]
     if missing:
         raise ModelError(missing, study.source, kind="study")
+    if study.series:
+        check_series_memory(study, len(res.t), len(series_outputs(names)))
     units = {n: res.units.get(n.rpartition(".")[0], "") for n in names}
+    units.update({c: res.units.get(c, "") for c in series_outputs(names)} if study.series
+                 else {})
     return names, units
+
+
+def check_series_memory(study: Study, rows: int, outputs: int) -> None:
+    """A study whose series would not fit in this machine's memory is a ``ModelError``
+    (``series.memory_problem``); one that would take more than ``series.WARN_BYTES``, an
+    ``InputWarning`` saying how much."""
+    problem = memory_problem(study.samples, rows, outputs)
+    if problem:
+        raise ModelError([Problem("[study] series", problem)], study.source, kind="study")
+    if series_bytes(study.samples, rows, outputs) > WARN_BYTES:
+        warn_outside(f"{study.source}: [study] {memory_text(study.samples, rows, outputs)}",
+                     InputWarning)
 
 
 def chunks_of(study: Study, workers: int) -> list[tuple[int, int]]:
@@ -226,7 +254,10 @@ def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor
             Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="pam2exu-study-")))
         done = run_chunks(run_variants, payload(run_as, names), chunks_of(run_as, workers),
                           parts, executor, resume=resume, progress=progress)
-    result = StudyResult(run_as, done.columns, names, units, linear_std, note)
+    table, series = split(done.columns)
+    result = StudyResult(run_as, table, names, units,
+                         long_table(table, series, series_outputs(names)) if series else None,
+                         linear_std, note)
     if out is not None:
         result.write(out)
         clear_parts(parts)
@@ -247,7 +278,8 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
         ``workers``); the table is the same, bit for bit, whatever runs it.
     out : str or Path, optional
         The per-variant table's file, ``.parquet`` or ``.csv`` (the summary beside it,
-        ``OUT.summary.csv``); checked before any variant runs. None: nothing written.
+        ``OUT.summary.csv``, and with ``series = true`` ``OUT.series.parquet`` or
+        ``OUT.series.csv``); checked before any variant runs. None: nothing written.
     resume : bool
         Run only the chunks missing under ``OUT.parts/`` (a study interrupted keeps every
         finished chunk there; the parts are removed once the files are written).

@@ -282,7 +282,6 @@ BAD = {  # (what to change in SLIDER_STUDY, a piece of the message that names th
                                "(at most 10,000,000;"),
     "clearance": (('analysis = "kinetostatic"', 'analysis = "clearance"'),
                   "analysis = 'clearance' is not available in a study yet"),
-    "series": (("seed = 7", "seed = 7\nseries = true"), "series = true is not available yet"),
 }
 
 
@@ -351,7 +350,7 @@ def test_two_worker_processes_give_the_same_table_bit_for_bit(slider):
 
 def test_a_deleted_part_and_resume_give_the_same_files(tmp_path, monkeypatch):
     (tmp_path / "four_bar.toml").write_text((EXAMPLES / "four_bar.toml").read_text())
-    (tmp_path / "s.toml").write_text(GRID_STUDY)
+    (tmp_path / "s.toml").write_text(GRID_STUDY.replace("steps = 4", "steps = 4\nseries = true"))
     whole = study(tmp_path / "s.toml", out=tmp_path / "whole.csv")
     from pam2exu.studies import runner
     monkeypatch.setattr(runner, "chunks_of", lambda s, w: [(0, 1), (1, 2), (2, 4)])
@@ -371,7 +370,9 @@ def test_a_deleted_part_and_resume_give_the_same_files(tmp_path, monkeypatch):
                         lambda *a, **k: ran.append(engine(*a, **k)) or ran[-1])
     study(tmp_path / "s.toml", out=tmp_path / "o.csv", resume=True)
     assert [tuple(c) for c in ran[0].computed] == [(1, 2)]   # only the missing chunk
-    assert (tmp_path / "o.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    for name in ("o.csv", "o.series.csv"):               # the series are in the parts too
+        assert (tmp_path / name).read_bytes() == \
+            (tmp_path / name.replace("o.", "whole.")).read_bytes()
     assert not (tmp_path / "o.csv.parts").exists()
     assert whole.table["status"].tolist() == ["rejected", "error", "ok", "error"]
 
