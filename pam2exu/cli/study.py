@@ -1,6 +1,6 @@
 """``pam2exu study``: run a study (docs/studies.md), print its summary, yield and errors,
 write its per-variant table (-o), ``OUT.summary.csv`` (and ``OUT.series.*``) beside it, and
-the pictures asked for (``--hist``, ``--band``, ``--scatter``) as ``OUT.<kind>.<names>.png``."""
+the pictures asked for (``--hist``, ``--band``, ``--scatter``, ``--tornado``) as ``OUT.<kind>.<names>.png``."""
 from __future__ import annotations
 
 import os
@@ -37,6 +37,10 @@ def add_parser(sub) -> None:
     st.add_argument("--band", action="append", default=[], metavar="OUTPUT",
                     help="1/5/50/95/99 %% percentiles of an output's series (motor.Mz) over "
                          "t, needs series = true: OUT.band.OUTPUT.png (repeatable)")
+    st.add_argument("--tornado", action="append", default=[], metavar="OUTPUT",
+                    help="tornado of a reduced output's first-order sensitivities "
+                         "∂y/∂p·σ_p at the nominal variant: OUT.tornado.OUTPUT.png "
+                         "(repeatable)")
     st.add_argument("--scatter", action="append", default=[], nargs=2,
                     metavar=("OUTPUT", "PARAMETER"),
                     help="a reduced output against a parameter, a point per variant: "
@@ -60,7 +64,7 @@ def command(args, warnings) -> int:
     workers = args.dask_local or args.workers or os.cpu_count() or 1
     with open_executor(args.workers, args.dask, args.dask_local) as executor:
         result = run_checked(run_as, names, units, out, executor, args.resume, workers,
-                             progress=True)
+                             progress=True, first_order=bool(args.tornado))
     print(result.report())
     if args.output:
         print(f"wrote {len(result)} {result.ROWS} to {args.output} and the summary to "
@@ -100,6 +104,18 @@ def planned_pictures(args, study, names: list[str]) -> list[tuple]:
             plots.check_parameter(parameter, study.names, "--scatter")
             planned.append((plots.scatter, (output, parameter),
                             plots.picture_path(base, "scatter", output, parameter)))
+        for output in args.tornado:
+            plots.check_reduced(output, names, "--tornado")
+            planned.append((tornado, (output,), plots.picture_path(base, "tornado", output)))
+        if study.method == "linear" and len(planned) > len(args.tornado):
+            raise PictureError("a linear study has no variants to draw: --hist, --band and "
+                               "--scatter need a sampled study (its --tornado draws the "
+                               "sensitivities)")
     except PictureError as exc:
         raise UsageError(str(exc)) from None
     return planned
+
+
+def tornado(result, output: str):
+    """``result.tornado(output)``: the drawing function of ``--tornado``."""
+    return result.tornado(output)

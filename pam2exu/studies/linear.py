@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ModelError, Pam2ExuError, Problem
 from ..results import Results
+from . import plots
 from .parameters import targets, write
 from .reduce import (FIRST_ORDER, LINEAR_STD, OK, REDUCTIONS, reduced_name, status)
 from .result import Yield, check_out, summary_path
@@ -186,6 +187,7 @@ class LinearResult:
 
     def __init__(self, study, sens: Sensitivities, reduced: list[str]):
         self.study, self.sensitivities, self.outputs = study, sens, list(reduced)
+        self.series = None                     # the table is the series: no series table
         self.table = sens.table()
         self.values = {n: sens.reduced(*n.rsplit(".", 1))[0] for n in self.outputs}
         self.status = status(self.values, study.requirements)
@@ -217,6 +219,20 @@ class LinearResult:
             u, per = units.get(base.removesuffix(".std"), ""), units.get(parameter, "")
             unit[n] = f"{u or '1'}/{per}" if per else u
         return Results(self.table["t"], cols, unit, self.study.analysis, self.study.model_path.stem)
+
+    def tornado(self, output: str, ax=None):
+        """The tornado of a reduced output (``motor.Mz.final``): each parameter's
+        first-order contribution ∂y_r/∂p · σ_p, the largest on top; returns the matplotlib
+        Axes.
+
+        Parameters
+        ----------
+        output : str
+            A reduced output (``motor.Mz.absmax``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
+        return plots.sensitivity_tornado(self.sensitivities, output, ax)
 
     def to_pandas(self):
         """The table as a pandas DataFrame (``pip install "pam2exu[pandas]"``)."""
@@ -250,6 +266,8 @@ class LinearResult:
             column, _, reduction = n.rpartition(".")
             parts = sorted(sens.contributions(column, reduction).items(),
                            key=lambda item: -abs(item[1]))[:SHOWN_PARAMETERS]
+            largest = abs(parts[0][1]) if parts else 0.0
+            parts = [(p, v) for p, v in parts if abs(v) > 1e-9 * largest]   # not round-off
             shown = ", ".join(f"{p} {v:+.3g}" for p, v in parts)
             lines.append(f"{n:<{width}}  {self.values[n]:>11.5g}  "
                          f"{sens.reduced_std(column, reduction):>11.5g}  {shown}")

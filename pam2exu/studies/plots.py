@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import PictureError, closest
 from ..results.plot import WIDTH, figure, label
-from .reduce import ERROR
+from .reduce import ERROR, REDUCTIONS
 from .summary import QUANTILES
 
 #: height of a study's picture [in] (its width is ``results.plot.WIDTH``)
@@ -266,3 +266,14 @@ def tornado(output: str, contributions: dict, ax=None, unit: str = ""):
     ax.set_xlabel(label("∂y/∂p · σ_p", unit))
     ax.set_title(f"{output}: first-order contributions")
     return ax
+
+
+def sensitivity_tornado(sensitivities, output: str, ax=None):
+    """The tornado of a reduced output (``motor.Mz.final``) from a study's sensitivities at
+    its nominal variant (``linear.Sensitivities``): ∂y_r/∂p · σ_p of every parameter."""
+    column, _, reduction = output.rpartition(".")
+    if column not in sensitivities.nominal or reduction not in REDUCTIONS:
+        known = [f"{c}.{r}" for c in sensitivities.nominal for r in REDUCTIONS]
+        raise _unknown("tornado", output, "a reduced output", known)
+    return tornado(output, sensitivities.contributions(column, reduction), ax,
+                   sensitivities.units.get(column, ""))

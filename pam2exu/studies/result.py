@@ -80,9 +80,9 @@ class StudyResult:
         Each reduced output's unit (and each series output's, with ``series``).
     series : dict of str to numpy.ndarray, optional
         The series table in long format (``series.long_table``), for ``series = true``.
-    linear_std : dict of str to float, optional
-        The first-order σ of the ``final`` and ``mean`` reductions (``linear.py``), for the
-        summary's ``linear_std`` [the reduced output's unit].
+    sensitivities : linear.Sensitivities, optional
+        ∂y/∂p at the nominal variant: the summary's ``linear_std`` of the ``final`` and
+        ``mean`` reductions, and the tornado plots.
     note : str
         Why the linear σ is not given, when it is not ('' otherwise), for the report.
 
@@ -114,8 +114,8 @@ class StudyResult:
     ROWS = "variants"
 
     def __init__(self, study, table: dict, outputs: list[str], units: dict[str, str],
-                 series: dict | None = None, linear_std: dict | None = None, note: str = ""):
-        self.study, self.note = study, note
+                 series: dict | None = None, sensitivities=None, note: str = ""):
+        self.study, self.note, self.sensitivities = study, note, sensitivities
         self.warnings = table.pop(WARNINGS, None)
         self.table = table
         if self.warnings is None:
@@ -127,7 +127,7 @@ class StudyResult:
             self.units["t"] = "s"
         self.series = series
         self.summary = summary({n: table[n] for n in self.outputs}, table["status"],
-                               linear_std)
+                               sensitivities and sensitivities.linear_std(self.outputs))
 
     def __len__(self) -> int:
         return len(self.table["sample"])
@@ -216,6 +216,25 @@ class StudyResult:
             Where to draw; default a new figure on the Agg canvas.
         """
         return plots.scatter(self, output, parameter, ax)
+
+    def tornado(self, output: str, ax=None):
+        """The tornado of a reduced output (``motor.Mz.final``): each parameter's
+        first-order contribution ∂y_r/∂p · σ_p at the nominal variant, the largest on top
+        (``plots.sensitivity_tornado``); returns the matplotlib Axes. PictureError when the
+        study has no sensitivities (``pam2exu.study(..., first_order=True)`` computes them).
+
+        Parameters
+        ----------
+        output : str
+            A reduced output (``motor.Mz.absmax``).
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure on the Agg canvas.
+        """
+        if self.sensitivities is None:
+            raise PictureError(f"tornado '{output}': the study has no sensitivities ("
+                               f"{self.note or 'none were asked for'}); ask for them with "
+                               "--tornado or pam2exu.study(..., first_order=True)")
+        return plots.sensitivity_tornado(self.sensitivities, output, ax)
 
     def to_parquet(self, path: str | Path) -> Path:
         """Write the per-variant table as Parquet (float64 columns bit for bit, each
@@ -307,7 +326,7 @@ class StudyResult:
         lines.append("  ".join([f"{'output':<{width}}", *(f"{c:>11}" for c in shown)]))
         for row in self.summary[:-1]:
             cells = [f"{row.count:>11d}", *(_number(getattr(row, c)) for c in shown[1:])]
-            lines.append("  ".join([f"{row.output:<{width}}", *cells]))
+            lines.append("  ".join([f"{row.output:<{width}}", *cells]).rstrip())
         if self.note:
             lines.append(self.note)
         y = self.yield_

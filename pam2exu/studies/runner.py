@@ -210,19 +210,27 @@ def chunks_of(study: Study, workers: int) -> list[tuple[int, int]]:
     return plan_chunks(study.samples, (study.steps + 1) * SECONDS_PER_ROW, workers)
 
 
-def linear_estimate(run_as: Study, names: list[str]) -> tuple[dict, str]:
-    """The linear σ of a sampled study's ``final`` and ``mean`` reductions (its summary's
-    ``linear_std``), and a note when it cannot be given: ({}, why)."""
+def linear_estimate(run_as: Study, names: list[str], asked: bool = False):
+    """The sensitivities at the nominal variant of a sampled study (``linear.py``): for the
+    linear σ of its ``final`` and ``mean`` reductions, or ``asked`` (a tornado plot). (None,
+    why) when the study has no use for them or they cannot be given; ``ModelError`` when
+    they were asked for and cannot be given."""
     kind = analysis_type(run_as.analysis)
-    if run_as.method not in SAMPLED or not any(r in LINEAR_STD for r in run_as.reduce):
-        return {}, ""
+    if run_as.method not in SAMPLED or not (asked or any(r in LINEAR_STD
+                                                         for r in run_as.reduce)):
+        return None, ""
     if not kind.first_order:
-        return {}, (f"linear σ: the first-order method does not differentiate the "
-                    f"{run_as.analysis} analysis")
+        why = f"the first-order method does not differentiate the {run_as.analysis} analysis"
+        if asked:
+            raise ModelError([Problem("[study]", f"no sensitivities: {why}")], run_as.source,
+                             kind="study")
+        return None, f"linear σ: {why}"
     try:
-        return sensitivities(run_as).linear_std(names), ""
+        return sensitivities(run_as), ""
     except ModelError as exc:
-        return {}, f"linear σ not available: {exc}"
+        if asked:
+            raise
+        return None, f"linear σ not available: {exc}"
 
 
 def checked(study_or_path, out=None, resume: bool = False, samples: int | None = None):
@@ -239,16 +247,19 @@ def checked(study_or_path, out=None, resume: bool = False, samples: int | None =
 
 
 def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor=None,
-                resume: bool = False, workers: int = 1, progress: bool = False) -> StudyResult:
+                resume: bool = False, workers: int = 1, progress: bool = False,
+                first_order: bool = False) -> StudyResult:
     """Run a checked study's chunks on ``executor`` (``execute.run_chunks``; parts under
     ``OUT.parts/``, removed once the files are written) and build its result; a linear
-    study: its sensitivities at the nominal variant (``linear.py``), in this process."""
+    study: its sensitivities at the nominal variant (``linear.py``), in this process.
+    ``first_order``: a sampled study's sensitivities are wanted (a tornado plot), not only
+    for the linear σ of its ``final`` and ``mean`` reductions."""
     if run_as.method == "linear":
         result = LinearResult(run_as, sensitivities(run_as), names)
         if out is not None:
             result.write(out)
         return result
-    linear_std, note = linear_estimate(run_as, names)
+    sens, note = linear_estimate(run_as, names, first_order)
     with contextlib.ExitStack() as stack:
         parts = Path(f"{out}.parts") if out is not None else \
             Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="pam2exu-study-")))
@@ -257,7 +268,7 @@ def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor
     table, series = split(done.columns)
     result = StudyResult(run_as, table, names, units,
                          long_table(table, series, series_outputs(names)) if series else None,
-                         linear_std, note)
+                         sens, note)
     if out is not None:
         result.write(out)
         clear_parts(parts)
@@ -266,7 +277,7 @@ def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor
 
 def study(study_or_path, executor=None, out=None, resume: bool = False,
           samples: int | None = None, workers: int | None = None,
-          progress: bool = False) -> StudyResult:
+          progress: bool = False, first_order: bool = False):
     """Run a study: every variant of it, reduced, with the summary and the yield.
 
     Parameters
@@ -289,10 +300,16 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
         Local worker processes (default 1: this process).
     progress : bool
         A progress bar on a terminal (variants done, rate, time left).
+    first_order : bool
+        Also compute a sampled study's sensitivities at the nominal variant
+        (``StudyResult.sensitivities``, ``StudyResult.tornado``), not only for the linear
+        σ of its ``final`` and ``mean`` reductions.
 
     Returns
     -------
-    StudyResult
+    StudyResult or LinearResult
+        A linear study (``method = "linear"``) gives a ``linear.LinearResult``: its table
+        is one row per output time (t, each output, its σ and its ∂y/∂p).
 
     Raises
     ------
@@ -317,6 +334,7 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
     run_as, names, units, out = checked(study_or_path, out, resume, samples)
     if executor is not None:
         return run_checked(run_as, names, units, out, executor, resume,
-                           workers or os.cpu_count() or 1, progress)
+                           workers or os.cpu_count() or 1, progress, first_order)
     with open_executor(workers or 1) as pool:
-        return run_checked(run_as, names, units, out, pool, resume, workers or 1, progress)
+        return run_checked(run_as, names, units, out, pool, resume, workers or 1, progress,
+                           first_order)

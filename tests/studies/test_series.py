@@ -260,12 +260,14 @@ def test_the_pictures_the_options_ask_for_and_their_files():
     loaded = loads_study(SERIES_STUDY, folder=EXAMPLES)
     names = ["motor.Mz.absmax", "motor.Mz.range", "slider.x.absmax", "slider.x.range"]
     args = Namespace(output="out/tol.parquet", study="s.toml", hist=["slider.x.range"],
-                     band=["motor.Mz"], scatter=[["motor.Mz.absmax", "rod.mass"]])
+                     band=["motor.Mz"], scatter=[["motor.Mz.absmax", "rod.mass"]],
+                     tornado=["motor.Mz.range"])
     assert [(f.__name__, a, str(p)) for f, a, p in planned_pictures(args, loaded, names)] == [
         ("hist", ("slider.x.range",), "out/tol.hist.slider.x.range.png"),
         ("band", ("motor.Mz",), "out/tol.band.motor.Mz.png"),
         ("scatter", ("motor.Mz.absmax", "rod.mass"),
-         "out/tol.scatter.motor.Mz.absmax.vs.rod.mass.png")]
+         "out/tol.scatter.motor.Mz.absmax.vs.rod.mass.png"),
+        ("tornado", ("motor.Mz.range",), "out/tol.tornado.motor.Mz.range.png")]
     args.output = None                                  # beside the study's name, here
     assert str(planned_pictures(args, loaded, names)[0][2]) == "s.hist.slider.x.range.png"
     assert str(plots.picture_path("a", "hist", "Força 1/x.Fx.max")) == \
