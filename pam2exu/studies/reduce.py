@@ -68,7 +68,6 @@ REDUCTIONS = {"min": minimum, "max": maximum, "absmax": absmax, "mean": mean, "r
               "final": final, "range": spread}
 
 
-
 # ---- first order: ∂(reduction)/∂p from the series' ∂y/∂p (the linear method) -------------
 # Each takes y (n,) and dy = ∂y/∂p (n, P) and gives the reduction's derivative (P,). On the
 # rows of a run a max is a max over finitely many values: where it is attained at one row
