@@ -175,7 +175,7 @@ class Variation:
         t : float or array_like
             Times [s].
         reached : float
-            s, how far along the straight path u0 + s δ the fixed deviation is: 1 (its
+            s [–], how far along the straight path u0 + s δ the fixed deviation is: 1 (its
             value) at every time of the motion, 0 … 1 on the path at t = 0.
 
         Returns

@@ -149,7 +149,7 @@ def test_deviations_that_cannot_be_absorbed_are_a_row_in_error(tmp_path, capsys)
     assert rows[1]["pin2.jr.max"] == "" and float(rows[0]["pin2.jr.max"]) > 0
     assert "1 × SolverError: t=0: the clearance of least norm of" in out
     assert ("radial clearance for a 99 % yield: none is enough for pin2: 1 of 2 variants are "
-            "in error (more than 1 %)") in out
+            "in error, and the q99 over all of them falls among those") in out
 
 
 def test_variants_in_error_count_against_the_yield_of_a_clearance():
