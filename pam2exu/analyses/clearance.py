@@ -32,8 +32,9 @@ def clearance(job: Job):
     interval (shared/spec/clearance.md): the clearance of least norm as the dimensions of
     the ``[[variation]]`` entries and the command vary.
 
-    From the nominal assembly (j = 0, λ = 0, by the backend), the slides' ODE through the
-    times of the grid, each one corrected by Newton on the Lagrange conditions
+    From the nominal assembly (j = 0, λ = 0, by the backend), the fixed deviations of the
+    ``[[variation]]`` entries reached along the straight path of dimensions (``as_made``),
+    then the slides' ODE through the times of the grid, each one corrected by Newton on the Lagrange conditions
     (``least_norm.follow``). The conditions of applicability are checked at the start
     (``require_applicable``), the strict minimum at every output row
     (``require_strict_minimum``).
@@ -48,7 +49,8 @@ def clearance(job: Job):
     closures = Closures(mech, q0)
     p, nq, m = closures.p, closures.nq, closures.m
     t0 = float(job.times[0])
-    require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m)), t0)
+    # at the nominal dimensions (the fixed deviations not yet reached: ``as_made``)
+    require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m), reached=0.0), t0)
     job.stage = "following the clearance of least norm (the slides' ODE)"
     y0 = np.r_[np.zeros(p), q0, np.zeros(m)]
     if closures.as_made:
