@@ -53,7 +53,7 @@ def clearance(job: Job):
     require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m), reached=0.0), t0)
     job.stage = "following the clearance of least norm (the slides' ODE)"
     y0 = np.r_[np.zeros(p), q0, np.zeros(m)]
-    if closures.as_made:
+    if closures.has_fixed:
         job.stage = "following the clearance of least norm to the dimensions as made (t = 0)"
         y0 = as_made(closures, t0, y0)
     y, ok, stop = follow(closures.evaluate, time_rate(closures.evaluate, p, start=t0),
@@ -256,8 +256,9 @@ class Closures:
         return out
 
     @property
-    def as_made(self) -> bool:
-        """Some ``[[variation]]`` has a fixed deviation (``fixed_dx`` …) to reach at t = 0."""
+    def has_fixed(self) -> bool:
+        """Some ``[[variation]]`` has a fixed deviation (``fixed_dx`` …) to reach at t = 0
+        (``as_made``)."""
         return any(v.has_fixed for v in self.mech.variations)
 
     def at(self, t: float, reached: float = 1.0) -> list:
