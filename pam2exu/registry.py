@@ -193,6 +193,13 @@ class AnalysisType:
         return resolve(self.function)(job)
 
     @property
+    def parts_as_made(self) -> bool:
+        """A study gives it a variant's points and lines as fixed deviations from the nominal
+        dimensions (``[[variation]]`` ``fixed_dx`` …), reached from the nominal assembly:
+        it gives clearances (an over-constrained mechanism assembles only nominal)."""
+        return CLEARANCE in self.levels
+
+    @property
     def gives_forces(self) -> bool:
         """Its outputs include forces (reactions, actuators' forces and torques)."""
         return FORCE in self.levels
@@ -242,7 +249,8 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
                  at_start=False,
                  summary="the clearance of least norm of an over-constrained mechanism as "
                  "its dimensions vary",
-                 function="pam2exu.analyses.clearance:clearance", element_outputs=False),
+                 function="pam2exu.analyses.clearance:clearance", element_outputs=False,
+                 in_studies=True),
     AnalysisType("equilibrium", "equilibri", frozenset({POSITION, FORCE}), driven=False,
                  at_start=True,
                  summary="the free degrees of freedom in stable static equilibrium at t = 0",

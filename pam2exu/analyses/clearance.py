@@ -32,8 +32,9 @@ def clearance(job: Job):
     interval (shared/spec/clearance.md): the clearance of least norm as the dimensions of
     the ``[[variation]]`` entries and the command vary.
 
-    From the nominal assembly (j = 0, λ = 0, by the backend), the slides' ODE through the
-    times of the grid, each one corrected by Newton on the Lagrange conditions
+    From the nominal assembly (j = 0, λ = 0, by the backend), the fixed deviations of the
+    ``[[variation]]`` entries reached along the straight path of dimensions (``as_made``),
+    then the slides' ODE through the times of the grid, each one corrected by Newton on the Lagrange conditions
     (``least_norm.follow``). The conditions of applicability are checked at the start
     (``require_applicable``), the strict minimum at every output row
     (``require_strict_minimum``).
@@ -48,9 +49,13 @@ def clearance(job: Job):
     closures = Closures(mech, q0)
     p, nq, m = closures.p, closures.nq, closures.m
     t0 = float(job.times[0])
-    require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m)), t0)
+    # at the nominal dimensions (the fixed deviations not yet reached: ``as_made``)
+    require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m), reached=0.0), t0)
     job.stage = "following the clearance of least norm (the slides' ODE)"
     y0 = np.r_[np.zeros(p), q0, np.zeros(m)]
+    if closures.has_fixed:
+        job.stage = "following the clearance of least norm to the dimensions as made (t = 0)"
+        y0 = as_made(closures, t0, y0)
     y, ok, stop = follow(closures.evaluate, time_rate(closures.evaluate, p, start=t0),
                          job.times, y0, p, nq)
     job.stage = "checking the clearance is a strict minimum at every row"
@@ -71,6 +76,43 @@ def clearance(job: Job):
     if p:
         _warn_far_from_first_order(job, closures, y[:, :p], list(rows), mob.redundant > 0)
     return collect(job, y[:, p:p + nq], extra=closures.columns(y[:, :p]))
+
+
+#: the rows of the straight path u0 + s δ at t = 0 where Newton corrects the clearance
+#: followed (s = 0, 1/4, …, 1); the integrator steps as it needs between them
+PATH_ROWS = 4
+#: the step in s of the central differences of h_s on that path: h is linear in a point's
+#: δ and smooth in a line's, so a large step loses nothing, while 1e-6 (the time's, whose
+#: rates are O(1)) leaves round-off of O(1e-10) in rates of O(δ) that the integrator's
+#: error control chases (the locomotive, 3e-4 m deviations: 5.5 s at 1e-6, 1.0 s at 1e-3,
+#: the clearances equal to 2e-16)
+PATH_RATE_STEP = 1e-3
+
+
+def as_made(closures: "Closures", t0: float, y0: np.ndarray) -> np.ndarray:
+    """y = (j, q, λ) at t0 with the fixed deviations δ of the ``[[variation]]`` entries:
+    the slides' ODE along the straight path of dimensions u0 + s δ, s from 0 (the nominal
+    assembly y0) to 1, corrected by Newton at ``PATH_ROWS`` + 1 values of s, the clearance a
+    strict minimum at each; SolverError (``t=<t0>:``) where the deviations cannot be
+    absorbed so."""
+    def along(s, q, lam):
+        return closures.evaluate(t0, q, lam, reached=s)
+
+    p, nq = closures.p, closures.nq
+    path = np.linspace(0.0, 1.0, PATH_ROWS + 1)
+    y, ok, stop = follow(along, time_rate(along, p, step=PATH_RATE_STEP), path, y0, p, nq)
+    for k, s in enumerate(path):
+        at, there = (float(s), y[k]) if ok[k] else (stop.time, stop.y)
+        found = applicability(along(at, *split(there, p, nq)[1:]))
+        if not ok[k] or found.ratio_i <= RANK or found.hessian <= RANK:
+            raise SolverError(
+                f"t={t0:g}: the clearance of least norm of {source(closures)} cannot absorb "
+                f"the fixed deviations of its [[variation]] entries (fixed_dx, fixed_dy, "
+                f"fixed_dangle): followed from the nominal assembly along the straight path "
+                f"of dimensions u0 + s δ, it stops at s = {at:.4g} (of 0 … 1). There "
+                f"{_nearest_failure(found, closures)}. Try clearance = true on another joint "
+                f"of the loop, or smaller fixed deviations; no row is kept", time=t0, step=0)
+    return y[-1]
 
 
 def source(closures: "Closures") -> str:
@@ -213,16 +255,23 @@ class Closures:
             out.update({f"{el.name}.{name}": v for name, v in values.items()})
         return out
 
-    def at(self, t: float) -> list:
+    @property
+    def has_fixed(self) -> bool:
+        """Some ``[[variation]]`` has a fixed deviation (``fixed_dx`` …) to reach at t = 0
+        (``as_made``)."""
+        return any(v.has_fixed for v in self.mech.variations)
+
+    def at(self, t: float, reached: float = 1.0) -> list:
         """The constraint elements with their varied points and lines at time t (copies;
-        the elements whose anchors do not vary are the mechanism's own)."""
+        the elements whose anchors do not vary are the mechanism's own), the fixed
+        deviations ``reached`` of the way (``Variation.offsets``)."""
         out = []
         for el in self.mech.constraints:
             refs = list(el.refs)
             for k, ref in enumerate(refs):
                 variation = self.mech.variation(el, k)
                 if variation is not None:
-                    refs[k] = _moved(ref, variation.offsets(np.array([t]))[0][0])
+                    refs[k] = _moved(ref, variation.offsets(np.array([t]), reached)[0][0])
             if refs != list(el.refs):
                 el = copy.copy(el)
                 el.refs = tuple(refs)
@@ -230,13 +279,15 @@ class Closures:
             out.append(el)
         return out
 
-    def evaluate(self, t: float, q: np.ndarray, lam: np.ndarray) -> Closure:
-        """C (without F_j j), F_q, F_j and W = Σ λ_i ∂²F_i/∂q² at (t, q)."""
+    def evaluate(self, t: float, q: np.ndarray, lam: np.ndarray,
+                 reached: float = 1.0) -> Closure:
+        """C (without F_j j), F_q, F_j and W = Σ λ_i ∂²F_i/∂q² at (t, q), the fixed
+        deviations ``reached`` of the way."""
         st = State([t], np.asarray(q, dtype=float)[None], hessians=True)
         C = np.zeros(self.m)
         Fq = np.zeros((1, self.m, self.nq))
         W = np.zeros((1, self.nq, self.nq))
-        for el, rows in zip(self.at(t), self.mech.rows):
+        for el, rows in zip(self.at(t, reached), self.mech.rows):
             if el.clearance:
                 v, target = el.clearance_constraint(st, self.start)
             else:

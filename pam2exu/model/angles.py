@@ -61,10 +61,13 @@ def element_in_radians(element: Element) -> Element:
 
 
 def variation_in_radians(variation: Variation) -> Variation:
-    """A copy of a degrees variation with ``dangle`` in radians (ω stays rad/s)."""
+    """A copy of a degrees variation with ``dangle`` and ``fixed_dangle`` in radians (ω
+    stays rad/s)."""
     out = copy.copy(variation)
     if variation.dangle is not None:
         out.dangle = degrees_to_radians(variation.dangle)
+    if variation.fixed_dangle is not None:
+        out.fixed_dangle = degrees_to_radians(variation.fixed_dangle)
     return out
 
 

@@ -227,7 +227,8 @@ class Model:
             or give it as ``anchor=``).
         **keys
             The new variation's keys, as for ``Variation``: ``anchor``, ``dx``, ``dy`` [m],
-            ``dangle`` [rad], ``w``, ``wx``, ``wy``, ``wangle`` [rad/s], ``tau`` [s].
+            ``dangle`` [rad], ``w``, ``wx``, ``wy``, ``wangle`` [rad/s], ``tau`` [s],
+            ``fixed_dx``, ``fixed_dy`` [m], ``fixed_dangle`` [rad].
 
         Returns
         -------

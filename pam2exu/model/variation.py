@@ -1,6 +1,9 @@
 """Dimension variations (``[[variation]]``, shared/spec/clearance.md): a point's or a line's
 local dimensions u moving away from their nominal u0 along a ramped cosine, the path u(t) the
-clearance analysis follows. The other analyses ignore them (nominal dimensions)."""
+clearance analysis follows, on top of a fixed deviation δ (``fixed_dx``, ``fixed_dy``,
+``fixed_dangle``: the part as made, an extension of the contract) that the analysis reaches
+at t = 0 along the straight path u0 + s δ, s from 0 to 1. The other analyses ignore them
+(nominal dimensions)."""
 from __future__ import annotations
 
 import math
@@ -14,11 +17,13 @@ from ..limits import is_number
 from .solid import LineRef, PointRef, Scope, _table
 
 #: the keys of a [[variation]] table, in the contract's order
-KEYS = ("anchor", "dx", "dy", "dangle", "w", "wx", "wy", "wangle", "tau")
+KEYS = ("anchor", "dx", "dy", "dangle", "w", "wx", "wy", "wangle", "tau", "fixed_dx",
+        "fixed_dy", "fixed_dangle")
 #: the varied components, in the order of ``Variation.offsets``' columns: (name, Δ key,
-#: ω key, range, unit)
-COMPONENTS = (("x", "dx", "wx", limits.LENGTH, "m"), ("y", "dy", "wy", limits.LENGTH, "m"),
-              ("angle", "dangle", "wangle", limits.ANGLE, "rad"))
+#: ω key, range, unit, δ key)
+COMPONENTS = (("x", "dx", "wx", limits.LENGTH, "m", "fixed_dx"),
+              ("y", "dy", "wy", limits.LENGTH, "m", "fixed_dy"),
+              ("angle", "dangle", "wangle", limits.ANGLE, "rad", "fixed_dangle"))
 #: the most a variation's cos(ω t) may advance between two output rows, ω t_end/steps [rad]:
 #: at π the rows sample each period twice (the Nyquist limit); beyond it they alias the
 #: variation into a slower false one, and following it between rows is work for nothing
@@ -65,8 +70,9 @@ class Variation:
     """One ``[[variation]]``: a declared point or line whose local dimensions vary with time.
 
     Each component (the point's local x and y, or the line's defining point and angle)
-    follows u(t) = u0 + (1 − e^(−t/τ)) (Δ/2) cos(ω t) (``ramped_cosine``), wherever the
-    point or line is an anchor. Only the clearance analysis reads it. Usually made by
+    follows u(t) = u0 + δ + (1 − e^(−t/τ)) (Δ/2) cos(ω t) (``ramped_cosine``), wherever
+    the point or line is an anchor; the clearance analysis reaches the fixed deviation δ
+    at t = 0 along the straight path u0 + s δ, s from 0 to 1 (``offsets(t, reached=s)``). Only the clearance analysis reads it. Usually made by
     ``Model.add_variation`` or a ``[[variation]]`` table; values are checked by
     ``Model.problems``, not here.
 
@@ -85,6 +91,11 @@ class Variation:
         ω of one component [rad/s]; None: ``w``.
     tau : float
         τ, the time constant of the ramp [s], > 0.
+    fixed_dx, fixed_dy : float
+        δ, the fixed deviation of the point's local coordinates (of a line's defining
+        point) as made [m].
+    fixed_dangle : float
+        δ of a line's angle as made [rad] (lines only).
     position : int, optional
         1-based position in the model file's ``[[variation]]`` array, for messages (set
         by the loader, or by ``Model.add_variation``).
@@ -112,6 +123,9 @@ class Variation:
     wy: float | None = None
     wangle: float | None = None
     tau: float = 1.0
+    fixed_dx: float = 0.0
+    fixed_dy: float = 0.0
+    fixed_dangle: float = 0.0
     #: 1-based position in the file's [[variation]] array (set by the loader or the model)
     position: int | None = field(default=None, repr=False, kw_only=True)
 
@@ -142,13 +156,27 @@ class Variation:
         own = getattr(self, "w" + component)
         return float(self.w if own is None else own)
 
-    def offsets(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """u(t) − u0 and u'(t) of the components x [m], y [m], angle [rad].
+    @property
+    def fixed(self) -> np.ndarray:
+        """δ: the fixed deviations of x [m], y [m] and the angle [rad] (0 for a point)."""
+        return np.array([float(getattr(self, c[5])) for c in COMPONENTS])
+
+    @property
+    def has_fixed(self) -> bool:
+        """Some component has a fixed deviation δ ≠ 0."""
+        return bool(np.any(self.fixed != 0.0))
+
+    def offsets(self, t, reached: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """u(t) − u0 = s δ + (1 − e^(−t/τ)) (Δ/2) cos(ω t) and u'(t) of the components
+        x [m], y [m], angle [rad].
 
         Parameters
         ----------
         t : float or array_like
             Times [s].
+        reached : float
+            s [–], how far along the straight path u0 + s δ the fixed deviation is: 1 (its
+            value) at every time of the motion, 0 … 1 on the path at t = 0.
 
         Returns
         -------
@@ -161,7 +189,7 @@ class Variation:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         pairs = [ramped_cosine(t, float(getattr(self, key)), self.omega(name), float(self.tau))
                  for name, key, *_ in COMPONENTS]
-        return (np.stack([u for u, _ in pairs], axis=1),
+        return (reached * self.fixed + np.stack([u for u, _ in pairs], axis=1),
                 np.stack([du for _, du in pairs], axis=1))
 
     @property
@@ -202,6 +230,9 @@ class Variation:
         out = []
         for key, limit, unit in (("dx", limits.LENGTH, "m"), ("dy", limits.LENGTH, "m"),
                                  ("dangle", limits.ANGLE, "rad"), ("w", limits.VALUE, "rad/s"),
+                                 ("fixed_dx", limits.LENGTH, "m"),
+                                 ("fixed_dy", limits.LENGTH, "m"),
+                                 ("fixed_dangle", limits.ANGLE, "rad"),
                                  ("wx", limits.VALUE, "rad/s"), ("wy", limits.VALUE, "rad/s"),
                                  ("wangle", limits.VALUE, "rad/s")):
             value = getattr(self, key)
@@ -227,7 +258,7 @@ class Variation:
             return out + [str(exc)]
         if kind == "point":
             out += [f"'{key}' varies a line's angle, and '{self.anchor}' is a point: remove "
-                    f"'{key}', or vary a line" for key in ("dangle", "wangle")
+                    f"'{key}', or vary a line" for key in ("dangle", "wangle", "fixed_dangle")
                     if getattr(self, key) not in (None, 0, 0.0)]
         return out
 

@@ -7,6 +7,10 @@ A name is ``solid.P.x`` / ``solid.P.y`` (a declared point), ``solid.L.x`` / ``so
 1-based), ``element.T`` / ``element.C`` (a transmission's numbers) and ``model.gravity``.
 The values are in the model's units (a line's angle in degrees in a degrees model): they
 are written into the model as its file would give them, and converted as the model is.
+For a clearance study a point's or a line's value is instead its part as made: the
+deviation from the nominal value is written as the fixed deviation of the point's or line's
+``[[variation]]`` (``fixed_dx``, ``fixed_dy``, ``fixed_dangle``; ``write_deviation``),
+which the clearance analysis reaches from the nominal assembly.
 """
 from __future__ import annotations
 
@@ -159,7 +163,30 @@ def write(model: Model, target: Target, value: float) -> None:
         setattr(holder, item, value)
 
 
-def varied(text: str, values: dict[str, float], source: str = "<string>") -> Model:
+#: the fixed deviation's key of a point's or line's component (``Target.path``'s last item)
+FIXED_KEYS = {0: "fixed_dx", 1: "fixed_dy", "angle": "fixed_dangle"}
+
+
+def is_dimension(target: Target) -> bool:
+    """The target is a point's or a line's coordinate (what ``[[variation]]`` varies)."""
+    return target.path[0] in ("point", "line")
+
+
+def write_deviation(model: Model, target: Target, value: float) -> None:
+    """Add value − nominal to the fixed deviation of the ``[[variation]]`` of ``target``'s
+    point or line (a new entry when it has none): the dimension as made is ``value``,
+    reached from the nominal one by the clearance analysis."""
+    _, owner, item, k = target.path
+    anchor = f"{owner}.{item}"
+    entry = next((v for v in model.variations if v.anchor == anchor), None)
+    if entry is None:
+        entry = model.add_variation(anchor)
+    key = FIXED_KEYS[k]
+    setattr(entry, key, float(getattr(entry, key)) + (float(value) - target.nominal))
+
+
+def varied(text: str, values: dict[str, float], source: str = "<string>",
+           as_made: bool = False) -> Model:
     """The model of ``text`` with a variant's ``values`` written in (what a worker builds).
 
     Parameters
@@ -170,6 +197,9 @@ def varied(text: str, values: dict[str, float], source: str = "<string>") -> Mod
         The variant: parameter name (``targets``) to its value, in the model's units.
     source : str
         The model file's name, for messages.
+    as_made : bool
+        The points' and lines' values are parts as made: written as fixed deviations
+        (``write_deviation``, a clearance study), the nominal dimensions kept.
 
     Returns
     -------
@@ -187,6 +217,8 @@ def varied(text: str, values: dict[str, float], source: str = "<string>") -> Mod
     model = loads(text, source=source)
     found = targets(model)
     for name, value in values.items():
-        write(model, found[name], float(value))
+        target = found[name]
+        (write_deviation if as_made and is_dimension(target) else write)(model, target,
+                                                                          float(value))
     model.validate()
     return model

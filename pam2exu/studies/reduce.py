@@ -21,6 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..elements import ELEMENTS
 from ..errors import ModelError, Problem, closest
 from ..results.extremes import clearance_columns
 from ..results.names import select_columns
@@ -65,7 +66,6 @@ def spread(y: np.ndarray) -> float:
 #: the contract's order
 REDUCTIONS = {"min": minimum, "max": maximum, "absmax": absmax, "mean": mean, "rms": rms,
               "final": final, "range": spread}
-
 
 
 # ---- first order: ∂(reduction)/∂p from the series' ∂y/∂p (the linear method) -------------
@@ -114,6 +114,29 @@ FIRST_ORDER = {"min": d_minimum, "max": d_maximum, "absmax": d_absmax, "mean": d
                "rms": d_rms, "final": d_final, "range": d_spread}
 #: the reductions whose first-order σ is the summary's ``linear_std`` (the contract's)
 LINEAR_STD = ("final", "mean")
+
+
+#: a joint's radial clearance (a revolute's ``jr``), as the joints declare what derives
+#: from their clearance parameters (``Element.clearance_derived``)
+RADIAL = frozenset(v.name for cls in ELEMENTS.values() for v in cls.clearance_derived)
+
+
+def radial_clearances(reduced: list[str]) -> list[str]:
+    """The reduced outputs ``<joint>.jr.max`` among ``reduced``: the radial clearance each
+    variant needs over the motion, in order.
+
+    Examples
+    --------
+    >>> radial_clearances(["pin2.jx.max", "pin2.jr.max", "pin2.jr.mean", "pin3.jr.max"])
+    ['pin2.jr.max', 'pin3.jr.max']
+    """
+    out = []
+    for name in reduced:
+        column, _, reduction = name.rpartition(".")
+        if reduction == "max" and column.rpartition(".")[2] in RADIAL:
+            out.append(name)
+    return out
+
 
 STATUSES = ("ok", "rejected", "error")
 OK, REJECTED, ERROR = STATUSES

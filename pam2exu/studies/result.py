@@ -22,10 +22,10 @@ from ..errors import OutputError, PictureError
 from ..results.table_csv import csv_cells, csv_field
 from ..results.writers import optional, write_whole
 from . import plots
-from .reduce import ERROR, OK, REJECTED
+from .reduce import ERROR, OK, REJECTED, radial_clearances
 from .messages import WARNINGS, Group, report_lines, warning_groups
 from .series import series_path, write_csv
-from .summary import error_groups, summary, write_summary
+from .summary import CLEARANCE_YIELD, error_groups, needed_for_yield, summary, write_summary
 
 #: the per-variant table's file formats, by suffix
 STUDY_FORMATS = {".parquet": "Parquet", ".csv": "CSV"}
@@ -142,6 +142,25 @@ class StudyResult:
         row = self.summary[-1]
         ok = int(np.count_nonzero(self.table["status"] == OK))
         return Yield(row.mean, row.min, row.max, ok, row.count)
+
+    def clearance_needed(self, share: float = CLEARANCE_YIELD) -> dict[str, float]:
+        """The radial clearance each joint needs for the yield ``share`` (a clearance study).
+
+        Parameters
+        ----------
+        share : float
+            The yield [–], 0 … 1.
+
+        Returns
+        -------
+        dict of str to float
+            ``<joint>.jr.max`` → its quantile at ``share`` over every variant, one in error
+            counted as needing more than any (``summary.needed_for_yield``; +inf when those
+            in error reach into it) [m]; empty for a study without radial clearances.
+        """
+        t = self.table
+        return {name: needed_for_yield(t[name], t["status"], share)
+                for name in radial_clearances(self.outputs)}
 
     def errors(self) -> list[Group]:
         """The variants in error grouped by the kind of their error
@@ -335,6 +354,7 @@ class StudyResult:
         rejected = int(np.count_nonzero(self.table["status"] == REJECTED))
         failed = int(np.count_nonzero(self.table["status"] == ERROR))
         lines.append(f"rejected by the requirements: {rejected}; in error: {failed}")
+        lines += _clearance_lines(self.clearance_needed(), len(self), failed)
         lines += report_lines(self.errors(), "errors")
         warned = int(np.count_nonzero(self.warnings != ""))
         if warned:
@@ -361,6 +381,23 @@ def write_parquet(columns: dict, units: dict, path: str | Path) -> Path:
         fields.append(pa.field(name, kind, metadata={"unit": units.get(name, "")}))
     table = pa.Table.from_arrays(arrays, schema=pa.schema(fields))
     return write_whole(Path(path), lambda tmp: parquet.write_table(table, tmp))
+
+
+def _clearance_lines(needed: dict[str, float], count: int, failed: int) -> list[str]:
+    """The report's lines of a clearance study: the radial clearance each joint needs for a
+    99 % yield (``StudyResult.clearance_needed``)."""
+    head = f"radial clearance for a {CLEARANCE_YIELD * 100:.0f} % yield:"
+    over = (f"its q{CLEARANCE_YIELD * 100:.0f} over the {count} variants" if not failed else
+            f"over all {count} variants, the {failed} in error counted as needing more")
+    out = []
+    for name, value in needed.items():
+        joint = name.rsplit(".", 2)[0]
+        out.append(f"{head} {joint} needs {value:.4g} m ({name}, {over})"
+                   if np.isfinite(value) else
+                   f"{head} none is enough for {joint}: {failed} of {count} variants are in "
+                   f"error, and the q{CLEARANCE_YIELD * 100:.0f} over all of them falls among "
+                   f"those")
+    return out
 
 
 def _number(x: float) -> str:

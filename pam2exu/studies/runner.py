@@ -36,7 +36,8 @@ from .study import MAX_SAMPLES, SAMPLED, Study, load_study, too_many
 
 #: the analyses a study runs today, as the registry declares them (``in_studies``: each
 #: variant runs as a single run would, the equilibrium and dynamic analyses with the model's
-#: [analysis] tolerance; a clearance study follows its own dimension path: not yet)
+#: [analysis] tolerance, the clearance analysis from the nominal assembly to the parts as
+#: made: ``AnalysisType.parts_as_made``)
 STUDY_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.in_studies)
 #: the analyses the first-order method differentiates (``AnalysisType.first_order``)
 FIRST_ORDER_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.first_order)
@@ -67,7 +68,7 @@ def run_variant(payload: dict, values: np.ndarray):
         warnings.simplefilter("always")
         try:
             model = varied(payload["model_text"], dict(zip(payload["names"], values)),
-                           payload["source"])
+                           payload["source"], as_made=payload.get("as_made", False))
             res = run(model, payload["analysis"], t_end=payload["t_end"],
                       steps=payload["steps"], outputs=payload["outputs"])
             reduced = reduce_run(res, payload["outputs"], payload["reduce"])
@@ -128,12 +129,14 @@ def payload(study: Study, reduced: list[str]) -> dict:
             "requirements": [tuple(r) for r in study.requirements], "names": study.names,
             "reduced": reduced, "values": study.variants(),
             "series": series_rows(analysis_type(study.analysis).at_start, study.steps)
-            if study.series else None}
+            if study.series else None,
+            "as_made": analysis_type(study.analysis).parts_as_made}
 
 
 def prepared(study: Study, samples: int | None = None) -> Study:
     """The study as it will run (``samples`` overriding its own); ``ModelError`` naming the
-    entry for what a study cannot do today (a linear method, a clearance analysis)."""
+    entry for what a study cannot do today (a linear study of an analysis it cannot
+    differentiate)."""
     problems = []
     if study.method not in STUDY_METHODS:
         problems.append(Problem("[study]", f"method = '{study.method}' is not available yet: "
@@ -314,8 +317,9 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
     Raises
     ------
     ModelError
-        The study file has problems, asks what a study cannot do yet (``linear``,
-        ``clearance``), or its nominal model does not run; nothing is written.
+        The study file has problems, asks what a study cannot do (``linear`` of an
+        analysis it cannot differentiate), or its nominal model does not run; nothing is
+        written.
     OutputError
         ``out`` has an unknown suffix or needs a library that is not installed; ``resume``
         without ``out``.

@@ -8,6 +8,11 @@ study gives for a ``final`` or a ``mean`` reduction; empty for the others). Then
 ``yield``: ``count`` = every variant, ``mean`` = the share with status ok, ``min`` and
 ``max`` = its 95 % Wilson score interval (scipy's ``binomtest(...).proportion_ci``).
 
+What a clearance study answers, the clearance a yield needs (``needed_for_yield``): for a
+joint's ``jr.max`` the value q such that the share of every variant (those in error
+included: no clearance lets them assemble) needing at most q is the yield asked; at 99 %,
+the column's q99 when no variant is in error.
+
 A value that does not exist (a std of fewer than two values, the statistics of no value,
 the yield row's other fields, ``linear_std`` of another reduction) is NaN in Python and an
 empty field in the file.
@@ -74,6 +79,36 @@ def wilson_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[flo
     from scipy.stats import binomtest
     ci = binomtest(k, n).proportion_ci(confidence_level=confidence, method="wilson")
     return float(ci.low), float(ci.high)
+
+
+#: the yield a clearance study's report gives each joint's radial clearance for
+CLEARANCE_YIELD = 0.99
+
+
+def needed_for_yield(y, statuses, share: float = CLEARANCE_YIELD) -> float:
+    """The least value a bound ``max`` must allow for the share ``share`` of every variant:
+    the quantile of y at ``share`` (numpy's linear method, as the summary's q99) over all
+    the variants, one in error counted as +inf (no bound lets it pass); +inf when those in
+    error reach into the quantile, NaN for no variant.
+
+    Examples
+    --------
+    >>> needed_for_yield([1.0, 2.0, np.nan], ["ok", "ok", "error"], 0.5)
+    2.0
+    >>> needed_for_yield([1.0, 2.0, np.nan], ["ok", "ok", "error"], 0.99)
+    inf
+    """
+    statuses = np.asarray(statuses, dtype=str)
+    y = np.asarray(y, dtype=float)
+    if y.size == 0:
+        return np.nan
+    failed = statuses == ERROR
+    ordered = np.sort(np.where(failed, np.inf, y))
+    if not np.isfinite(ordered[int(np.ceil((y.size - 1) * share))]):
+        return np.inf
+    # the quantile reads only the order statistics either side of (n − 1) share, both
+    # finite: those in error, above them, may stand at any larger value
+    return float(np.quantile(np.where(failed, np.max(y[~failed]), y), share))
 
 
 def yield_row(statuses) -> SummaryRow:

@@ -153,6 +153,23 @@ def test_variation_defaults_are_the_contracts():
     assert (v.wx, v.wy, v.wangle) == (None, None, None)
     assert [v.omega(c) for c in ("x", "y", "angle")] == [1.0, 1.0, 1.0]
     assert v.position == 1 and v.where == "[[variation]] #1 (anchor 'ground.O')"
+    assert (v.fixed_dx, v.fixed_dy, v.fixed_dangle, v.has_fixed) == (0.0, 0.0, 0.0, False)
+
+
+def test_fixed_deviations_add_to_the_ramped_cosine_reached_on_the_straight_path():
+    """u(t) − u0 = s δ + (1 − e^(−t/τ)) (Δ/2) cos(ω t), s = 1 unless given (extension:
+    docs/clearance.md, 'Parts as made')."""
+    (v,) = loads(with_variation('anchor = "ground.rail"\nfixed_dx = 3e-4\nfixed_dangle = -0.02'
+                                '\ndy = 4e-3\nw = 2.0\ntau = 0.5')).variations
+    t = np.array([0.0, 0.7])
+    u, du = v.offsets(t)
+    ramp = -np.expm1(-t / 0.5) * 2e-3 * np.cos(2.0 * t)
+    np.testing.assert_allclose(u, np.column_stack([[3e-4] * 2, ramp, [-0.02] * 2]),
+                               rtol=1e-15, atol=0)
+    assert u[0].tolist() == [3e-4, 0.0, -0.02] and v.has_fixed
+    half, _ = v.offsets(t, reached=0.5)
+    np.testing.assert_allclose(half[0], [1.5e-4, 0.0, -0.01], rtol=1e-15, atol=0)
+    assert du[:, 0].tolist() == [0.0, 0.0]            # a fixed deviation does not move
 
 
 def test_variation_keys_from_toml_and_from_python_agree():
@@ -255,7 +272,7 @@ def test_a_line_varied_twice():
     assert "line 'ground.rail' is already varied by [[variation]] #1" in message
 
 
-@pytest.mark.parametrize("key", ["dangle", "wangle"])
+@pytest.mark.parametrize("key", ["dangle", "wangle", "fixed_dangle"])
 def test_an_angle_on_a_point(key):
     message = only_problem(with_variation(f'anchor = "crank.A"\n{key} = 0.1'))
     assert message == (f"[[variation]] #1 (anchor 'crank.A'): '{key}' varies a line's angle, "
@@ -312,6 +329,8 @@ def test_non_numbers_are_errors_each_named():
 @pytest.mark.parametrize("entry, words", [
     ("dx = 2e6", "'dx' = 2e+06 m is out of range: its magnitude must be at most 1e+06 m"),
     ("dangle = 1e8", "'dangle' = 1e+08 rad is out of range"),
+    ("fixed_dy = -2e6", "'fixed_dy' = -2e+06 m is out of range: its magnitude must be at most"),
+    ("fixed_dangle = 1e8", "'fixed_dangle' = 1e+08 rad is out of range"),
     ("w = -1e13", "'w' = -1e+13 rad/s is out of range"),
     ("tau = 1e10", "'tau' = 1e+10 s is out of range: it must lie between 1e-09 s and 1e+09 s")])
 def test_numbers_out_of_the_ranges_of_limits(entry, words):

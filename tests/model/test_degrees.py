@@ -154,10 +154,11 @@ def test_variation_dangle_in_degrees_and_its_frequency_in_rad_per_s(guides):
     m.angles = "deg"
     m["ground"].lines["rail"]["angle"] = 0.3 * TO_DEG
     m["slider"].lines["axis"]["angle"] = 0.2 * TO_DEG
-    m.add_variation("ground.rail", dy=1e-3, dangle=0.5, wangle=2.0)
+    m.add_variation("ground.rail", dy=1e-3, dangle=0.5, wangle=2.0, fixed_dangle=-0.25)
     mech = m.mechanism()
     v = mech.variations[0]
     assert (v.dangle, v.wangle, v.dy) == (pytest.approx(0.5 / TO_DEG, rel=1e-15), 2.0, 1e-3)
+    assert v.fixed_dangle == pytest.approx(-0.25 / TO_DEG, rel=1e-15)
     assert mech.solids[0].lines["rail"]["angle"] == pytest.approx(0.3, rel=1e-15)
     assert m.variations[0].dangle == 0.5
 

@@ -94,3 +94,31 @@ values = [1.62, 3.71]
 def test_a_variant_that_makes_the_model_invalid_is_a_model_error():
     with pytest.raises(pam2exu.ModelError, match="mass is negative"):
         varied(FOUR_BAR.read_text(), {"crank.mass": -0.1})
+
+
+def test_a_clearance_variant_writes_its_points_and_lines_as_fixed_deviations():
+    """as_made: a point's or line's value becomes value − nominal in the fixed deviation of
+    its [[variation]] (the model's own entry when it has one, a new one otherwise); the
+    nominal dimensions stay; other parameters are written as usual."""
+    text = (ROOT / "examples" / "clearance" / "locomotive.toml").read_text(encoding="utf-8")
+    model = varied(text, {"frame.O2.x": 1.5 + 2e-4, "frame.O2.y": -1e-4,
+                          "wheel2.A.x": 0.25 - 3e-4, "rod.mass": 7.0}, as_made=True)
+    assert model["frame"].points["O2"] == [1.5, 0.0] and model["wheel2"].points["A"] == [0.25, 0.0]
+    assert model["rod"].mass == 7.0
+    own = model.variations[0]                                        # frame.O2, the file's
+    assert (own.anchor, own.dx, own.fixed_dx, own.fixed_dy) == ("frame.O2", 3.7e-4,
+                                                                (1.5 + 2e-4) - 1.5, -1e-4)
+    new = model.variations[-1]
+    assert (new.anchor, new.fixed_dx, new.fixed_dy, new.position) == \
+        ("wheel2.A", (0.25 - 3e-4) - 0.25, 0.0, 3)
+    plain = varied(text, {"frame.O2.x": 1.5 + 2e-4})                 # the other analyses
+    assert plain["frame"].points["O2"][0] == 1.5 + 2e-4 and not plain.variations[0].has_fixed
+
+
+def test_a_line_angle_is_a_fixed_deviation_of_its_angle():
+    model = pam2exu.load(ROOT / "tests" / "data" / "every_element.toml")
+    nominal = targets(model)["ground.rail.angle"].nominal
+    text = (ROOT / "tests" / "data" / "every_element.toml").read_text(encoding="utf-8")
+    varied_model = varied(text, {"ground.rail.angle": nominal + 0.5}, as_made=True)
+    (v,) = [v for v in varied_model.variations if v.anchor == "ground.rail"]
+    assert v.fixed_dangle == (nominal + 0.5) - nominal and v.fixed_dx == 0.0

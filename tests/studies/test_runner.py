@@ -280,8 +280,6 @@ BAD = {  # (what to change in SLIDER_STUDY, a piece of the message that names th
     "samples absurdly large": (("samples = 3", "samples = 1000000000000"),
                                "[study]: samples = 1,000,000,000,000: more than a study runs "
                                "(at most 10,000,000;"),
-    "clearance": (('analysis = "kinetostatic"', 'analysis = "clearance"'),
-                  "analysis = 'clearance' is not available in a study yet"),
 }
 
 
