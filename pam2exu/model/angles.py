@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ..complex_step import scalar
 from ..elements import Element
 from ..errors import Problem, echo
 from ..limits import is_number
@@ -29,7 +30,7 @@ DEGREE = math.pi / 180.0
 
 def degrees_to_radians(value: float) -> float:
     """a [rad] = a [deg] · π/180."""
-    return float(value) * DEGREE
+    return scalar(value) * DEGREE
 
 
 def solid_in_radians(solid: Solid) -> Solid:

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ModelError, Pam2ExuError, Problem
 from ..results import Results
+from ..results.units import angle_factor, in_angles
 from . import plots
 from .parameters import targets, write
 from .reduce import (FIRST_ORDER, LINEAR_STD, OK, REDUCTIONS, reduced_name, status)
@@ -144,7 +145,9 @@ def sensitivities(study) -> Sensitivities:
     with warnings.catch_warnings():                  # the nominal run warned in ``nominal``
         warnings.simplefilter("ignore")
         res = run(model, study.analysis, t_end=study.t_end, steps=study.steps, outputs=wanted)
-    t, q = res.t, mech.coordinates(res)
+    t, q = res.t, mech.coordinates(in_angles(res, "rad"))    # the passes work in radians
+    # ∂y/∂p in the result's units: an angular output in degrees in a degrees model
+    factor = {c: angle_factor(job.units.get(c, ""), model.angles)[0] for c in job.columns}
     found = targets(model)
     derivative = {c: np.empty((len(t), len(study.names))) for c in job.columns}
     problems = []
@@ -159,10 +162,10 @@ def sensitivities(study) -> Sensitivities:
             problems.append(Problem(f"[[parameter]] '{name}'", str(exc)))
             continue
         for c in job.columns:
-            derivative[c][:, k] = d[c]
+            derivative[c][:, k] = d[c] * factor[c]
     if problems:
         raise ModelError(problems, study.source, kind="study")
-    units = {**{c: job.units.get(c, "") for c in job.columns},
+    units = {**{c: res.units.get(c, "") for c in job.columns},
              **{p.name: p.unit for p in study.parameters}}
     return Sensitivities(t, {c: np.array(res[c]) for c in job.columns}, derivative,
                          study.names, study.sigmas(), units)

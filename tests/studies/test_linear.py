@@ -188,3 +188,36 @@ tol = 1e-4
     with pytest.raises(pam2exu.ModelError, match=r"\[\[parameter\]\] 'crank3.A.x'.*cannot "
                                                  "vary in this over-constrained mechanism"):
         study(loads_study(text, source=str(tmp_path / "s.toml")))
+
+
+def test_a_degrees_model_differentiates_per_degree_in_degrees(tmp_path):
+    """A model in degrees: an angle parameter per degree, an angular output in degrees
+    (against central differences of whole runs of the degrees model)."""
+    from pam2exu.studies.parameters import varied
+    text = (EXAMPLES / "slider_crank.toml").read_text()
+    text = text.replace('name = "slider-crank"', 'name = "slider-crank"\nangles = "deg"')
+    text = text.replace("fi = -0.2", "fi = -11.459").replace(
+        "C = [0.0, 10.0, 0.0, 0.0]", "C = [0.0, 572.9577951308232, 0.0, 0.0]")
+    (tmp_path / "deg.toml").write_text(text)
+    (tmp_path / "s.toml").write_text("""
+[study]
+model = "deg.toml"
+analysis = "kinetostatic"
+steps = 6
+t_end = 0.3
+method = "linear"
+outputs = ["slider.x", "rod.fi", "motor.Mz"]
+reduce = ["final"]
+[[parameter]]
+name = "ground.rail.angle"
+distribution = "normal"
+tol = 0.1
+""")
+    result = study(tmp_path / "s.toml")
+    runs = [pam2exu.run(varied(text, {"ground.rail.angle": v}), "kinetostatic", steps=6,
+                        t_end=0.3) for v in (1e-4, -1e-4)]
+    assert result.results().units["rod.fi.d.ground.rail.angle"] == "deg/deg"
+    for c in ("slider.x", "rod.fi", "motor.Mz"):
+        fd = (runs[0][c] - runs[1][c]) / 2e-4
+        assert np.allclose(result.table[f"{c}.d.ground.rail.angle"], fd, rtol=1e-6,
+                           atol=1e-9 * np.max(np.abs(fd)))
