@@ -1,0 +1,59 @@
+"""The shipped sweep examples/studies/four_bar_coupler_sweep.toml (docs/studies.md, "A sweep
+of the four-bar's coupler length") against the four-bar's transmission angle in closed form.
+
+Reference, nothing from pam2exu: with crank a, coupler b, rocker c, ground d and crank angle
+θ, the law of cosines in the triangles (A, B, O4) and (O2, A, O4) gives the angle γ between
+coupler and rocker, cos γ = (b² + c² − a² − d² + 2ad cos θ) / (2bc); the transmission angle
+is its acute version, μ = arccos |cos γ|. The study's reductions are the min and max of μ
+over the rows θ_k = 2π k / steps.
+"""
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pam2exu.studies import load_study
+from pam2exu.studies.runner import study as run_study
+
+ROOT = Path(__file__).resolve().parents[2]
+SWEEP = ROOT / "examples" / "studies" / "four_bar_coupler_sweep.toml"
+#: examples/four_bar.toml: crank a, rocker c, ground d [m]; θ = 2π t
+A, C, D = 0.1, 0.3, 0.4
+#: few rows, 0 and π among them (where μ is extreme for this crank-rocker)
+STEPS = 6
+
+
+def transmission_angle(a, b, c, d, theta):
+    """μ = arccos |(b² + c² − a² − d² + 2ad cos θ) / (2bc)|: the four-bar's transmission
+    angle, acute."""
+    return np.arccos(np.abs((b * b + c * c - a * a - d * d + 2 * a * d * np.cos(theta))
+                            / (2 * b * c)))
+
+
+@pytest.fixture(scope="module")
+def sweep():
+    study = dataclasses.replace(load_study(SWEEP), steps=STEPS)
+    return study, run_study(study)
+
+
+def test_the_sweeps_transmission_angles_are_the_closed_forms(sweep):
+    study, result = sweep
+    theta = 2 * math.pi * np.arange(STEPS + 1) / STEPS
+    lengths = result.table["coupler.B.x"]
+    assert lengths.tolist() == study.parameters[0].values
+    assert set(result.table["status"]) <= {"ok", "rejected"}
+    for b, low, high in zip(lengths, result.table["coupler.transmission_angle.min"],
+                            result.table["coupler.transmission_angle.max"]):
+        mu = transmission_angle(A, b, C, D, theta)
+        assert abs(low - mu.min()) <= 1e-9 and abs(high - mu.max()) <= 1e-9, b
+
+
+def test_the_sweep_accepts_the_lengths_whose_angle_stays_above_40_degrees(sweep):
+    _, result = sweep
+    theta = 2 * math.pi * np.arange(STEPS + 1) / STEPS
+    expected = ["ok" if transmission_angle(A, b, C, D, theta).min() >= math.radians(40)
+                else "rejected" for b in result.table["coupler.B.x"]]
+    assert result.table["status"].tolist() == expected
+    assert expected.count("ok") == 5 and expected.count("rejected") == 3
