@@ -548,13 +548,14 @@ def plot_dynamic(path, measured):
     plt.close(fig)
 
 
-def replace_section(page: Path, lines: list[str]) -> None:
-    """Put ``lines`` (BEGIN … END) in place of the page's section 8, or at its end."""
+def replace_section(page: Path, lines: list[str], begin: str = BEGIN, end: str = END) -> None:
+    """Put ``lines`` (begin … end) in place of the page's section between those markers
+    (default section 8's), or at its end."""
     text = page.read_text(encoding="utf-8") if page.exists() else ""
     block = "\n".join(lines)
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
+    if begin in text and end in text:
+        head, rest = text.split(begin, 1)
+        _, tail = rest.split(end, 1)
         text = head + block + tail
     else:
         text = text.rstrip("\n") + ("\n\n" if text else "") + block + "\n"

@@ -58,6 +58,8 @@ class Plan:
     clearance_repeats: int = 3               # section 7: repeats of each clearance way
     dynamic_tolerances: tuple = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)   # section 8
     dynamic_repeats: int = 3                 # its repeats (one for a run over 20 s)
+    study_variants: int = 2000               # section 9: the four-bar study's variants
+    study_steps: int = 100                   # and each variant's steps
 
 
 FULL = Plan()
@@ -65,7 +67,8 @@ QUICK = Plan(steps=(1000,), big_steps=0, tolerances=(1e-6, 1e-13), repeats=2, bi
              compare_steps=(2000,), compare_repeats=5, chain_sizes=(1, 2, 4, 8),
              chain_steps=200, long_turns=10, long_steps=10000, backend_steps=5000,
              backend_repeats=1, memory_steps=20000, clearance_repeats=1,
-             dynamic_tolerances=(1e-4, 1e-6), dynamic_repeats=1)
+             dynamic_tolerances=(1e-4, 1e-6), dynamic_repeats=1, study_variants=40,
+             study_steps=20)
 
 
 # ---- timing --------------------------------------------------------------------------------

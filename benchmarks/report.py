@@ -14,6 +14,7 @@ from .cases import CHAIN, CHAIN_LAW, TWO_PI
 from .measure import DEFAULT_TOLERANCE, KINDS, fit_exponent, warning_summary
 from .clearance import clearance_section
 from .dynamics import dynamic_section
+from .studies import study_section
 from .report_backends import backends_section
 
 
@@ -75,10 +76,10 @@ def chain_fits(chain_rows):
 
 def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows, newton,
                  profiles, sections, elapsed, side=None, memory=None, clearance=None,
-                 dynamics=None):
+                 dynamics=None, studies=None):
     """Write performance.md; ``side`` and ``memory``: section 6 (backends.py), ``clearance``:
-    section 7 (clearance.py), ``dynamics``: section 8 (dynamics.py), each left out when
-    None."""
+    section 7 (clearance.py), ``dynamics``: section 8 (dynamics.py), ``studies``: section 9
+    (studies.py), each left out when None."""
     lines = []
     add = lines.append
     add("# Performance: speed against error")
@@ -111,6 +112,7 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         "written to a temporary directory")
     add("python benchmarks/dynamics.py                 # section 8 alone, replaced in "
         "place, and docs/img/dynamic_work_precision.png")
+    add("python benchmarks/studies.py                  # section 9 alone, replaced in place")
     add("```")
     add("")
     add("`--no-memory` leaves out the runs of a million steps in section 6 (about half a "
@@ -507,4 +509,6 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
         lines += clearance_section(clearance)
     if dynamics is not None:
         lines += dynamic_section(dynamics)
+    if studies is not None:
+        lines += study_section(studies)
     (out_dir / "performance.md").write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -32,6 +32,10 @@ What it measures (each section of docs/performance.md is one of these):
    AccuracyWarnings and failures, the faster backend per tolerance, scipy's DOP853 beside
    them (dynamics.py; ``python benchmarks/dynamics.py`` reruns this section alone and
    replaces it in docs/performance.md).
+9. Studies (issue 24): the four-bar's kinetostatic study of 2,000 variants × 100 steps in this
+   process, on 2 worker processes and on a Dask LocalCluster(2), variants per second and time
+   per variant-step, beside pylinkage's Monte-Carlo ``analyze_tolerance`` when it imports
+   (studies.py; ``python benchmarks/studies.py`` reruns this section alone).
 
 References (the top-level ``references`` package, shared with the tests; nothing comes from
 pam2exu). Kinematics: the closed forms of references/closed_form.py (``four_bar``, chained
@@ -45,7 +49,7 @@ Layout: this file is the command line and the order of the run. Measuring:
 cases.py (the mechanisms and their references), plain_exudyn.py (the hand-written Exudyn
 four-bar), measure.py (grids, timing, errors of one configuration), sections.py (the
 sections 1–5 above), backends.py (section 6), clearance.py (section 7), dynamics.py
-(section 8). Reporting: report.py (docs/performance.md),
+(section 8), studies.py (section 9). Reporting: report.py (docs/performance.md),
 report_backends.py (its section 6), plot.py (docs/img/work_precision.png). The file puts the repository root on ``sys.path`` so that
 ``benchmarks`` and ``references`` import from a clone (``python -m benchmarks.speed_vs_error``
 from the root does the same).
@@ -69,6 +73,7 @@ from benchmarks.measure import DEFAULT_TOLERANCE, FULL, QUICK, log, machine, run
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
 from benchmarks.plot import plot  # noqa: E402
 from benchmarks.report import write_report  # noqa: E402
+from benchmarks.studies import measure as measure_studies  # noqa: E402
 from benchmarks.sections import (AgainstPlain, chain, hard_cases, newton_grid,  # noqa: E402
                                  profile, work_precision)
 
@@ -136,12 +141,13 @@ def main(argv=None):
                                                  memory, plan)
     clearance = section("7. clearance: ODE against Newton", measure_clearance, plan)
     dynamics = section("8. dynamic: work against precision", measure_dynamics, plan)
+    studies = section("9. studies: variants per second", measure_studies, plan)
     elapsed = time.perf_counter() - start
     out_dir.mkdir(parents=True, exist_ok=True)
     plot(out_dir / "img" / "work_precision.png", grid, chain_rows, side)
     plot_dynamic(out_dir / "img" / "dynamic_work_precision.png", dynamics)
     write_report(out_dir, info, plan, args.quick, grid, hard, chain_rows, plain_rows, newton,
-                 profiles, sections, elapsed, side, peaks, clearance, dynamics)
+                 profiles, sections, elapsed, side, peaks, clearance, dynamics, studies)
     log(f"wrote {out_dir / 'performance.md'} and {out_dir / 'img' / 'work_precision.png'} "
         f"({elapsed / 60:.1f} minutes)")
 
