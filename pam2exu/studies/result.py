@@ -31,6 +31,8 @@ from .summary import CLEARANCE_YIELD, error_groups, needed_for_yield, summary, w
 STUDY_FORMATS = {".parquet": "Parquet", ".csv": "CSV"}
 #: the summary's columns the printed report shows
 SHOWN = ("count", "mean", "std", "min", "q05", "q50", "q95", "max")
+#: the variants of a grid study the printed report lists (a sweep's result is its rows)
+GRID_SHOWN = 50
 
 
 class Yield(NamedTuple):
@@ -334,7 +336,8 @@ class StudyResult:
 
     def report(self) -> str:
         """The printed form: the summary table, the yield, the variants in error and those
-        that warned, grouped by the kind of their message (``messages.report_lines``)."""
+        that warned, grouped by the kind of their message (``messages.report_lines``); for a
+        grid study, then its variants (``grid_lines``)."""
         s = self.study
         lines = [f"study of {os.path.normpath(s.model_path)}: {s.analysis}, {len(self)} variants "
                  f"({s.method}{f', seed {s.seed}' if s.method != 'grid' else ''}), "
@@ -360,6 +363,8 @@ class StudyResult:
         if warned:
             lines.append(f"variants that warned: {warned} of {len(self)}")
             lines += report_lines(self.warning_groups(), "warnings")
+        if s.method == "grid":
+            lines += grid_lines(self.table, self.parameters + self.outputs)
         return "\n".join(lines)
 
     def __str__(self) -> str:
@@ -398,6 +403,22 @@ def _clearance_lines(needed: dict[str, float], count: int, failed: int) -> list[
                    f"error, and the q{CLEARANCE_YIELD * 100:.0f} over all of them falls among "
                    f"those")
     return out
+
+
+def grid_lines(table: dict, columns: list[str], shown: int = GRID_SHOWN) -> list[str]:
+    """A grid study's variants, one line each (the first ``shown``): sample, status, the
+    parameters' values and the reduced outputs (empty for a variant in error)."""
+    widths = [max(11, len(c)) for c in columns]
+    lines = ["  ".join(["sample", f"{'status':<8}", *(f"{c:>{w}}" for c, w in zip(columns,
+                                                                                 widths))])]
+    n = len(table["sample"])
+    for i in range(min(n, shown)):
+        cells = [_number(float(table[c][i])).rjust(w) for c, w in zip(columns, widths)]
+        lines.append("  ".join([f"{table['sample'][i]:>6d}", f"{table['status'][i]:<8}",
+                                *cells]))
+    if n > shown:
+        lines.append(f"… and the other {n - shown} of the {n} variants (-o OUT writes them all)")
+    return lines
 
 
 def _number(x: float) -> str:

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from pam2exu.studies import load_study
+from pam2exu.studies.result import grid_lines
 from pam2exu.studies.runner import study as run_study
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -57,3 +58,29 @@ def test_the_sweep_accepts_the_lengths_whose_angle_stays_above_40_degrees(sweep)
                 else "rejected" for b in result.table["coupler.B.x"]]
     assert result.table["status"].tolist() == expected
     assert expected.count("ok") == 5 and expected.count("rejected") == 3
+
+
+def test_a_grid_study_prints_each_variant_with_its_values(sweep):
+    _, result = sweep
+    lines = result.report().splitlines()
+    head = next(k for k, line in enumerate(lines) if line.startswith("sample "))
+    assert lines[head].split() == ["sample", "status", "coupler.B.x",
+                                   "coupler.transmission_angle.min",
+                                   "coupler.transmission_angle.max"]
+    rows = [line.split() for line in lines[head + 1:]]
+    table = result.table
+    assert [int(r[0]) for r in rows] == table["sample"].tolist()
+    assert [r[1] for r in rows] == table["status"].tolist()
+    for k, name in enumerate(("coupler.B.x", "coupler.transmission_angle.min",
+                              "coupler.transmission_angle.max"), start=2):
+        assert np.allclose([float(r[k]) for r in rows], table[name], rtol=5e-5, atol=0)
+
+
+def test_grid_lines_leave_an_error_rows_outputs_empty_and_count_the_rest():
+    table = {"sample": np.arange(3), "status": np.array(["ok", "error", "rejected"]),
+             "p": np.array([1.0, 2.0, 3.0]), "y.min": np.array([0.5, np.nan, 0.25])}
+    lines = grid_lines(table, ["p", "y.min"], shown=2)
+    assert [line.split() for line in lines[1:3]] == [["0", "ok", "1", "0.5"],
+                                                     ["1", "error", "2"]]
+    assert lines[3] == "… and the other 1 of the 3 variants (-o OUT writes them all)"
+    assert len(grid_lines(table, ["p", "y.min"])) == 4
