@@ -51,7 +51,7 @@ def command(args, warnings) -> int:
     from ..console import UsageError
     from ..studies.result import summary_path
     from ..studies.series import series_path
-    from ..studies.execute import open_executor
+    from ..studies.execute import open_executor, workers_of
     from ..studies.runner import checked, run_checked
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be ≥ 1, got {args.workers}")
@@ -63,8 +63,9 @@ def command(args, warnings) -> int:
     pictures = planned_pictures(args, run_as, names)
     workers = args.dask_local or args.workers or os.cpu_count() or 1
     with open_executor(args.workers, args.dask, args.dask_local) as executor:
-        result = run_checked(run_as, names, units, out, executor, args.resume, workers,
-                             progress=True, first_order=bool(args.tornado))
+        result = run_checked(run_as, names, units, out, executor, args.resume,
+                             workers_of(executor, workers), progress=True,
+                             first_order=bool(args.tornado))
     print(result.report())
     if args.output:
         print(f"wrote {len(result)} {result.ROWS} to {args.output} and the summary to "

@@ -103,6 +103,15 @@ def is_dask_client(executor) -> bool:
     return distributed is not None and isinstance(executor, distributed.Client)
 
 
+def workers_of(executor, default: int) -> int:
+    """The processes that run chunks at once on ``executor``: for a Dask client its
+    cluster's threads (``Client.nthreads``, summed over the workers connected now), else
+    ``default`` (a pool's size, or this process)."""
+    if is_dask_client(executor):
+        return max(1, sum(executor.nthreads().values()))
+    return default
+
+
 @contextlib.contextmanager
 def open_executor(workers: int | None = None, dask: str | None = None,
                   dask_local: int | None = None, retries: int = RETRIES):

@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import (InputWarning, ModelError, OutputError, Pam2ExuError, Problem,
                       warn_outside)
 from ..registry import ANALYSES, analysis_type
-from .execute import open_executor, run_chunks
+from .execute import open_executor, run_chunks, workers_of
 from .messages import WARNINGS, kind
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
@@ -300,7 +300,9 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
     samples : int, optional
         The number of variants, instead of the study's (sampled methods).
     workers : int, optional
-        Local worker processes (default 1: this process).
+        Local worker processes (default 1: this process); with ``executor``, the processes
+        it runs at once, for the chunks' size (default: a Dask cluster's threads, else the
+        cores).
     progress : bool
         A progress bar on a terminal (variants done, rate, time left).
     first_order : bool
@@ -338,7 +340,8 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
     run_as, names, units, out = checked(study_or_path, out, resume, samples)
     if executor is not None:
         return run_checked(run_as, names, units, out, executor, resume,
-                           workers or os.cpu_count() or 1, progress, first_order)
+                           workers or workers_of(executor, os.cpu_count() or 1), progress,
+                           first_order)
     with open_executor(workers or 1) as pool:
         return run_checked(run_as, names, units, out, pool, resume, workers or 1, progress,
                            first_order)

@@ -19,7 +19,7 @@ import pytest
 
 from pam2exu.errors import OutputError
 from pam2exu.studies import execute, parts
-from pam2exu.studies.execute import ChunkError, open_executor, run_chunks
+from pam2exu.studies.execute import ChunkError, open_executor, run_chunks, workers_of
 from pam2exu.studies.parts import part_files, part_path, plan_chunks
 
 ROWS = 23
@@ -109,6 +109,18 @@ def test_in_process_a_pool_and_dask_give_the_same_bytes(tmp_path, payload, clust
             assert (part_path(tmp_path / folder, start, stop).read_bytes()
                     == part_path(tmp_path / "a.parts", start, stop).read_bytes())
     assert len(calls(payload)) == 3 * len(CHUNKS) + 2
+
+
+def test_the_chunks_of_a_dask_cluster_are_sized_for_its_workers_not_this_machines(cluster):
+    """A study sent to a cluster of several machines (``--dask ADDRESS``) is cut for the
+    cluster's worker processes (they were this machine's cores: too few chunks to keep a
+    larger cluster busy)."""
+    with open_executor(dask=cluster.scheduler_address) as client:
+        assert workers_of(client, 64) == 2            # two single-threaded workers
+    assert workers_of(None, 3) == 3
+    with ThreadPoolExecutor(5) as pool:
+        assert workers_of(pool, 5) == 5
+    assert len(plan_chunks(1000, 0.05, 2)) == 8 < len(plan_chunks(1000, 0.05, 64)) == 50
 
 
 def test_resume_computes_only_the_missing_and_unreadable_parts(tmp_path, payload):
