@@ -1,6 +1,6 @@
 """Speed against error of pam2exu, measured in one run; writes docs/performance.md.
 
-    python benchmarks/speed_vs_error.py            # full run (about 5 minutes on 2 cores)
+    python benchmarks/speed_vs_error.py            # full run (about 8 minutes on 2 cores)
     python benchmarks/speed_vs_error.py --quick    # smoke test (under a minute), written to
                                                    # a temporary directory, not to docs/
     python benchmarks/speed_vs_error.py --no-memory   # without section 6's million-step runs

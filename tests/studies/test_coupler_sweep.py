@@ -9,6 +9,7 @@ over the rows θ_k = 2π k / steps.
 """
 import dataclasses
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -84,3 +85,12 @@ def test_grid_lines_leave_an_error_rows_outputs_empty_and_count_the_rest():
                                                      ["1", "error", "2"]]
     assert lines[3] == "… and the other 1 of the 3 variants (-o OUT writes them all)"
     assert len(grid_lines(table, ["p", "y.min"])) == 4
+
+
+def test_the_docs_show_the_shipped_sweep_file():
+    """docs/studies.md shows the file as shipped (its opening comment aside)."""
+    page = (ROOT / "docs" / "studies.md").read_text(encoding="utf-8")
+    shown = re.search(r"```toml\n(\[study\]\nmodel = \"\.\./four_bar\.toml\".*?)```", page,
+                      re.S).group(1)
+    text = SWEEP.read_text(encoding="utf-8")
+    assert shown == text[text.index("[study]"):]
