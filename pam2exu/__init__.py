@@ -212,7 +212,9 @@ def study(study_or_path, executor=None, out=None, resume=False, samples=None, wo
     samples : int, optional
         The number of variants, instead of the study's (sampled methods).
     workers : int, optional
-        Local worker processes (default 1).
+        Local worker processes (default 1); with an ``executor``, the processes it runs at
+        once, for the chunks' size (default: a Dask cluster's worker threads, else the
+        cores).
     progress : bool
         A progress bar on a terminal (variants done, rate, time left).
 
