@@ -58,7 +58,7 @@ from pam2exu.studies.reduce import reduce_run  # noqa: E402
 from pam2exu.studies.runner import study as run_study  # noqa: E402
 
 from benchmarks.dynamics import replace_section  # noqa: E402
-from benchmarks.measure import FULL, QUICK, ROOT, best_of, log, machine  # noqa: E402
+from benchmarks.measure import FULL, QUICK, ROOT, log, machine  # noqa: E402
 
 BEGIN = ("<!-- section 9: written by benchmarks/studies.py (python benchmarks/studies.py "
          "rewrites it alone) -->")
@@ -103,6 +103,7 @@ class ExecutorRow:
     workers: int = 1
     dask: bool = False
     seconds: float = math.nan        # the study, the executor running
+    cpu: float = math.nan            # this process's CPU time meanwhile
     start: float = math.nan          # asking for the executor until it is there
     stop: float = math.nan           # closing it
     ok: int = 0
@@ -118,6 +119,10 @@ class ExecutorRow:
     def us_per_variant_step(self) -> float:
         return 1e6 * self.seconds / (self.variants * self.steps)
 
+    @property
+    def cpu_us_per_variant_step(self) -> float:
+        return 1e6 * self.cpu / (self.variants * self.steps)
+
 
 @dataclass
 class PylinkageRow:
@@ -127,6 +132,11 @@ class PylinkageRow:
     samples: int
     seconds: float
     version: str | None = None
+    cpu: float = math.nan            # this process's CPU time, the best of the repeats
+
+    @property
+    def cpu_us_per_sample_step(self) -> float:
+        return 1e6 * self.cpu / (self.samples * self.steps)
 
     @property
     def per_second(self) -> float:
@@ -153,6 +163,21 @@ def the_study(variants: int, steps: int):
                        source="benchmarks/studies.py", folder=ROOT / "examples")
 
 
+def best_cpu_of(fn, repeats):
+    """(least CPU time of this process [s], least wall time [s], the result of the run of
+    least CPU time) over ``repeats`` calls of fn(): CPU time is what a machine busy with
+    other work changes least."""
+    cpu, wall, out = math.inf, math.inf, None
+    for _ in range(repeats):
+        c0, w0 = time.process_time(), time.perf_counter()
+        value = fn()
+        c1, w1 = time.process_time(), time.perf_counter()
+        wall = min(wall, w1 - w0)
+        if c1 - c0 < cpu:
+            cpu, out = c1 - c0, value
+    return cpu, wall, out
+
+
 def load_average() -> float:
     try:
         return os.getloadavg()[0]
@@ -174,9 +199,9 @@ def run_on(label: str, workers: int, dask_local: int | None, study, reference=No
     try:
         begin = time.perf_counter()
         with open_executor(workers, dask_local=dask_local) as executor:
-            ready = time.perf_counter()
+            ready, cpu = time.perf_counter(), time.process_time()
             result = run_study(study, executor=executor, workers=workers)
-            done = time.perf_counter()
+            done, row.cpu = time.perf_counter(), time.process_time() - cpu
         row.start, row.seconds, row.stop = ready - begin, done - ready, time.perf_counter() - done
         table = result.table
         row.ok = int(np.sum(table["status"] == "ok"))
@@ -196,27 +221,31 @@ def same_table(a: dict, b: dict) -> bool:
 
 
 def anatomy(study) -> dict:
-    """Seconds of one variant's parts, each the best of ANATOMY_REPEATS in this process: the
-    model built from its text with the variant's values, a run of it (and of LONGER times
-    its steps: the cost per step and the fixed cost of a run), the reduction."""
+    """CPU seconds of one variant's parts, each the least of ANATOMY_REPEATS in this
+    process: the model built from its text with the variant's values, a run of it (and of
+    LONGER times its steps: the cost per step and the fixed cost of a run), the reduction;
+    and Exudyn's share of the run's wall time (``res.info["backend_seconds"]``)."""
     values = dict(zip(study.names, study.variants(0, 1)[0]))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model_s, model = best_of(lambda: varied(study.model_text, values, "benchmark"),
-                                 ANATOMY_REPEATS)
+        model_s, _, model = best_cpu_of(lambda: varied(study.model_text, values,
+                                                       "benchmark"), ANATOMY_REPEATS)
 
         def fresh(steps):
             """A run of a model built anew (as each variant is), less the building."""
-            seconds, res = best_of(lambda: run(varied(study.model_text, values, "benchmark"),
-                                               study.analysis, t_end=study.t_end, steps=steps,
-                                               outputs=study.outputs), ANATOMY_REPEATS)
-            return seconds - model_s, res
-        run_s, res = fresh(study.steps)
-        long_s, _ = fresh(LONGER * study.steps)
-    reduce_s, _ = best_of(lambda: reduce_run(res, study.outputs, study.reduce),
-                          ANATOMY_REPEATS)
+            def once():
+                start = time.perf_counter()
+                res = run(varied(study.model_text, values, "benchmark"), study.analysis,
+                          t_end=study.t_end, steps=steps, outputs=study.outputs)
+                return res, time.perf_counter() - start
+            seconds, _, (res, wall) = best_cpu_of(once, ANATOMY_REPEATS)
+            return seconds - model_s, res, wall
+        run_s, res, wall = fresh(study.steps)
+        long_s, _, _ = fresh(LONGER * study.steps)
+    reduce_s, _, _ = best_cpu_of(lambda: reduce_run(res, study.outputs, study.reduce),
+                                 ANATOMY_REPEATS)
     per_step = (long_s - run_s) / ((LONGER - 1) * study.steps)
-    return {"model": model_s, "run": run_s, "exudyn": res.info["backend_seconds"],
+    return {"model": model_s, "run": run_s, "exudyn_share": res.info["backend_seconds"] / wall,
             "reduce": reduce_s, "per_step": per_step, "fixed": run_s - study.steps * per_step}
 
 
@@ -249,11 +278,11 @@ def pylinkage_rows(samples: int, steps_list) -> tuple[list, str]:
     rows = []
     for steps in steps_list:
         linkage, names = pylinkage_four_bar(steps)
-        seconds, analysis = best_of(lambda: analyze_tolerance(
+        cpu, seconds, analysis = best_cpu_of(lambda: analyze_tolerance(
             linkage, {n: TOL for n in names}, iterations=steps, n_samples=samples, seed=1),
             PYLINKAGE_REPEATS)
         assert analysis.output_cloud.shape == (samples, steps, 2), analysis.output_cloud.shape
-        rows.append(PylinkageRow(steps, samples, seconds, version))
+        rows.append(PylinkageRow(steps, samples, seconds, version, cpu))
     return rows, f"pylinkage {version}, measured in this run"
 
 
@@ -267,19 +296,22 @@ def measure(plan, variants: int | None = None, steps: int | None = None) -> Meas
         "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         **machine()})
     out.anatomy = anatomy(study)
-    log(f"  one variant: " + ", ".join(f"{k} {1e3 * v:.2f} ms" for k, v in out.anatomy.items()))
+    log("  one variant: " + ", ".join(f"{k} {v:.0%}" if k.endswith("share") else
+                                     f"{k} {1e3 * v:.2f} ms" for k, v in out.anatomy.items()))
     reference = None
     for label, workers, dask_local in EXECUTORS:
         row, table = run_on(label, workers, dask_local, study, reference)
         reference = table if reference is None else reference
         out.rows.append(row)
         log(f"  {label}: " + (row.failure or f"{row.seconds:.1f} s, {row.per_second:.1f} "
-                              f"variants/s, {row.us_per_variant_step:.0f} µs/variant-step, "
+                              f"variants/s, {row.us_per_variant_step:.0f} µs/variant-step "
+                              f"(CPU here {row.cpu_us_per_variant_step:.0f}), "
                               f"start {row.start:.1f} s, identical {row.identical}"))
     out.pylinkage, out.pylinkage_note = pylinkage_rows(variants, sorted({steps, 20}))
     for r in out.pylinkage:
         log(f"  pylinkage {r.version or '(quoted)'} {r.steps} steps: {r.per_second:.0f} "
-            f"samples/s, {r.us_per_sample_step:.1f} µs/sample-step")
+            f"samples/s, {r.us_per_sample_step:.1f} µs/sample-step (CPU "
+            f"{r.cpu_us_per_sample_step:.1f})")
     return out
 
 
@@ -309,9 +341,12 @@ def study_section(m: Measured) -> list[str]:
         "written and merged), *start* and *stop* the executor's own (a process pool starts "
         "its processes lazily, inside the study; a Dask `LocalCluster` of single-threaded "
         "worker processes before it). Variants per second and time per variant-step "
-        "(study / (variants × steps)) are the study's. Beside them, pylinkage's Monte-Carlo "
+        "(study / (variants × steps)) are the study's. *CPU here* is the CPU time of the "
+        "benchmark's own process meanwhile: all the work in-process, only the client's share "
+        "(sending chunks, writing parts, merging) with workers; it is what a machine busy "
+        "with other work changes least. Beside them, pylinkage's Monte-Carlo "
         "`analyze_tolerance` on the same four-bar and the same three tolerances (best of "
-        f"{PYLINKAGE_REPEATS}): {m.pylinkage_note}.")
+        f"{PYLINKAGE_REPEATS}, in this process): {m.pylinkage_note}.")
     add("")
     add(f"Measured {info.get('date', '')} on {info.get('CPU', '')} ({info.get('cores', '')} "
         f"cores, a shared virtual machine), Python {info.get('Python', '')}, Exudyn "
@@ -322,39 +357,39 @@ def study_section(m: Measured) -> list[str]:
     rows = []
     for r in m.rows:
         if r.failure:
-            rows.append([r.executor, f"{r.variants:,} × {r.steps}", "failed: " + r.failure,
-                         "", "", "", "", "", "", ""])
+            rows.append([r.executor, f"{r.variants:,} × {r.steps}", "failed: " + r.failure]
+                        + [""] * 9)
             continue
         rows.append([r.executor, f"{r.variants:,} × {r.steps}", f"{r.seconds:.1f}",
                      f"{r.per_second:.1f}", f"{r.us_per_variant_step:.0f}",
-                     f"{r.per_second / base.per_second:.2f}×",
+                     f"{r.per_second / base.per_second:.2f}×", f"{r.cpu:.1f}",
+                     f"{r.cpu_us_per_variant_step:.0f}",
                      f"{r.start:.1f}" if r.workers == 1 or r.dask else "in the study",
-                     f"{r.stop:.1f}", _yes(r.identical),
-                     " / ".join(f"{x:.1f}" for x in r.load)])
+                     f"{r.stop:.1f}", _yes(r.identical) + " / "
+                     + " / ".join(f"{x:.1f}" for x in r.load)])
     for p in m.pylinkage:
         name = f"pylinkage {p.version} `analyze_tolerance`" if p.version else \
             "pylinkage `analyze_tolerance` (quoted, not measured)"
         rows.append([name, f"{p.samples:,} × {p.steps}", f"{p.seconds:.2f}",
-                     f"{p.per_second:,.0f}", f"{p.us_per_sample_step:.1f}", "", "", "", "",
+                     f"{p.per_second:,.0f}", f"{p.us_per_sample_step:.1f}", "",
+                     "" if math.isnan(p.cpu) else f"{p.cpu:.2f}",
+                     "" if math.isnan(p.cpu) else f"{p.cpu_us_per_sample_step:.1f}", "", "",
                      ""])
     lines += _table(["executor", "variants × steps", "study [s]", "variants/s",
-                     "µs per variant-step", "against in-process", "start [s]", "stop [s]",
-                     "table bit-identical to in-process", "load average before / after"],
-                    rows)
+                     "µs per variant-step", "against in-process", "CPU here [s]",
+                     "CPU here, µs per variant-step", "start [s]", "stop [s]",
+                     "table bit-identical to in-process / load average before / after"], rows)
     add("")
     same = next((p for p in m.pylinkage if p.steps == m.steps), None)
-    done = [r for r in m.rows if r.failure is None]
     text = ""
-    if base is not None and same is not None:
-        best = max(done, key=lambda r: r.per_second)
-        text = (f"Against pylinkage at the same {m.steps} steps"
-                + ("" if same.version else " (its quoted figure)")
-                + f": pam2exu in-process runs {base.per_second:.1f} variants/s against "
-                  f"{same.per_second:,.0f} samples/s, {same.per_second / base.per_second:.0f}× "
-                  f"fewer; its best executor here ({best.executor}) {best.per_second:.1f}, "
-                  f"{same.per_second / best.per_second:.0f}× fewer; per step "
-                  f"{base.us_per_variant_step:.0f} µs against {same.us_per_sample_step:.1f} "
-                  "µs. ")
+    if base is not None and same is not None and same.version:
+        text = (f"Against pylinkage at the same {m.steps} steps, both in this process: per "
+                f"step {base.cpu_us_per_variant_step:.0f} µs of CPU against "
+                f"{same.cpu_us_per_sample_step:.1f}, "
+                f"{base.cpu_us_per_variant_step / same.cpu_us_per_sample_step:.0f}× more "
+                f"(wall time: {base.per_second:.1f} variants/s against "
+                f"{same.per_second:,.0f} samples/s, "
+                f"{same.per_second / base.per_second:.0f}× fewer). ")
     elif base is not None and m.pylinkage:
         p = m.pylinkage[0]
         text = (f"Against pylinkage's quoted {p.per_second:,.0f} samples/s of {p.steps} steps "
@@ -370,22 +405,26 @@ def study_section(m: Measured) -> list[str]:
     if a and base is not None:
         alone = a["model"] + a["run"] + a["reduce"]
         add("")
-        add(f"Where a variant's time goes (one variant alone, best of {ANATOMY_REPEATS} in "
-            f"this process): the model from its text with the variant's values "
-            f"{1e3 * a['model']:.1f} ms, the run {1e3 * a['run']:.1f} ms (of which Exudyn, "
-            f"building and solving its system, {1e3 * a['exudyn']:.1f} ms; the rest is "
-            f"pam2exu's native pass and checks), the reduction {1e3 * a['reduce']:.2f} ms: "
-            f"{1e3 * alone:.1f} ms, against {1e3 / base.per_second:.1f} ms per variant in the "
-            f"in-process study. From a second run of {LONGER} × {m.steps} steps, a run "
-            f"costs {1e3 * a['fixed']:.1f} ms whatever its steps (building the mechanism and "
-            f"its Exudyn system, assembling, the checks) and {1e6 * a['per_step']:.0f} µs per "
+        add(f"Where a variant's time goes (one variant alone, the least CPU time of "
+            f"{ANATOMY_REPEATS} in this process): the model from its text with the variant's "
+            f"values {1e3 * a['model']:.1f} ms, the run {1e3 * a['run']:.1f} ms (Exudyn, "
+            f"building and solving its system, {a['exudyn_share']:.0%} of its wall time; the "
+            f"rest is pam2exu's native pass and checks), the reduction "
+            f"{1e3 * a['reduce']:.2f} ms: {1e3 * alone:.1f} ms, against "
+            f"{1e3 * base.cpu / base.variants:.1f} ms of CPU per variant in the in-process "
+            f"study. From a second run of {LONGER} × {m.steps} steps, a run costs "
+            f"{1e3 * a['fixed']:.1f} ms whatever its steps (building the mechanism and its "
+            f"Exudyn system, assembling, the checks) and {1e6 * a['per_step']:.0f} µs per "
             f"step: {a['fixed'] / a['run']:.0%} of a {m.steps}-step variant's run is that "
             "fixed cost, and the place to gain.")
-    slow = [r for r in done if r.load and max(r.load) > 0.5 * float(info.get("cores") or 1)]
-    if slow:
+    cores = float(info.get("cores") or 1)
+    busy = [x for r in m.rows for x in r.load if x == x]
+    if busy and max(busy) > 0.5 * cores:
         add("")
-        add("The machine was not idle during this run (load averages in the table): the "
-            "times are upper bounds, and the ratios between executors are what to read.")
+        add(f"The machine was busy with other work during this run (1-minute load averages "
+            f"up to {max(busy):.1f} on {cores:.0f} cores, in the table): the wall times, and "
+            "the ratios between executors (whose workers compete for the same cores), are "
+            "upper bounds and vary from run to run; the CPU times vary least.")
     lines += ["", END]
     return lines
 
