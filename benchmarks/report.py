@@ -116,7 +116,11 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
     add("```")
     add("")
     add("`--no-memory` leaves out the runs of a million steps in section 6 (about half a "
-        "minute).")
+        "minute). Section 9 times pylinkage beside pam2exu where it imports: pylinkage is no "
+        "dependency of pam2exu, so run the benchmark with an interpreter that has it (a "
+        "virtual environment made with `--system-site-packages`, then `pip install "
+        "pylinkage` in it); without it the section gives the figure issue 24 quotes, and "
+        "says so.")
     add("")
     add("Time per step is the wall time of `pam2exu.run(model, analysis=..., steps=..., "
         "solver=SolveSettings(tolerance=...))` (a loaded `Model`, so without parsing the "
