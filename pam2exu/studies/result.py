@@ -415,7 +415,7 @@ def grid_lines(table: dict, columns: list[str], shown: int = GRID_SHOWN) -> list
     for i in range(min(n, shown)):
         cells = [_number(float(table[c][i])).rjust(w) for c, w in zip(columns, widths)]
         lines.append("  ".join([f"{table['sample'][i]:>6d}", f"{table['status'][i]:<8}",
-                                *cells]))
+                                *cells]).rstrip())
     if n > shown:
         lines.append(f"… and the other {n - shown} of the {n} variants (-o OUT writes them all)")
     return lines
