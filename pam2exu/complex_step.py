@@ -38,8 +38,11 @@ def number_type(*values) -> np.dtype:
 
 
 def as_array(x) -> np.ndarray:
-    """``np.asarray(x, dtype=float)``, keeping a complex array complex."""
-    return np.asarray(x, dtype=number_type(x))
+    """``np.asarray(x, dtype=float)``, keeping a complex array complex (one conversion: it
+    is on the path of every point of every run)."""
+    a = np.asarray(x)
+    return a if a.dtype == np.float64 or a.dtype == np.complex128 else a.astype(
+        complex if a.dtype.kind == "c" else float)
 
 
 def hypot(x, y):
