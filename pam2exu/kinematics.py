@@ -208,6 +208,24 @@ def stack(*quantities: Quantity) -> Quantity:
                     hess)
 
 
+@dataclass
+class PointSet:
+    """Points and directions of solids to build at once (``State.prepare``), from
+    [(solid, local (2,), translate)] as ``State.asked`` lists them."""
+
+    solids: np.ndarray          # (K,) int
+    local: np.ndarray           # (K, 2)
+    translate: np.ndarray       # (K,) bool: a point (True) or a direction
+    keys: list                  # the State's keys of them
+
+    @classmethod
+    def of(cls, asked: list[tuple]) -> "PointSet":
+        return cls(np.array([a[0] for a in asked], dtype=int),
+                   np.array([a[1] for a in asked], dtype=float).reshape(-1, 2),
+                   np.array([a[2] for a in asked], dtype=bool),
+                   [(a[0], np.asarray(a[1], dtype=float).tobytes(), a[2]) for a in asked])
+
+
 class State:
     """Coordinates q (n, 3·solids) at times t (n,), and optionally velocities qd.
 
@@ -226,6 +244,8 @@ class State:
         # what is evaluated once per State: (cos fi, sin fi) per solid, points and directions
         self._trig: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._rotated_memo: dict[tuple, Quantity] = {}
+        #: the points and directions built one by one, as ``prepare`` takes them
+        self.asked: list[tuple] = []
 
     def coordinate(self, solid: int, k: int) -> Quantity:
         """v = q[column(solid, k)]: x (k=0), y (k=1) or fi (k=2) of a solid."""
@@ -257,6 +277,7 @@ class State:
         key = (solid, local.tobytes(), translate)
         if key not in self._rotated_memo:
             self._rotated_memo[key] = self._build_rotated(solid, local, translate)
+            self.asked.append((solid, local, translate))
         return self._rotated_memo[key]
 
     def _build_rotated(self, solid: int, local: np.ndarray, translate: bool) -> Quantity:
@@ -281,6 +302,33 @@ class State:
             hess = {(solid, solid): np.zeros((self.n, 2, 3, 3), dtype=As.dtype)}
             hess[solid, solid][:, :, 2, 2] = -As
         return Quantity(value, jac, rate, conv, hess)
+
+    def prepare(self, points: "PointSet") -> None:
+        """Build the points and directions of ``points`` at once, in one vectorised pass,
+        with the values ``point`` and ``direction`` give one by one (real coordinates, no
+        velocities: otherwise they are left to those)."""
+        if self.qd is not None or np.iscomplexobj(self.q):
+            return
+        solids, local, translate = points.solids, points.local, points.translate
+        fi = self.q[:, PER_SOLID * solids + 2]                        # (n, K)
+        c, s = np.cos(fi), np.sin(fi)
+        As = np.stack([c * local[:, 0] - s * local[:, 1], s * local[:, 0] + c * local[:, 1]],
+                      axis=-1)                                        # (n, K, 2)
+        origin = np.stack([self.q[:, PER_SOLID * solids], self.q[:, PER_SOLID * solids + 1]],
+                          axis=-1)
+        value = np.where(translate[None, :, None], As + origin, As)
+        jac = np.zeros((self.n, len(solids), 2, 3))
+        jac[:, translate, 0, 0] = jac[:, translate, 1, 1] = 1.0
+        jac[..., 2] = perp(As)
+        hess = None
+        if self.hessians:                      # ∂²(A s)/∂fi² = −A s, the rest 0
+            hess = np.zeros((self.n, len(solids), 2, 3, 3))
+            hess[..., 2, 2] = -As
+        for k, key in enumerate(points.keys):
+            solid = key[0]
+            self._rotated_memo[key] = Quantity(
+                value[:, k], {solid: jac[:, k]}, None, None,
+                None if hess is None else {(solid, solid): hess[:, k]})
 
     def point(self, solid: int, local) -> Quantity:
         """v = R + A(fi) s: global position of the point s of a solid."""

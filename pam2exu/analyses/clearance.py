@@ -12,19 +12,19 @@ clearance it feeds is ``least_norm``.
 """
 from __future__ import annotations
 
-import copy
 from dataclasses import replace
 
 import numpy as np
 
 from ..errors import MobilityError, ModelError, SolverError
 from ..kinematics import PER_SOLID, State
-from ..model.solid import LineRef
+from .closures import Closures
 from .job import Job, check_mobility, collect
 from .least_norm import (RANK, Applicability, Closure, Stop, applicability, follow,
-                         lagrange_jacobian, split, time_rate)
-from .native import target_values
-from .positions import GUESS_STIFFNESS, assemble
+                         lagrange_jacobian, lagrange_jacobian_rows, newton_rows, split,
+                         strict_minimum_rows)
+from . import native
+from .positions import GUESS_STIFFNESS, assemble, positions
 
 
 def clearance(job: Job):
@@ -51,18 +51,22 @@ def clearance(job: Job):
     t0 = float(job.times[0])
     # at the nominal dimensions (the fixed deviations not yet reached: ``as_made``)
     require_applicable(closures, closures.evaluate(t0, q0, np.zeros(m), reached=0.0), t0)
+    if not p and not closures.varied:
+        return kinematic_closure(job, closures)
+    job.info["clearance_method"] = FOLLOWED
     job.stage = "following the clearance of least norm (the slides' ODE)"
     y0 = np.r_[np.zeros(p), q0, np.zeros(m)]
     if closures.has_fixed:
         job.stage = "following the clearance of least norm to the dimensions as made (t = 0)"
         y0 = as_made(closures, t0, y0)
-    y, ok, stop = follow(closures.evaluate, time_rate(closures.evaluate, p, start=t0),
-                         job.times, y0, p, nq)
+    y, ok, stop = follow(closures.evaluate, None, job.times, y0, p, nq,
+                         rate=closures.evaluate_rate, correct=corrector(closures))
     job.stage = "checking the clearance is a strict minimum at every row"
     rows = range(0, len(job.times), job.every)
-    for k in rows:
-        if not ok[k]:
-            break
+    checked = np.array([k for k in rows if ok[k]], dtype=int)
+    lost = _first_lost(closures, job.times[checked], y[checked])
+    if lost is not None:
+        k = int(checked[lost])
         q, lam = y[k, p:p + nq], y[k, p + nq:]
         t = float(job.times[k])
         try:
@@ -78,15 +82,103 @@ def clearance(job: Job):
     return collect(job, y[:, p:p + nq], extra=closures.columns(y[:, :p]))
 
 
+#: ``RunInfo.clearance_method`` of a run that follows the least-norm clearance
+FOLLOWED = "the slides' ODE, Newton on the Lagrange conditions at every row"
+#: ``RunInfo.clearance_method`` of a run with no clearance joint and no varied anchor
+KINEMATIC = ("no clearance joint and no varied anchor: no clearance (no column), the "
+             "positions those of the kinematic analysis (the backend's, refined by Newton on "
+             "the closure)")
+
+
+def kinematic_closure(job: Job, closures: "Closures"):
+    """The clearance analysis of a mechanism with no clearance joint (p = 0) whose
+    ``[[variation]]`` entries move no anchor: the least-norm clearance is empty, λ = 0, and
+    the closure C(q, t) = 0 (square and regular, ``require_applicable``) fixes the
+    positions: the kinematic ones (the backend's, ``positions``), each row refined by
+    Newton on C = 0 as ``least_norm.newton`` refines the ODE's; the condition (i) at every
+    row (σ_min/σ_max of F_q, vectorised) as ``require_strict_minimum`` checks it."""
+    job.info["clearance_method"] = KINEMATIC
+    q = positions(job, redundant=False)
+    q[1:] = refine(closures.mech, job.times[1:], q[1:])   # row 0: the assembly, as follow's
+    job.stage = "checking the clearance is a strict minimum at every row"
+    rows = np.arange(0, len(job.times), job.every)
+    jacobian = native.equations(closures.mech, State(job.times[rows], q[rows])).jacobian
+    s = np.linalg.svd(jacobian, compute_uv=False)
+    lost = np.nonzero(s[:, -1] <= RANK * s[:, 0])[0]
+    if lost.size:
+        k = int(rows[lost[0]])
+        t = float(job.times[k])
+        try:
+            require_strict_minimum(closures.evaluate(t, q[k], np.zeros(closures.m)), t,
+                                   source(closures), closures)
+        except SolverError as error:
+            raise _with_rows(error, job, closures, np.asarray(q), k) from None
+    return collect(job, q, extra={})
+
+
+def refine(mech, times: np.ndarray, q: np.ndarray, tolerance: float = 1e-13,
+           iterations: int = 30) -> np.ndarray:
+    """q with every row refined by Newton on C(q, t) = 0, C square (all rows at once), until
+    each row's step is below ``tolerance`` (relative to 1 + |q|), as ``least_norm.newton``."""
+    q = np.array(q, dtype=float)
+    active = np.arange(len(times))
+    for _ in range(iterations):
+        eq = native.equations(mech, State(times[active], q[active]))
+        step = np.linalg.solve(eq.jacobian, -eq.residual[..., None])[..., 0]
+        q[active] += step
+        done = (np.max(np.abs(step), axis=1)
+                <= tolerance * (1.0 + np.max(np.abs(q[active]), axis=1)))
+        active = active[~done]
+        if not active.size:
+            break
+    return q
+
+
+def corrector(closures: Closures, t0: float | None = None):
+    """``follow``'s ``correct``: Newton on h = 0 at every row reached at once
+    (``least_norm.newton_rows``), along the time, or with ``t0`` along the straight path
+    u0 + s δ at t0 (the rows' "times" are then s)."""
+    def rows(times, q, lam):
+        if t0 is None:
+            return closures.evaluate_rows(times, q, lam)
+        return _path_rows(closures, t0, times, q, lam)
+
+    def correct(times, ys):
+        return newton_rows(rows, closures.Fj, times, ys, closures.p, closures.nq)
+    return correct
+
+
+def _path_rows(closures: Closures, t0: float, reached: np.ndarray, q, lam):
+    """``evaluate_rows`` on the straight path u0 + s δ at t0, one row per s."""
+    out = [closures.evaluate_rows(np.array([t0]), q[k:k + 1], lam[k:k + 1], reached=s)
+           for k, s in enumerate(reached)]
+    return tuple(np.concatenate([o[i] for o in out]) for i in range(3))
+
+
+#: a row whose conditions ``strict_minimum_rows`` finds within this factor of the limit
+#: (RANK) is decided by ``applicability`` itself, one row at a time
+MARGIN = 10.0
+
+
+def _first_lost(closures: Closures, times: np.ndarray, y: np.ndarray) -> int | None:
+    """The index of the first row of (times, y) where (i) or the reduced Hessian's condition
+    may fail (``require_strict_minimum`` decides), None where every row holds clearly."""
+    if not len(times):
+        return None
+    p, nq = closures.p, closures.nq
+    _, Fq, W = closures.evaluate_rows(times, y[:, p:p + nq], y[:, p + nq:])
+    ratio, hessian = strict_minimum_rows(closures.Fj, Fq, W)
+    near = np.nonzero((ratio <= MARGIN * RANK) | (hessian <= MARGIN * RANK))[0]
+    for k in near:
+        found = applicability(Closure(np.zeros(closures.m), Fq[k], closures.Fj, W[k]))
+        if found.ratio_i <= RANK or found.hessian <= RANK:
+            return int(k)
+    return None
+
+
 #: the rows of the straight path u0 + s δ at t = 0 where Newton corrects the clearance
 #: followed (s = 0, 1/4, …, 1); the integrator steps as it needs between them
 PATH_ROWS = 4
-#: the step in s of the central differences of h_s on that path: h is linear in a point's
-#: δ and smooth in a line's, so a large step loses nothing, while 1e-6 (the time's, whose
-#: rates are O(1)) leaves round-off of O(1e-10) in rates of O(δ) that the integrator's
-#: error control chases (the locomotive, 3e-4 m deviations: 5.5 s at 1e-6, 1.0 s at 1e-3,
-#: the clearances equal to 2e-16)
-PATH_RATE_STEP = 1e-3
 
 
 def as_made(closures: "Closures", t0: float, y0: np.ndarray) -> np.ndarray:
@@ -100,7 +192,10 @@ def as_made(closures: "Closures", t0: float, y0: np.ndarray) -> np.ndarray:
 
     p, nq = closures.p, closures.nq
     path = np.linspace(0.0, 1.0, PATH_ROWS + 1)
-    y, ok, stop = follow(along, time_rate(along, p, step=PATH_RATE_STEP), path, y0, p, nq)
+    y, ok, stop = follow(along, None, path, y0, p, nq,
+                         rate=lambda s, q, lam: closures.evaluate_rate(t0, q, lam, reached=s,
+                                                                       along="s"),
+                         correct=corrector(closures, t0))
     for k, s in enumerate(path):
         at, there = (float(s), y[k]) if ok[k] else (stop.time, stop.y)
         found = applicability(along(at, *split(there, p, nq)[1:]))
@@ -188,6 +283,15 @@ def first_order(closures: "Closures", t: float, q_nominal: np.ndarray) -> np.nda
     return np.linalg.solve(lagrange_jacobian(c), rhs)[:closures.p]
 
 
+def first_order_rows(closures: Closures, times: np.ndarray,
+                     q_nominal: np.ndarray) -> np.ndarray:
+    """``first_order`` at every row (times (n,), q_nominal (n, nq)) at once: (n, p)."""
+    C, Fq, W = closures.evaluate_rows(times, q_nominal, np.zeros((len(times), closures.m)))
+    rhs = np.concatenate([np.zeros((len(times), closures.p + closures.nq)), -C], axis=1)
+    H = lagrange_jacobian_rows(closures.Fj, Fq, W)
+    return np.linalg.solve(H, rhs[..., None])[:, :closures.p, 0]
+
+
 def _warn_far_from_first_order(job, closures, j, rows, redundant):
     """The contract's recommended warning: a clearance column that departs from its
     first-order estimate (``first_order``, at the nominal positions by the backend) by more
@@ -200,9 +304,7 @@ def _warn_far_from_first_order(job, closures, j, rows, redundant):
             "no first-order estimate of the clearance to compare with: the nominal mechanism "
             f"has no position at t = {job.times[found.solved]:.6g} s ({found.error})")
         return
-    q_nominal = found.q
-    estimate = np.array([first_order(closures, float(job.times[k]), q_nominal[k])
-                         for k in rows])
+    estimate = first_order_rows(closures, job.times[rows], found.q[rows])
     gap = np.abs(j[rows] - estimate)
     far = gap > 0.5 * np.max(np.abs(j[rows]), axis=0)
     for col in np.nonzero(far.any(axis=0))[0]:
@@ -213,98 +315,6 @@ def _warn_far_from_first_order(job, closures, j, rows, redundant):
             f"t = {job.times[k]:.6g} s: the variations are too large for the linear picture, "
             "or a singular position of the nominal mechanism is near (docs/clearance.md, "
             "'When the method applies')")
-
-
-class Closures:
-    """The closure of ``mech`` at any time, with its clearance parameters laid out.
-
-    Parameters
-    ----------
-    mech : Mechanism
-        The validated mechanism (its ``variations`` bound).
-    start : numpy.ndarray
-        q at the nominal assembly (what a prismatic's sense is read from).
-    """
-
-    def __init__(self, mech, start: np.ndarray):
-        self.mech = mech
-        self.start = State([0.0], np.asarray(start, dtype=float)[None])
-        #: the clearance elements, in element order, and the names of their parameters
-        self.elements = [el for el in mech.constraints if el.clearance]
-        self.names = [f"{el.name}.{var.name}" for el in self.elements
-                      for var in el.clearance_parameters]
-        self.p, self.nq, self.m = len(self.names), mech.nq, mech.n_equations
-        self.Fj = np.zeros((self.m, self.p))
-        k = 0
-        for el, rows in zip(mech.constraints, mech.rows):
-            if el in self.elements:
-                width = len(el.clearance_parameters)
-                self.Fj[rows, k:k + width] = np.asarray(el.clearance_terms, dtype=float)
-                k += width
-
-    def columns(self, j: np.ndarray) -> dict[str, np.ndarray]:
-        """The result columns of the clearance parameters j (n, p), and those derived from
-        them (a revolute's jr), as ``<element>.<name>``."""
-        out, k = {}, 0
-        for el in self.elements:
-            values = {}
-            for var in el.clearance_parameters:
-                values[var.name] = j[:, k]
-                k += 1
-            values.update(el.clearance_derived_values(values))
-            out.update({f"{el.name}.{name}": v for name, v in values.items()})
-        return out
-
-    @property
-    def has_fixed(self) -> bool:
-        """Some ``[[variation]]`` has a fixed deviation (``fixed_dx`` …) to reach at t = 0
-        (``as_made``)."""
-        return any(v.has_fixed for v in self.mech.variations)
-
-    def at(self, t: float, reached: float = 1.0) -> list:
-        """The constraint elements with their varied points and lines at time t (copies;
-        the elements whose anchors do not vary are the mechanism's own), the fixed
-        deviations ``reached`` of the way (``Variation.offsets``)."""
-        out = []
-        for el in self.mech.constraints:
-            refs = list(el.refs)
-            for k, ref in enumerate(refs):
-                variation = self.mech.variation(el, k)
-                if variation is not None:
-                    refs[k] = _moved(ref, variation.offsets(np.array([t]), reached)[0][0])
-            if refs != list(el.refs):
-                el = copy.copy(el)
-                el.refs = tuple(refs)
-                el.ref1, el.ref2 = refs[0], refs[1] if len(refs) > 1 else None
-            out.append(el)
-        return out
-
-    def evaluate(self, t: float, q: np.ndarray, lam: np.ndarray,
-                 reached: float = 1.0) -> Closure:
-        """C (without F_j j), F_q, F_j and W = Σ λ_i ∂²F_i/∂q² at (t, q), the fixed
-        deviations ``reached`` of the way."""
-        st = State([t], np.asarray(q, dtype=float)[None], hessians=True)
-        C = np.zeros(self.m)
-        Fq = np.zeros((1, self.m, self.nq))
-        W = np.zeros((1, self.nq, self.nq))
-        for el, rows in zip(self.at(t, reached), self.mech.rows):
-            if el.clearance:
-                v, target = el.clearance_constraint(st, self.start)
-            else:
-                v, target = el.constraint(st)
-            f = target_values(target, st.t, el.equations)[0]
-            C[rows] = (v.value - f)[0]
-            v.rows(Fq, rows.start)
-            v.weighted_hessian(np.asarray(lam, dtype=float)[None, rows], W)
-        return Closure(C, Fq[0], self.Fj, W[0])
-
-
-def _moved(ref, offset: np.ndarray):
-    """A point or line reference moved by u − u0 = (dx, dy, dangle) in its solid's frame."""
-    if isinstance(ref, LineRef):
-        return replace(ref, point=(ref.point[0] + offset[0], ref.point[1] + offset[1]),
-                       angle=ref.angle + offset[2])
-    return replace(ref, local=(ref.local[0] + offset[0], ref.local[1] + offset[1]))
 
 
 # ---- when the method applies (shared/spec/clearance.md, "When the method applies") -------

@@ -59,11 +59,7 @@ def lagrange(j: np.ndarray, lam: np.ndarray, c: Closure) -> np.ndarray:
 
 def lagrange_jacobian(c: Closure) -> np.ndarray:
     """h_y = [[I, 0, F_jᵀ], [0, W, F_qᵀ], [F_j, F_q, 0]] (F_j constant)."""
-    m, p = c.Fj.shape
-    nq = c.Fq.shape[1]
-    return np.block([[np.eye(p), np.zeros((p, nq)), c.Fj.T],
-                     [np.zeros((nq, p)), c.W, c.Fq.T],
-                     [c.Fj, c.Fq, np.zeros((m, m))]])
+    return lagrange_jacobian_rows(c.Fj, c.Fq[None], c.W[None])[0]
 
 
 def newton(evaluate: Evaluate, t: float, y: np.ndarray, p: int, nq: int,
@@ -82,6 +78,90 @@ def newton(evaluate: Evaluate, t: float, y: np.ndarray, p: int, nq: int,
         if np.max(np.abs(step)) <= tolerance * (1.0 + np.max(np.abs(y))):
             return y, True
     return y, False
+
+
+#: evaluate_rows(times (n,), q (n, nq), λ (n, m)) -> (C (n, m), F_q (n, m, nq), W (n, nq, nq))
+EvaluateRows = Callable[[np.ndarray, np.ndarray, np.ndarray], tuple]
+
+
+def lagrange_rows(y: np.ndarray, Fj: np.ndarray, C: np.ndarray, Fq: np.ndarray, p: int,
+                  nq: int) -> np.ndarray:
+    """h of every row (n, p + nq + m): ``lagrange`` at each."""
+    j, lam = y[:, :p], y[:, p + nq:]
+    return np.concatenate([j + lam @ Fj, np.einsum("nmq,nm->nq", Fq, lam), C + j @ Fj.T],
+                          axis=1)
+
+
+def lagrange_jacobian_rows(Fj: np.ndarray, Fq: np.ndarray, W: np.ndarray) -> np.ndarray:
+    """h_y of every row (n, N, N): ``lagrange_jacobian`` at each."""
+    n, m, nq = Fq.shape
+    p = Fj.shape[1]
+    H = np.zeros((n, p + nq + m, p + nq + m))
+    H[:, :p, :p] = np.eye(p)
+    H[:, :p, p + nq:] = Fj.T
+    H[:, p:p + nq, p:p + nq] = W
+    H[:, p:p + nq, p + nq:] = np.transpose(Fq, (0, 2, 1))
+    H[:, p + nq:, :p] = Fj
+    H[:, p + nq:, p:p + nq] = Fq
+    return H
+
+
+def newton_rows(evaluate_rows: EvaluateRows, Fj: np.ndarray, times: np.ndarray,
+                y: np.ndarray, p: int, nq: int, tolerance: float = 1e-13,
+                iterations: int = 30) -> tuple[np.ndarray, np.ndarray]:
+    """(y, converged) of every row: ``newton`` at each row from its own y, all rows at
+    once (the rows are independent: the corrections of ``follow``)."""
+    y = np.array(y, dtype=float)
+    ok = np.zeros(len(times), dtype=bool)
+    active = np.arange(len(times))
+    for _ in range(iterations):
+        if not active.size:
+            break
+        at = y[active]
+        C, Fq, W = evaluate_rows(times[active], at[:, p:p + nq], at[:, p + nq:])
+        h = lagrange_rows(at, Fj, C, Fq, p, nq)
+        H = lagrange_jacobian_rows(Fj, Fq, W)
+        try:
+            step = np.linalg.solve(H, -h[..., None])[..., 0]
+        except np.linalg.LinAlgError:            # some row singular: it stops there
+            step = np.full_like(h, np.nan)
+            for r in range(len(active)):
+                try:
+                    step[r] = np.linalg.solve(H[r], -h[r])
+                except np.linalg.LinAlgError:
+                    pass
+        singular = ~np.isfinite(step).all(axis=1) & np.isfinite(h).all(axis=1)
+        y[active[~singular]] = at[~singular] + step[~singular]
+        done = (np.max(np.abs(step), axis=1)
+                <= tolerance * (1.0 + np.max(np.abs(y[active]), axis=1)))
+        ok[active[done]] = True
+        active = active[~done & ~singular]
+    return y, ok
+
+
+def strict_minimum_rows(Fj: np.ndarray, Fq: np.ndarray, W: np.ndarray):
+    """(σ_min/σ_max of [F_j F_q], the smallest eigenvalue of the reduced Hessian) of every
+    row: ``applicability``'s ``ratio_i`` and ``hessian`` at each, in batches."""
+    n, m, nq = Fq.shape
+    p = Fj.shape[1]
+    A = np.concatenate([np.broadcast_to(Fj, (n, m, p)), Fq], axis=2)
+    _, s, Vt = np.linalg.svd(A)
+    top = s[:, 0]
+    smallest = np.zeros(n) if m > min(m, p + nq) else s[:, -1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(top > 0, smallest / top, np.inf)
+    rank = np.sum(s > RANK * top[:, None], axis=1)
+    hessian = np.full(n, np.inf)
+    full = np.zeros((n, p + nq, p + nq))
+    full[:, :p, :p] = np.eye(p)
+    full[:, p:, p:] = W
+    for r in np.unique(rank):
+        rows = np.nonzero(rank == r)[0]
+        Z = np.transpose(Vt[rows, r:], (0, 2, 1))
+        if Z.shape[2]:
+            reduced = np.transpose(Z, (0, 2, 1)) @ full[rows] @ Z
+            hessian[rows] = np.linalg.eigvalsh(reduced)[:, 0]
+    return ratio, hessian
 
 
 @dataclass
@@ -199,12 +279,17 @@ class Followed(NamedTuple):
     stop: Stop | None        # None: it reached the last output time
 
 
-def follow(evaluate: Evaluate, h_t: Callable, times: np.ndarray, y0: np.ndarray, p: int,
-           nq: int, rtol: float = 1e-10, atol: float = 1e-12,
-           max_steps: int | None = None) -> Followed:
+def follow(evaluate: Evaluate, h_t: Callable | None, times: np.ndarray, y0: np.ndarray,
+           p: int, nq: int, rtol: float = 1e-10, atol: float = 1e-12,
+           max_steps: int | None = None, rate: Callable | None = None,
+           correct: Callable | None = None) -> Followed:
     """The slides' ODE y' = −h_y⁻¹ h_t from y0 at times[0], integrated by scipy's DOP853
     step by step through every output time (its dense output there, as ``solve_ivp`` with
     ``t_eval``), then Newton on h = 0 at each output time from the integrated value.
+    h_t is ``h_t(t, q, λ)`` (e.g. ``time_rate``), or, with ``rate(t, q, λ)`` -> (Closure,
+    h_t) given instead (``Closures.evaluate_rate``), from the same evaluation as h_y.
+    ``correct(times, ys)`` -> (ys, converged) corrects the rows reached all at once
+    (``newton_rows``); None: ``newton`` at each.
 
     It stops at the first of: h_y singular or the step size fallen to round-off
     (``Stop.SINGULAR``), more than ``max_steps`` steps in one output interval
@@ -217,7 +302,9 @@ def follow(evaluate: Evaluate, h_t: Callable, times: np.ndarray, y0: np.ndarray,
 
     def rhs(t, y):
         j, q, lam = split(y, p, nq)
-        return -np.linalg.solve(lagrange_jacobian(evaluate(t, q, lam)), h_t(t, q, lam))
+        c, rate_t = rate(t, q, lam) if rate is not None else (evaluate(t, q, lam),
+                                                              h_t(t, q, lam))
+        return -np.linalg.solve(lagrange_jacobian(c), rate_t)
 
     times = np.asarray(times, dtype=float)
     out = np.full((len(times), len(y0)), np.nan)
@@ -225,31 +312,47 @@ def follow(evaluate: Evaluate, h_t: Callable, times: np.ndarray, y0: np.ndarray,
     out[0], ok[0] = y0, True
     if len(times) == 1:
         return Followed(out, ok, None)
+    predicted = np.full_like(out, np.nan)
+    taken = np.zeros(len(times), dtype=int)       # the steps to reach each row
+    k, steps, stop = 1, 0, None
     try:
         solver = DOP853(rhs, times[0], y0, times[-1], rtol=rtol, atol=atol)
     except np.linalg.LinAlgError:
         return Followed(out, ok, Stop(float(times[0]), Stop.SINGULAR, y0))
-    k, steps = 1, 0
     while k < len(times):
         t, y = float(solver.t), solver.y
         try:
             solver.step()
         except np.linalg.LinAlgError:
-            return Followed(out, ok, Stop(t, Stop.SINGULAR, y, steps))
+            stop = Stop(t, Stop.SINGULAR, y, steps)
+            break
         if solver.status == "failed" or not np.isfinite(solver.y).all():
-            return Followed(out, ok, Stop(t, Stop.SINGULAR, y, steps))
+            stop = Stop(t, Stop.SINGULAR, y, steps)
+            break
         steps += 1
         if times[k] <= solver.t:
             passed = np.searchsorted(times, solver.t, side="right")
-            for row, y in zip(range(k, passed), solver.dense_output()(times[k:passed]).T):
-                out[row], ok[row] = newton(evaluate, float(times[row]), y, p, nq)
-                if not ok[row]:
-                    out[row] = np.nan
-                    return Followed(out, ok, Stop(float(times[row]), Stop.NEWTON, y, steps))
+            predicted[k:passed] = solver.dense_output()(times[k:passed]).T
+            taken[k:passed] = steps
             k, steps = passed, 0
         elif steps >= max_steps:
-            return Followed(out, ok, Stop(float(solver.t), Stop.WORK, solver.y, steps))
-    return Followed(out, ok, None)
+            stop = Stop(float(solver.t), Stop.WORK, solver.y, steps)
+            break
+    # Newton at every row reached (independent of each other: the integration goes on
+    # from its own state); the first that fails ends the rows, as if met on the way
+    if correct is None:
+        def correct(at, ys):
+            pairs = [newton(evaluate, float(t), y, p, nq) for t, y in zip(at, ys)]
+            return (np.array([y for y, _ in pairs]).reshape(ys.shape),
+                    np.array([c for _, c in pairs], dtype=bool))
+    out[1:k], ok[1:k] = correct(times[1:k], predicted[1:k])
+    failed = np.nonzero(~ok[1:k])[0]
+    if failed.size:
+        row = 1 + int(failed[0])
+        out[row:], ok[row:] = np.nan, False
+        return Followed(out, ok, Stop(float(times[row]), Stop.NEWTON, predicted[row],
+                                      int(taken[row])))
+    return Followed(out, ok, stop)
 
 
 def step_by_step(evaluate: Evaluate, times: np.ndarray, y0: np.ndarray, p: int, nq: int):

@@ -50,7 +50,8 @@ def target_values(target, t, m):
     if isinstance(target, Law):
         f, df, ddf = target(t)
         return f[:, None], df[:, None], ddf[:, None]
-    return np.broadcast_to(as_array(target), (m,)), 0.0, 0.0
+    target = as_array(target)                  # (m,), or (n, m) where it varies by row
+    return np.broadcast_to(target, np.broadcast_shapes(target.shape, (m,))), 0.0, 0.0
 
 
 def equations(mech, st: State, jacobian: bool = True) -> Equations:

@@ -183,9 +183,10 @@ class Prismatic(Element):
         relative = st.angle(line2.solid) - st.angle(line1.solid)
         at_start = (start.q[0, column(line2.solid, 2)] + line2.angle
                     - start.q[0, column(line1.solid, 2)] - line1.angle)
-        sense = round(at_start / math.pi)
+        sense = np.round(np.real(at_start) / math.pi)   # (real in a complex step)
+        target = line1.angle - line2.angle + sense * math.pi   # (n,) where the lines vary
         return (stack(_on_line(st, line1, line2.solid, line2.point), relative),
-                np.array([0.0, line1.angle - line2.angle + sense * math.pi]))
+                np.stack(np.broadcast_arrays(0.0, target), axis=-1))
 
     def build(self, ex):
         line1, line2 = self.refs

@@ -60,6 +60,9 @@ class RunInfo(MutableMapping):
         (|error| / (1 + |value|), largest over coordinates, rates and rows) [-].
     integration_steps : int
         dynamic: the steps of the finest run of a segment (of the backend's integrator).
+    clearance_method : str
+        clearance: how the clearance of least norm was computed (the slides' ODE, or, with
+        no clearance joint and no varied anchor, the kinematic positions).
     undefined : str
         Columns asked for that are NaN by definition at some rows, and why (an
         instantaneous centre where its solid translates: ``points.columns``).
@@ -93,6 +96,7 @@ class RunInfo(MutableMapping):
     stiffness_eigenvalue: float | None = None
     integration_error: float | None = None
     integration_steps: int | None = None
+    clearance_method: str | None = None
 
     def _field(self, key: str) -> str:
         if key in RENAMED:

@@ -1,0 +1,215 @@
+"""The closure of a mechanism with clearance joints, as the clearance analysis evaluates it
+(shared/spec/clearance.md): F(u(t), j, q, r(t)) = C(q, t) + F_j j at one time or at many
+rows at once, its rate along the path of dimensions, and its clearance parameters laid out.
+
+``Closures.evaluate`` gives C, F_q, F_j and W = Σ λ_i ∂²F_i/∂q² at one (t, q, λ), every
+constraint element's rows (``Element.constraint``, or ``Element.clearance_constraint``
+where the element has ``clearance = true``) with the points and lines of the
+``[[variation]]`` entries at u(t); ``evaluate_rows`` the same at n rows in one State (the
+checks and the Newton corrections of every output row at once); ``evaluate_rate`` adds
+h_t = (0, F_qtᵀλ, C_t) from the same evaluation: F_u u′ and F_qu u′ by one complex step in
+the dimensions u, the laws' f′ from the laws. The mathematics they feed is ``least_norm``.
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..kinematics import PointSet, State
+from ..model.solid import LineRef
+from ..model.variation import COMPONENTS
+from .least_norm import Closure
+from .native import target_values
+
+#: the imaginary step of ``Closures.evaluate_rate``: Im F(u + i STEP u′) / STEP = F_u u′,
+#: exact to rounding (no difference is taken)
+STEP = 1e-30
+
+
+class Closures:
+    """The closure of ``mech`` at any time, with its clearance parameters laid out.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The validated mechanism (its ``variations`` bound).
+    start : numpy.ndarray
+        q at the nominal assembly (what a prismatic's sense is read from).
+    """
+
+    def __init__(self, mech, start: np.ndarray):
+        self.mech = mech
+        self.start = State([0.0], np.asarray(start, dtype=float)[None])
+        #: the clearance elements, in element order, and the names of their parameters
+        self.elements = [el for el in mech.constraints if el.clearance]
+        self.names = [f"{el.name}.{var.name}" for el in self.elements
+                      for var in el.clearance_parameters]
+        self.p, self.nq, self.m = len(self.names), mech.nq, mech.n_equations
+        #: (element, anchor k, its Variation) of every varied anchor of a constraint element
+        self.varied = [(el, k, v) for el in mech.constraints for k in range(len(el.refs))
+                       if (v := mech.variation(el, k)) is not None]
+        #: the Variations that move some anchor, once each
+        self._variations = list({id(v): v for _, _, v in self.varied}.values())
+        #: their laws' constants (V, 3): τ, ω, Δ/2 and δ of x, y, angle (``_offsets``)
+        laws = [[(float(v.tau), v.omega(name), 0.5 * float(getattr(v, key)))
+                 for name, key, *_ in COMPONENTS] for v in self._variations]
+        self._tau, self._omega, self._half = np.array(laws).reshape(-1, 3, 3).transpose(2, 0, 1)
+        self._fixed = np.array([v.fixed for v in self._variations]).reshape(-1, 3)
+        #: (index, element, [(anchor k, Variation)]) of the elements with a varied anchor
+        self._varied_elements = []
+        for index, el in enumerate(mech.constraints):
+            anchors = [(k, v) for e, k, v in self.varied if e is el]
+            if anchors:
+                self._varied_elements.append((index, el, anchors))
+        #: the points and directions of the elements at their nominal dimensions
+        #: (``State.prepare``: built at once at every evaluation; a varied one is built
+        #: where it is asked for, at its dimensions then)
+        nominal = State([0.0], self.start.q, hessians=True)
+        for el in mech.constraints:
+            self._constraint(el, nominal)
+        self._points = PointSet.of(nominal.asked)
+        self.Fj = np.zeros((self.m, self.p))
+        k = 0
+        for el, rows in zip(mech.constraints, mech.rows):
+            if el in self.elements:
+                width = len(el.clearance_parameters)
+                self.Fj[rows, k:k + width] = np.asarray(el.clearance_terms, dtype=float)
+                k += width
+
+    def columns(self, j: np.ndarray) -> dict[str, np.ndarray]:
+        """The result columns of the clearance parameters j (n, p), and those derived from
+        them (a revolute's jr), as ``<element>.<name>``."""
+        out, k = {}, 0
+        for el in self.elements:
+            values = {}
+            for var in el.clearance_parameters:
+                values[var.name] = j[:, k]
+                k += 1
+            values.update(el.clearance_derived_values(values))
+            out.update({f"{el.name}.{name}": v for name, v in values.items()})
+        return out
+
+    @property
+    def has_fixed(self) -> bool:
+        """Some ``[[variation]]`` has a fixed deviation (``fixed_dx`` …) to reach at t = 0
+        (``as_made``)."""
+        return any(v.has_fixed for v in self.mech.variations)
+
+    def at(self, t, reached: float = 1.0, along: str | None = None) -> list:
+        """The constraint elements with their varied points and lines at time t (copies;
+        the elements whose anchors do not vary are the mechanism's own), the fixed
+        deviations ``reached`` of the way (``Variation.offsets``). ``t`` a float, or an
+        array (n,): the varied coordinates are then arrays, one value per row. ``along``
+        "t" or "s": each offset u − u0 is given the imaginary part ``STEP`` · du/dt (time)
+        or ``STEP`` · δ (the path u0 + s δ), the complex step of ``evaluate_rate``."""
+        rows = np.ndim(t) > 0
+        moved = {}
+        if self._variations:
+            u, du = self._offsets(np.atleast_1d(t), reached)           # (V, n, 3)
+            if along is not None:
+                u = u + 1j * STEP * (du if along == "t" else self._fixed[:, None])
+            for variation, offset in zip(self._variations, u):
+                moved[id(variation)] = offset.T if rows else offset[0]
+        out = list(self.mech.constraints)
+        for index, el, anchors in self._varied_elements:
+            refs = list(el.refs)
+            for k, variation in anchors:
+                refs[k] = _moved(refs[k], moved[id(variation)], rows)
+            el = copy.copy(el)
+            el.refs = tuple(refs)
+            el.ref1, el.ref2 = refs[0], refs[1] if len(refs) > 1 else None
+            out[index] = el
+        return out
+
+    def _offsets(self, t: np.ndarray, reached: float):
+        """u − u0 and u′ (V, n, 3) of every varied anchor's Variation at the times t (n,):
+        ``Variation.offsets`` of them all at once (``variation.ramped_cosine``'s terms)."""
+        tt = t[None, :, None]
+        tau, omega, half = self._tau[:, None], self._omega[:, None], self._half[:, None]
+        decay = np.exp(-tt / tau)
+        ramp = -np.expm1(-tt / tau)
+        cos, sin = np.cos(omega * tt), np.sin(omega * tt)
+        return (reached * self._fixed[:, None] + ramp * half * cos,
+                half * (decay / tau * cos - ramp * omega * sin))
+
+    def evaluate(self, t: float, q: np.ndarray, lam: np.ndarray,
+                 reached: float = 1.0) -> Closure:
+        """C (without F_j j), F_q, F_j and W = Σ λ_i ∂²F_i/∂q² at (t, q), the fixed
+        deviations ``reached`` of the way."""
+        C, Fq, W, _, _ = self._evaluate(t, q[None], lam[None], reached)
+        return Closure(C[0], Fq[0], self.Fj, W[0])
+
+    def evaluate_rows(self, times: np.ndarray, q: np.ndarray, lam: np.ndarray,
+                      reached: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(C (n, m), F_q (n, m, nq), W (n, nq, nq)) at the rows (t_k, q_k, λ_k) in one
+        State: ``evaluate`` at each row."""
+        return self._evaluate(np.asarray(times, dtype=float), q, lam, reached)[:3]
+
+    def evaluate_rate(self, t: float, q: np.ndarray, lam: np.ndarray, reached: float = 1.0,
+                      along: str = "t") -> tuple[Closure, np.ndarray]:
+        """(the Closure at (t, q, λ), h_t): the rate of the Lagrange conditions along the
+        path at fixed y = (j, q, λ), h_t = (0, F_qtᵀλ, C_t) (F_j constant), along the time
+        (``along`` "t": C_t = F_u u′ − f′, u′ the variations' rates, f′ the laws') or the
+        straight path of the fixed deviations (``along`` "s": F_u δ at time t): F_u u′ and
+        F_qu u′ exact, by one complex step in the dimensions u (``STEP``)."""
+        C, Fq, W, rate, jacobian_rate = self._evaluate(t, q[None], lam[None], reached, along)
+        closure = Closure(C[0], Fq[0], self.Fj, W[0])
+        return closure, np.concatenate([np.zeros(self.p), jacobian_rate[0].T @ lam, rate[0]])
+
+    def _evaluate(self, t, q, lam, reached=1.0, along=None):
+        """(C, F_q, W, C_t, F_qt) at the rows (t, q, λ) (t a float for one row; the last
+        two None without ``along``)."""
+        n = q.shape[0]
+        st = State(np.broadcast_to(t, (n,)), np.asarray(q, dtype=float), hessians=True)
+        dtype = complex if along is not None else float
+        C = np.zeros((n, self.m), dtype)
+        Fq = np.zeros((n, self.m, self.nq), dtype)
+        W = np.zeros((n, self.nq, self.nq), dtype)
+        f_rate = np.zeros((n, self.m))
+        lam = np.asarray(lam, dtype=float)
+        st.prepare(self._points)
+        for el, rows in zip(self.at(t, reached, along), self.mech.rows):
+            v, target = self._constraint(el, st)
+            f, df, _ = target_values(target, st.t, el.equations)
+            C[:, rows] = v.value - f
+            if along == "t":
+                f_rate[:, rows] = df
+            v.rows(Fq, rows.start)
+            v.weighted_hessian(lam[:, rows], W)
+        if along is None:
+            return C, Fq, W, None, None
+        return C.real, Fq.real, W.real, C.imag / STEP - f_rate, Fq.imag / STEP
+
+
+    def _constraint(self, el, st: State):
+        """(v, target) of an element's rows: with clearance, ``clearance_constraint``."""
+        if el.clearance:
+            return el.clearance_constraint(st, self.start)
+        return el.constraint(st)
+
+
+@dataclass(frozen=True)
+class _MovedLine(LineRef):
+    """A line whose defining point and angle are arrays, one value per row
+    (``Closures.at`` on rows): its direction and normal by NumPy."""
+
+    @property
+    def direction(self):
+        return (np.cos(self.angle), np.sin(self.angle))
+
+    @property
+    def normal(self):
+        return (-np.sin(self.angle), np.cos(self.angle))
+
+
+def _moved(ref, offset: np.ndarray, rows: bool = False):
+    """A point or line reference moved by u − u0 = (dx, dy, dangle) in its solid's frame
+    (``rows``: each an array, one value per row)."""
+    if isinstance(ref, LineRef):
+        line = _MovedLine if rows else type(ref)
+        return line(ref.solid, (ref.point[0] + offset[0], ref.point[1] + offset[1]),
+                    ref.angle + offset[2], ref.label)
+    return replace(ref, local=(ref.local[0] + offset[0], ref.local[1] + offset[1]))
+
