@@ -17,8 +17,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..kinematics import PointSet, State
+from ..kinematics import PER_SOLID, PointSet, State
 from ..model.solid import LineRef
+from ..laws import Law
 from ..model.variation import COMPONENTS
 from .least_norm import Closure
 from .native import target_values
@@ -70,6 +71,9 @@ class Closures:
         for el in mech.constraints:
             self._constraint(el, nominal)
         self._points = PointSet.of(nominal.asked)
+        varied = [el for _, el, _ in self._varied_elements]
+        self._linear = Linear(self, [k for k, el in enumerate(mech.constraints)
+                                     if not any(el is v for v in varied)])
         self.Fj = np.zeros((self.m, self.p))
         k = 0
         for el, rows in zip(mech.constraints, mech.rows):
@@ -169,8 +173,14 @@ class Closures:
         W = np.zeros((n, self.nq, self.nq), dtype)
         f_rate = np.zeros((n, self.m))
         lam = np.asarray(lam, dtype=float)
-        st.prepare(self._points)
-        for el, rows in zip(self.at(t, reached, along), self.mech.rows):
+        fast = along is not None and n == 1 and self._linear.elements
+        if fast:                                  # the ODE's right-hand sides
+            C[0], Fq[0], W[0], f_rate[0] = self._linear.evaluate(st.t, q[0], lam[0])
+        else:
+            st.prepare(self._points)
+        for k, (el, rows) in enumerate(zip(self.at(t, reached, along), self.mech.rows)):
+            if fast and k in self._linear.elements:
+                continue
             v, target = self._constraint(el, st)
             f, df, _ = target_values(target, st.t, el.equations)
             C[:, rows] = v.value - f
@@ -182,12 +192,101 @@ class Closures:
             return C, Fq, W, None, None
         return C.real, Fq.real, W.real, C.imag / STEP - f_rate, Fq.imag / STEP
 
-
     def _constraint(self, el, st: State):
         """(v, target) of an element's rows: with clearance, ``clearance_constraint``."""
         if el.clearance:
             return el.clearance_constraint(st, self.start)
         return el.constraint(st)
+
+
+#: random configurations on which ``Linear`` fits (beyond the unknowns) and checks
+SAMPLES = 8
+
+
+class Linear:
+    """The constraint elements (their indices ``elements``) whose rows are linear in x =
+    (the values of the closure's points and directions, q): v = A x, A found by least
+    squares on random configurations and checked on as many others (a revolute P2 − P1,
+    a fixed solid's or an actuator's coordinates). For the ODE's right-hand sides they are
+    evaluated by products: F_q = A ∂x/∂q, and W from the points' ∂²(A s)/∂fi² = −A s.
+    Their rows do not depend on the varied dimensions; their C_t is −f′ (the laws)."""
+
+    def __init__(self, closures: "Closures", candidates: list[int]):
+        self.points, self.nq, self.m = closures._points, closures.nq, closures.m
+        mech, K = closures.mech, len(closures._points.keys)
+        rng = np.random.default_rng(0)
+        size = 2 * K + self.nq + SAMPLES
+        q = rng.uniform(-np.pi, np.pi, (2 * size, self.nq))
+        x = self.values(q)
+        st = State(np.zeros(2 * size), q, hessians=False)
+        self.elements, self.rows, blocks, self.targets = {}, [], [], []
+        for k in candidates:
+            el, rows = mech.constraints[k], mech.rows[k]
+            v, target = closures._constraint(el, st)
+            A = np.linalg.lstsq(x[:size], v.value[:size], rcond=None)[0].T
+            if np.max(np.abs(x[size:] @ A.T - v.value[size:])) <= 1e-11 * (
+                    1.0 + np.max(np.abs(v.value))):
+                self.elements[k] = el
+                self.rows.append(np.arange(rows.start, rows.stop))
+                blocks.append(A)
+                self.targets.append((rows, target, el.equations))
+        self.rows = np.concatenate(self.rows) if self.rows else np.zeros(0, int)
+        self.A = np.vstack(blocks) if blocks else np.zeros((0, 2 * K + self.nq))
+        s = self.points
+        self.fi = PER_SOLID * s.solids + 2
+        #: the targets that are constants (f, f′ = 0), once; the laws at each evaluation
+        self.constant = np.zeros(self.m)
+        laws = []
+        for rows, target, d in self.targets:
+            if isinstance(target, Law):
+                laws.append((rows, target))
+            else:
+                self.constant[rows] = target_values(target, np.zeros(1), d)[0]
+        self.targets = laws
+        #: ∂x/∂q but its angle columns of the points (``evaluate`` writes them)
+        self.jac = np.zeros((2 * K + self.nq, self.nq))
+        point = np.arange(K)[s.translate]
+        self.jac[2 * point, PER_SOLID * s.solids[s.translate]] = 1.0
+        self.jac[2 * point + 1, PER_SOLID * s.solids[s.translate] + 1] = 1.0
+        self.jac[2 * K:, :] = np.eye(self.nq)
+        self.even, self.odd = 2 * np.arange(K), 2 * np.arange(K) + 1
+
+    def values(self, q: np.ndarray) -> np.ndarray:
+        """x (n, 2K + nq) at the configurations q (n, nq)."""
+        return np.hstack([self._rotated(q)[1].reshape(len(q), -1), q])
+
+    def _rotated(self, q):
+        """(A s (n, K, 2), the points' and directions' values (n, K, 2))."""
+        s = self.points
+        fi = q[:, PER_SOLID * s.solids + 2]
+        c, sn = np.cos(fi), np.sin(fi)
+        As = np.stack([c * s.local[:, 0] - sn * s.local[:, 1],
+                       sn * s.local[:, 0] + c * s.local[:, 1]], axis=-1)
+        origin = np.stack([q[:, PER_SOLID * s.solids], q[:, PER_SOLID * s.solids + 1]],
+                          axis=-1)
+        return As, np.where(s.translate[None, :, None], As + origin, As)
+
+    def evaluate(self, t: np.ndarray, q: np.ndarray, lam: np.ndarray):
+        """(C, F_q, W, f′) of the rows of ``elements`` at one (t, q, λ), zero elsewhere."""
+        K = len(self.points.keys)
+        As, value = self._rotated(q[None])
+        As = As[0]
+        x = np.concatenate([value[0].ravel(), q])
+        jac = self.jac.copy()
+        jac[self.even, self.fi] = -As[:, 1]                  # ∂(A s)/∂fi = Ω A s
+        jac[self.odd, self.fi] = As[:, 0]
+        C, Fq = -self.constant, np.zeros((self.m, self.nq))
+        W, f_rate = np.zeros((self.nq, self.nq)), np.zeros(self.m)
+        C[self.rows] += self.A @ x
+        Fq[self.rows] = self.A @ jac
+        weights = (lam[self.rows] @ self.A[:, :2 * K]).reshape(K, 2)
+        np.add.at(W, (self.fi, self.fi), -np.sum(weights * As, axis=1))
+        for rows, law in self.targets:
+            f, df, _ = law(t)
+            C[rows] -= f[0]
+            f_rate[rows] = df[0]
+        return C, Fq, W, f_rate
+
 
 
 @dataclass(frozen=True)
