@@ -71,9 +71,7 @@ class Closures:
         for el in mech.constraints:
             self._constraint(el, nominal)
         self._points = PointSet.of(nominal.asked)
-        varied = [el for _, el, _ in self._varied_elements]
-        self._linear = Linear(self, [k for k, el in enumerate(mech.constraints)
-                                     if not any(el is v for v in varied)])
+        self._fitted: Linear | None = None
         self.Fj = np.zeros((self.m, self.p))
         k = 0
         for el, rows in zip(mech.constraints, mech.rows):
@@ -109,13 +107,7 @@ class Closures:
         "t" or "s": each offset u − u0 is given the imaginary part ``STEP`` · du/dt (time)
         or ``STEP`` · δ (the path u0 + s δ), the complex step of ``evaluate_rate``."""
         rows = np.ndim(t) > 0
-        moved = {}
-        if self._variations:
-            u, du = self._offsets(np.atleast_1d(t), reached)           # (V, n, 3)
-            if along is not None:
-                u = u + 1j * STEP * (du if along == "t" else self._fixed[:, None])
-            for variation, offset in zip(self._variations, u):
-                moved[id(variation)] = offset.T if rows else offset[0]
+        moved = self._moved_offsets(t, reached, along)
         out = list(self.mech.constraints)
         for index, el, anchors in self._varied_elements:
             refs = list(el.refs)
@@ -126,6 +118,18 @@ class Closures:
             el.ref1, el.ref2 = refs[0], refs[1] if len(refs) > 1 else None
             out[index] = el
         return out
+
+    def _moved_offsets(self, t, reached: float, along: str | None) -> dict:
+        """id(Variation) -> u − u0 (3,) at the time t (an array (3, n) for times (n,)),
+        with the complex step of ``along`` (``at``)."""
+        moved = {}
+        if self._variations:
+            u, du = self._offsets(np.atleast_1d(t), reached)           # (V, n, 3)
+            if along is not None:
+                u = u + 1j * STEP * (du if along == "t" else self._fixed[:, None])
+            for variation, offset in zip(self._variations, u):
+                moved[id(variation)] = offset.T if np.ndim(t) > 0 else offset[0]
+        return moved
 
     def _offsets(self, t: np.ndarray, reached: float):
         """u − u0 and u′ (V, n, 3) of every varied anchor's Variation at the times t (n,):
@@ -175,7 +179,10 @@ class Closures:
         lam = np.asarray(lam, dtype=float)
         fast = along is not None and n == 1 and self._linear.elements
         if fast:                                  # the ODE's right-hand sides
-            C[0], Fq[0], W[0], f_rate[0] = self._linear.evaluate(st.t, q[0], lam[0])
+            moved = self._moved_offsets(t, reached, along)
+            C[0], Fq[0], W[0], f_rate[0] = self._linear.evaluate(st.t, q[0], lam[0], moved)
+            if len(self._linear.elements) == len(self.mech.constraints):
+                return C.real, Fq.real, W.real, C.imag / STEP - f_rate, Fq.imag / STEP
         else:
             st.prepare(self._points)
         for k, (el, rows) in enumerate(zip(self.at(t, reached, along), self.mech.rows)):
@@ -191,6 +198,16 @@ class Closures:
         if along is None:
             return C, Fq, W, None, None
         return C.real, Fq.real, W.real, C.imag / STEP - f_rate, Fq.imag / STEP
+
+    @property
+    def _linear(self) -> "Linear":
+        """The elements evaluated by products in the ODE's right-hand sides (``Linear``),
+        found when first needed (a run with no ODE never fits them)."""
+        if self._fitted is None:
+            lines = [el for el, a, _ in self.varied if isinstance(el.refs[a], LineRef)]
+            self._fitted = Linear(self, [k for k, el in enumerate(self.mech.constraints)
+                                         if not any(el is e for e in lines)])
+        return self._fitted
 
     def _constraint(self, el, st: State):
         """(v, target) of an element's rows: with clearance, ``clearance_constraint``."""
@@ -220,6 +237,9 @@ class Linear:
         x = self.values(q)
         st = State(np.zeros(2 * size), q, hessians=False)
         self.elements, self.rows, blocks, self.targets = {}, [], [], []
+        #: (rows, ∂v/∂P (d, 2), the point's solid, id(Variation)) of every varied point
+        #: anchor of an element here: v moves by ∂v/∂P A(fi) δ with the point's offset δ
+        self.moves: list[tuple] = []
         for k in candidates:
             el, rows = mech.constraints[k], mech.rows[k]
             v, target = closures._constraint(el, st)
@@ -230,6 +250,7 @@ class Linear:
                 self.rows.append(np.arange(rows.start, rows.stop))
                 blocks.append(A)
                 self.targets.append((rows, target, el.equations))
+                self.moves += self._moves(closures, el, rows)
         self.rows = np.concatenate(self.rows) if self.rows else np.zeros(0, int)
         self.A = np.vstack(blocks) if blocks else np.zeros((0, 2 * K + self.nq))
         s = self.points
@@ -251,6 +272,30 @@ class Linear:
         self.jac[2 * K:, :] = np.eye(self.nq)
         self.even, self.odd = 2 * np.arange(K), 2 * np.arange(K) + 1
 
+    @staticmethod
+    def _moves(closures: "Closures", el, rows: slice) -> list[tuple]:
+        """``moves`` of an element linear in its points: ∂v/∂P of each varied point anchor,
+        from its values with the point's local coordinates moved by (1, 0) and (0, 1) at
+        q = 0 (A(fi) = I there; exact for rows linear in P)."""
+        out = []
+        for e, a, variation in closures.varied:
+            if e is not el:
+                continue
+            st = State([0.0], np.zeros((1, closures.nq)), jacobians=False)
+            base = closures._constraint(el, st)[0].value[0]
+            G = []
+            for unit in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)):
+                shifted = copy.copy(el)
+                refs = list(el.refs)
+                refs[a] = _moved(refs[a], np.array(unit))
+                shifted.refs = tuple(refs)
+                shifted.ref1, shifted.ref2 = refs[0], refs[1] if len(refs) > 1 else None
+                st = State([0.0], np.zeros((1, closures.nq)), jacobians=False)
+                G.append(closures._constraint(shifted, st)[0].value[0] - base)
+            out.append((np.arange(rows.start, rows.stop), np.array(G).T,
+                        el.refs[a].solid, id(variation)))
+        return out
+
     def values(self, q: np.ndarray) -> np.ndarray:
         """x (n, 2K + nq) at the configurations q (n, nq)."""
         return np.hstack([self._rotated(q)[1].reshape(len(q), -1), q])
@@ -266,8 +311,10 @@ class Linear:
                           axis=-1)
         return As, np.where(s.translate[None, :, None], As + origin, As)
 
-    def evaluate(self, t: np.ndarray, q: np.ndarray, lam: np.ndarray):
-        """(C, F_q, W, f′) of the rows of ``elements`` at one (t, q, λ), zero elsewhere."""
+    def evaluate(self, t: np.ndarray, q: np.ndarray, lam: np.ndarray, moved: dict):
+        """(C, F_q, W, f′) of the rows of ``elements`` at one (t, q, λ), zero elsewhere, their
+        varied points at the offsets ``moved`` (id(Variation) -> u − u0, complex in a complex
+        step: then so are C, F_q and W)."""
         K = len(self.points.keys)
         As, value = self._rotated(q[None])
         As = As[0]
@@ -285,6 +332,16 @@ class Linear:
             f, df, _ = law(t)
             C[rows] -= f[0]
             f_rate[rows] = df[0]
+        if self.moves:
+            C, Fq, W = C.astype(complex), Fq.astype(complex), W.astype(complex)
+        for rows, G, solid, variation in self.moves:
+            dx, dy = moved[variation][0], moved[variation][1]
+            fi = q[PER_SOLID * solid + 2]
+            c, sn = np.cos(fi), np.sin(fi)
+            Ad = np.array([c * dx - sn * dy, sn * dx + c * dy])       # A(fi) δ
+            C[rows] += G @ Ad
+            Fq[rows, PER_SOLID * solid + 2] += G @ np.array([-Ad[1], Ad[0]])
+            W[PER_SOLID * solid + 2, PER_SOLID * solid + 2] -= lam[rows] @ (G @ Ad)
         return C, Fq, W, f_rate
 
 

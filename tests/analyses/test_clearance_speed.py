@@ -56,7 +56,7 @@ def test_h_t_is_the_rate_of_h_along_the_time_and_the_straight_path():
             np.testing.assert_allclose(getattr(c, name), getattr(plain, name), rtol=0,
                                        atol=1e-14)
     mech = closures.mech
-    assert [mech.constraints[k].name for k in sorted(closures._linear.elements)] == [
+    assert [mech.constraints[k].name for k in sorted(closures._fitted.elements)] == [
         mech.constraints[0].name, "turn"]
     c, h_s = closures.evaluate_rate(0.0, q, lam, reached=0.4, along="s")
     d = 1e-4                                                    # h is smooth in s
@@ -123,3 +123,31 @@ def test_without_a_clearance_joint_the_positions_are_the_kinematic_ones(request)
     np.testing.assert_allclose(q, y[:, :closures.nq], rtol=0, atol=1e-12)
     for t, row in zip(res.t, q):
         assert np.max(np.abs(closures.evaluate(t, row, np.zeros(closures.m)).F)) <= 1e-13
+
+
+def test_varied_points_of_linear_elements_move_by_their_rate(request):
+    """The locomotive: every element is linear in its points (``closures.Linear``), two of
+    them with a varied point (axle 2's frame.O2, pin 3's wheel3.A), moved by ∂v/∂P A(fi) δ
+    in the right-hand sides: h_t against the central difference of h in t (to its own
+    error, F_qtᵀλ included), the Closure against ``evaluate``'s to rounding."""
+    model = pam2exu.load(request.config.rootpath / "examples/clearance/locomotive.toml")
+    res = _quiet(model, analysis="assembly")
+    mech = model.mechanism()
+    q = np.array([res[f"{s.name}.{k}"][0] for s in mech.solids for k in ("x", "y", "fi")])
+    q = q + 0.01                                          # off the assembly: F ≠ 0
+    closures = Closures(mech, q)
+    lam = np.linspace(-1.0, 1.0, closures.m)
+    for t in (0.7, 3.1):
+        c, h_t = closures.evaluate_rate(t, q, lam)
+        assert len(closures._fitted.elements) == len(mech.constraints)
+        assert len(closures._fitted.moves) == 2
+        d = 1e-5
+        reference = (_h(closures, t + d, q, lam) - _h(closures, t - d, q, lam)) / (2 * d)
+        np.testing.assert_allclose(h_t, reference, rtol=0, atol=1e-9)
+        rows = slice(closures.p, closures.p + closures.nq)               # F_qtᵀλ
+        np.testing.assert_allclose(h_t[rows], reference[rows], rtol=0, atol=1e-10)
+        assert np.max(np.abs(h_t[rows])) > 1e-5
+        plain = closures.evaluate(t, q, lam)
+        for name in ("F", "Fq", "W"):
+            np.testing.assert_allclose(getattr(c, name), getattr(plain, name), rtol=0,
+                                       atol=1e-14)
