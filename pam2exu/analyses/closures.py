@@ -170,20 +170,25 @@ class Closures:
         """(C, F_q, W, C_t, F_qt) at the rows (t, q, λ) (t a float for one row; the last
         two None without ``along``)."""
         n = q.shape[0]
-        st = State(np.broadcast_to(t, (n,)), np.asarray(q, dtype=float), hessians=True)
-        dtype = complex if along is not None else float
-        C = np.zeros((n, self.m), dtype)
-        Fq = np.zeros((n, self.m, self.nq), dtype)
-        W = np.zeros((n, self.nq, self.nq), dtype)
-        f_rate = np.zeros((n, self.m))
         lam = np.asarray(lam, dtype=float)
         fast = along is not None and n == 1 and self._linear.elements
         if fast:                                  # the ODE's right-hand sides
             moved = self._moved_offsets(t, reached, along)
-            C[0], Fq[0], W[0], f_rate[0] = self._linear.evaluate(st.t, q[0], lam[0], moved)
+            C, Fq, W, f_rate = self._linear.evaluate(np.array([t], dtype=float), q[0],
+                                                     lam[0], moved)
             if len(self._linear.elements) == len(self.mech.constraints):
-                return C.real, Fq.real, W.real, C.imag / STEP - f_rate, Fq.imag / STEP
+                return (C.real[None], Fq.real[None], W.real[None],
+                        (C.imag / STEP - f_rate)[None], (Fq.imag / STEP)[None])
+        st = State(np.broadcast_to(t, (n,)), np.asarray(q, dtype=float), hessians=True)
+        dtype = complex if along is not None else float
+        if fast:
+            C, Fq, W, f_rate = (a[None].astype(dtype) for a in (C, Fq, W, f_rate))
+            f_rate = f_rate.real
         else:
+            C = np.zeros((n, self.m), dtype)
+            Fq = np.zeros((n, self.m, self.nq), dtype)
+            W = np.zeros((n, self.nq, self.nq), dtype)
+            f_rate = np.zeros((n, self.m))
             st.prepare(self._points)
         for k, (el, rows) in enumerate(zip(self.at(t, reached, along), self.mech.rows)):
             if fast and k in self._linear.elements:
