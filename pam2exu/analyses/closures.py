@@ -276,6 +276,10 @@ class Linear:
         self.jac[2 * point + 1, PER_SOLID * s.solids[s.translate] + 1] = 1.0
         self.jac[2 * K:, :] = np.eye(self.nq)
         self.even, self.odd = 2 * np.arange(K), 2 * np.arange(K) + 1
+        #: the entries of x that are points' coordinates, and the columns of q added there
+        self.shift = np.r_[2 * point, 2 * point + 1]
+        self.origin = np.r_[PER_SOLID * s.solids[s.translate],
+                            PER_SOLID * s.solids[s.translate] + 1]
 
     @staticmethod
     def _moves(closures: "Closures", el, rows: slice) -> list[tuple]:
@@ -320,19 +324,23 @@ class Linear:
         """(C, F_q, W, f′) of the rows of ``elements`` at one (t, q, λ), zero elsewhere, their
         varied points at the offsets ``moved`` (id(Variation) -> u − u0, complex in a complex
         step: then so are C, F_q and W)."""
-        K = len(self.points.keys)
-        As, value = self._rotated(q[None])
-        As = As[0]
-        x = np.concatenate([value[0].ravel(), q])
+        K, s = len(self.points.keys), self.points
+        c, sn = np.cos(q[self.fi]), np.sin(q[self.fi])
+        x = np.empty(2 * K + self.nq)
+        x[self.even] = c * s.local[:, 0] - sn * s.local[:, 1]      # A s
+        x[self.odd] = sn * s.local[:, 0] + c * s.local[:, 1]
         jac = self.jac.copy()
-        jac[self.even, self.fi] = -As[:, 1]                  # ∂(A s)/∂fi = Ω A s
-        jac[self.odd, self.fi] = As[:, 0]
+        jac[self.even, self.fi] = -x[self.odd]                      # ∂(A s)/∂fi = Ω A s
+        jac[self.odd, self.fi] = x[self.even]
+        weights = lam[self.rows] @ self.A[:, :2 * K]
+        curvature = -(weights[self.even] * x[self.even] + weights[self.odd] * x[self.odd])
+        x[self.shift] += q[self.origin]                             # points: R + A s
+        x[2 * K:] = q
         C, Fq = -self.constant, np.zeros((self.m, self.nq))
-        W, f_rate = np.zeros((self.nq, self.nq)), np.zeros(self.m)
+        f_rate = np.zeros(self.m)
         C[self.rows] += self.A @ x
         Fq[self.rows] = self.A @ jac
-        weights = (lam[self.rows] @ self.A[:, :2 * K]).reshape(K, 2)
-        np.add.at(W, (self.fi, self.fi), -np.sum(weights * As, axis=1))
+        W = np.diag(np.bincount(self.fi, curvature, minlength=self.nq))   # ∂²(A s)/∂fi²
         for rows, law in self.targets:
             f, df, _ = law(t)
             C[rows] -= f[0]
