@@ -201,12 +201,13 @@ class Solver:
         active = np.arange(len(t))
         eps = np.finfo(float).eps
         last = np.full(len(t), np.inf)        # the previous step's size
+        g = terms.targets(t, 0)               # the laws' values, the same every iteration
         for _ in range(self.settings.max_iterations):
             if not active.size:
                 break
-            ta, za = t[active], z[active]
+            ta, za, ga = t[active], z[active], g[:, active]
             with np.errstate(all="ignore"):
-                phi = terms.residual(ta, za)
+                phi = terms.residual(ta, za, ga)
                 dz = self.solve(terms.jacobian(za), -phi)
                 step = np.max(np.abs(dz) * self.w, axis=1, initial=0.0)
                 small = step <= tol
@@ -214,7 +215,8 @@ class Solver:
                 ask = ~small | self.least_squares
                 size = np.zeros_like(phi)
                 if ask.any():
-                    magnitude = np.maximum(terms.magnitude(ta[ask], za[ask]), self.floor.T)
+                    magnitude = np.maximum(terms.magnitude(ta[ask], za[ask], ga[:, ask]),
+                                           self.floor.T)
                     size[ask] = np.divide(np.abs(phi[ask]), magnitude,
                                           out=np.abs(phi[ask]) * np.inf, where=magnitude > 0)
                     size[phi == 0] = 0.0
@@ -415,10 +417,11 @@ class Solver:
         rhs = np.empty((terms.m, 2, len(t)))
         rhs[:, 1] = terms.velocity_rhs_cols(t)[order]
         w = self.w[:, None]
+        g = terms.targets(t, 0)
         with np.errstate(all="ignore"):
             for _ in range(iterations):
                 A = terms.dense_cols(terms.jacobian_cols(z))[order]
-                rhs[:, 0] = -terms.residual_cols(t, z)[order]
+                rhs[:, 0] = -terms.residual_cols(t, z, g)[order]
                 swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
                 if not regular.all():
                     return None

@@ -18,6 +18,12 @@ from scipy import sparse
 from ...laws import Law
 from .forms import ONE
 
+#: up to this many steps, terms are summed by ``numpy.bincount`` (one call, no sparse-matrix
+#: overhead); above, by the sparse summing matrix (``_summer``): both add each row's terms
+#: one after the other in the terms' order, so the two give the same bits
+BINCOUNT_STEPS = 32
+
+
 def _summer(index: np.ndarray, size: int) -> sparse.csr_matrix:
     """S (size, len(index)) with S[index[k], k] = 1: S @ values (k, n) sums the values per
     index, term after term (sparse: the same sum in the same order whatever n, so that a
@@ -57,16 +63,18 @@ class Terms:
         self.pc = p[:, 3]
         self.sr, self.sa, self.sb = (s[:, k].astype(int) for k in range(3))
         self.salpha, self.sc = s[:, 3], s[:, 4]
-        self.row_sum = _summer(np.r_[self.pr, self.sr], self.m)
+        self.row_index = np.r_[self.pr, self.sr]
+        self.row_sum = _summer(self.row_index, self.m)
+        self.law_rows = np.array([r for r, _, _ in self.laws], dtype=int)
+        # the terms' constants as columns, kept (evaluations broadcast them over the steps)
+        self._pc, self._sc, self._alpha = self.pc[:, None], self.sc[:, None], self.salpha[:, None]
+        self._apc, self._asc = np.abs(self._pc), np.abs(self._sc)
 
         # Jacobian entries: (row, column) of each term's derivative, ONE columns left out
-        entries = [(self.pr, self.pa, "p_b"), (self.pr, self.pb, "p_a"),
-                   (self.sr, self.sa, "s_sin"), (self.sr, self.sb, "s_cos")]
-        self._entry_kinds = []
+        entries = [(self.pr, self.pa), (self.pr, self.pb), (self.sr, self.sa), (self.sr, self.sb)]
         rr, cc = [], []
-        for rows_, cols, kind in entries:
+        for rows_, cols in entries:
             keep = cols != nz
-            self._entry_kinds.append((kind, keep))
             rr.append(rows_[keep])
             cc.append(cols[keep])
         rr, cc = np.concatenate(rr), np.concatenate(cc)
@@ -74,7 +82,17 @@ class Terms:
         pattern, where = np.unique(flat, return_inverse=True)
         #: the Jacobian's nonzero pattern: Φ_z[:, rows[k], cols[k]] = data[:, k]
         self.rows, self.cols = pattern // max(nz, 1), pattern % max(nz, 1)
+        self.entry_index = where
         self.entry_sum = _summer(where, len(pattern))
+        # the Jacobian's terms in the order of ``entries``: products c z_other (both
+        # derivatives in one gather), then c sin(z_b + α) and c z_a cos(z_b + α)
+        kb, ka = self.pa != nz, self.pb != nz
+        ks, kc = self.sa != nz, self.sb != nz
+        self._jp_c = np.r_[self.pc[kb], self.pc[ka]][:, None]
+        self._jp_i = np.r_[self.pb[kb], self.pa[ka]]
+        self._js_c, self._js_b, self._js_alpha = self._sc[ks], self.sb[ks], self._alpha[ks]
+        self._jc_c, self._jc_a, self._jc_b = self._sc[kc], self.sa[kc], self.sb[kc]
+        self._jc_alpha = self._alpha[kc]
 
     # ---- evaluation: one column per step --------------------------------------------------
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
@@ -88,59 +106,62 @@ class Terms:
         return out
 
     @staticmethod
-    def _sum(values: np.ndarray, S) -> np.ndarray:
-        """S values: the terms' values (k, n) summed per row or entry (``_summer``)."""
-        return np.asarray(S @ values)
+    def _sum(values: np.ndarray, index: np.ndarray, size: int, S) -> np.ndarray:
+        """The terms' values (k, n) summed per row or entry: out[index[k]] += values[k],
+        term after term (``numpy.bincount`` for a few steps, else S values, ``_summer``)."""
+        n = values.shape[1]
+        if n > BINCOUNT_STEPS:
+            return np.asarray(S @ values)
+        flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
+        return np.bincount(flat, weights=values.ravel(), minlength=size * n).reshape(size, n)
 
-    def _targets(self, t: np.ndarray, order: int) -> list:
-        """[(row, g^(order)(t))] of the rows with a law: g = f or f²."""
-        out = []
-        for r, law, power in self.laws:
+    def targets(self, t: np.ndarray, order: int) -> np.ndarray:
+        """g^(order)(t) (laws, n) of the rows with a law (``law_rows``): g = f or f²."""
+        out = np.empty((len(self.laws), len(t)))
+        for k, (r, law, power) in enumerate(self.laws):
             f, df, ddf = law(t)
             if power == 1:
-                g = (f, df, ddf)[order]
+                out[k] = (f, df, ddf)[order]
             else:
-                g = (f * f, 2 * f * df, 2 * (df * df + f * ddf))[order]
-            out.append((r, g))
+                out[k] = (f * f, 2 * f * df, 2 * (df * df + f * ddf))[order]
         return out
 
-    def residual_cols(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """Φ(z, t) (m, n)."""
+    def residual_cols(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
+                      ) -> np.ndarray:
+        """Φ(z, t) (m, n); g: ``targets(t, 0)`` when already known."""
         x = self._ext(z)
-        values = np.concatenate([self.pc[:, None] * x[self.pa] * x[self.pb],
-                                 self.sc[:, None] * x[self.sa]
-                                 * np.sin(x[self.sb] + self.salpha[:, None])])
-        out = self._sum(values, self.row_sum)
-        for r, g in self._targets(t, 0):
-            out[r] -= g
+        values = np.concatenate([self._pc * x[self.pa] * x[self.pb],
+                                 self._sc * x[self.sa] * np.sin(x[self.sb] + self._alpha)])
+        out = self._sum(values, self.row_index, self.m, self.row_sum)
+        if self.laws:
+            out[self.law_rows] -= self.targets(t, 0) if g is None else g
         return out
 
-    def magnitude_cols(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """Σ |terms| per row (m, n): the size round-off errors of Φ scale with."""
+    def magnitude_cols(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
+                       ) -> np.ndarray:
+        """Σ |terms| per row (m, n): the size round-off errors of Φ scale with; g:
+        ``targets(t, 0)`` when already known."""
         x = np.abs(self._ext(z))
-        values = np.concatenate([np.abs(self.pc)[:, None] * x[self.pa] * x[self.pb],
-                                 np.abs(self.sc)[:, None] * x[self.sa]])
-        out = self._sum(values, self.row_sum)
-        for r, g in self._targets(t, 0):
-            out[r] += np.abs(g)
+        values = np.concatenate([self._apc * x[self.pa] * x[self.pb], self._asc * x[self.sa]])
+        out = self._sum(values, self.row_index, self.m, self.row_sum)
+        if self.laws:
+            out[self.law_rows] += np.abs(self.targets(t, 0) if g is None else g)
         return out
 
     def magnitude_at(self, scales: np.ndarray) -> np.ndarray:
         """Σ |terms| per row (m,) with every coordinate at its scale (nz,)."""
         x = np.r_[scales, 1.0][:, None]
-        values = np.concatenate([np.abs(self.pc)[:, None] * x[self.pa] * x[self.pb],
-                                 np.abs(self.sc)[:, None] * x[self.sa]])
-        return self._sum(values, self.row_sum)[:, 0]
+        values = np.concatenate([self._apc * x[self.pa] * x[self.pb], self._asc * x[self.sa]])
+        return self._sum(values, self.row_index, self.m, self.row_sum)[:, 0]
 
     def jacobian_cols(self, z: np.ndarray) -> np.ndarray:
         """Φ_z as data (nnz, n) on the pattern (``rows``, ``cols``)."""
         x = self._ext(z)
-        arg = x[self.sb] + self.salpha[:, None]
-        pc, sc = self.pc[:, None], self.sc[:, None]
-        parts = {"p_b": pc * x[self.pb], "p_a": pc * x[self.pa],
-                 "s_sin": sc * np.sin(arg), "s_cos": sc * x[self.sa] * np.cos(arg)}
-        values = np.concatenate([parts[kind][keep] for kind, keep in self._entry_kinds])
-        return self._sum(values, self.entry_sum)
+        values = np.concatenate([
+            self._jp_c * x[self._jp_i],
+            self._js_c * np.sin(x[self._js_b] + self._js_alpha),
+            self._jc_c * x[self._jc_a] * np.cos(x[self._jc_b] + self._jc_alpha)])
+        return self._sum(values, self.entry_index, len(self.rows), self.entry_sum)
 
     def dense_cols(self, data: np.ndarray) -> np.ndarray:
         """Φ_z (m, nz, n) from its data (nnz, n)."""
@@ -151,32 +172,34 @@ class Terms:
     def velocity_rhs_cols(self, t: np.ndarray) -> np.ndarray:
         """g'(t) (m, n): Φ_z ż = g' (−Φ_t)."""
         out = np.zeros((self.m, len(t)))
-        for r, g in self._targets(t, 1):
-            out[r] = g
+        if self.laws:
+            out[self.law_rows] = self.targets(t, 1)
         return out
 
     def gamma_cols(self, t: np.ndarray, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
         """γ (m, n): Φ_z z̈ = γ = g'' − (d/dt Φ_z) ż."""
         x, v = self._ext(z), np.zeros((self.nz + 1, z.shape[1]))
         v[:self.nz] = zd
-        arg = x[self.sb] + self.salpha[:, None]
+        arg = x[self.sb] + self._alpha
         wb = v[self.sb]
         values = np.concatenate([
-            2.0 * self.pc[:, None] * v[self.pa] * v[self.pb],
-            self.sc[:, None] * wb * (2.0 * v[self.sa] * np.cos(arg) - x[self.sa] * wb * np.sin(arg))])
-        out = -self._sum(values, self.row_sum)
-        for r, g in self._targets(t, 2):
-            out[r] += g
+            2.0 * self._pc * v[self.pa] * v[self.pb],
+            self._sc * wb * (2.0 * v[self.sa] * np.cos(arg) - x[self.sa] * wb * np.sin(arg))])
+        out = -self._sum(values, self.row_index, self.m, self.row_sum)
+        if self.laws:
+            out[self.law_rows] += self.targets(t, 2)
         return out
 
     # ---- evaluation: one row per step -------------------------------------------------------
-    def residual(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """Φ(z, t) (n, m)."""
-        return self.residual_cols(t, z.T).T
+    def residual(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
+                 ) -> np.ndarray:
+        """Φ(z, t) (n, m); g: ``targets(t, 0)`` when already known."""
+        return self.residual_cols(t, z.T, g).T
 
-    def magnitude(self, t: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """Σ |terms| per row (n, m)."""
-        return self.magnitude_cols(t, z.T).T
+    def magnitude(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
+                  ) -> np.ndarray:
+        """Σ |terms| per row (n, m); g: ``targets(t, 0)`` when already known."""
+        return self.magnitude_cols(t, z.T, g).T
 
     def jacobian(self, z: np.ndarray) -> np.ndarray:
         """Φ_z as data (n, nnz) on the pattern (``rows``, ``cols``)."""
