@@ -21,6 +21,7 @@ before the run stops there. Runs shorter than SHORT steps are solved step by ste
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -195,6 +196,8 @@ class Solver:
     # ---- Newton -------------------------------------------------------------------------------
     def newton(self, t: np.ndarray, z: np.ndarray):
         """(z, ok) after Newton's iteration from z at every step at once."""
+        if len(t) == 1:
+            return self._newton_one(t, z)
         terms, tol = self.terms, self.settings.tolerance
         z = np.array(z, dtype=float)
         ok = np.zeros(len(t), dtype=bool)
@@ -236,6 +239,42 @@ class Solver:
             ok[active[done]] = True
             active = active[finite & ~done]
         return z, ok
+
+    def _newton_one(self, t: np.ndarray, z: np.ndarray):
+        """``newton`` at one step (t (1,), z (1, nz)): the same arithmetic, without the
+        bookkeeping of the steps still active (the sequential passes call it step by step)."""
+        terms, tol, w = self.terms, self.settings.tolerance, self.w
+        x = np.array(z[0], dtype=float)
+        eps = np.finfo(float).eps
+        done_below = max(64 * eps, 100 * tol)
+        last = np.inf
+        g = terms.targets(t, 0)
+        for _ in range(self.settings.max_iterations):
+            zc = x[:, None]
+            with np.errstate(all="ignore"):
+                phi = terms.residual_cols(t, zc, g)[:, 0]
+                dz = self.solve(terms.jacobian_cols(zc).T, -phi[None])[0]
+                step = float(np.max(np.abs(dz) * w, initial=0.0))
+                small = step <= tol
+                floor = True                   # Φ within round-off of its terms
+                if not small or self.least_squares:
+                    magnitude = np.maximum(terms.magnitude_cols(t, zc, g)[:, 0], self.floor[:, 0])
+                    size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
+                                     where=magnitude > 0)
+                    size[phi == 0] = 0.0
+                    floor = bool(np.all(size <= 64 * eps))
+                    if self.least_squares:
+                        small = small and bool(np.all(size <= done_below))
+            self.iterations += 1
+            if not math.isfinite(step):
+                return x[None], np.zeros(1, dtype=bool)
+            stalled = floor and step > 0.7 * last
+            if not stalled:
+                x = x + dz
+            last = step
+            if small or stalled:
+                return x[None], np.ones(1, dtype=bool)
+        return x[None], np.zeros(1, dtype=bool)
 
     def damped(self, t: float, z: np.ndarray, iterations: int = 200):
         """(z, ok): Newton's iteration at one time from a poor guess, each step shortened
