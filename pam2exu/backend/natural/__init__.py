@@ -53,8 +53,10 @@ class Natural(Backend):
 
     def weights(self, form: Formulation, mech) -> np.ndarray:
         """What Newton's step is measured in: points / L, unit vectors and angles as they are."""
-        L = mech.scale()
-        return np.array([1.0 / L if c.kind == "point" else 1.0 for c in form.coordinates])
+        def make():
+            L = mech.scale()
+            return np.array([1.0 / L if c.kind == "point" else 1.0 for c in form.coordinates])
+        return _kept(form, "weights", make)
 
     def solve_positions(self, mech, times, start, settings, *, redundant=False, forces=False,
                         anchor_stiffness=0.0, rates=False) -> Positions:
@@ -160,7 +162,7 @@ class Natural(Backend):
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
         value in the whole turn nearest ``start`` (in chunks of steps: bounded memory; one
         row per quantity inside, the step axis last)."""
-        K = _summing(form.pose_forms())
+        K = _kept(form, "pose_sum", lambda: _summing(form.pose_forms()))
         kind = self._angle_kinds(form)
         qT = np.empty((mech.nq, len(z)))             # one row per x, y, fi
         free, c = kind.free, kind.coordinate
@@ -187,6 +189,10 @@ class Natural(Backend):
 
     def _angle_kinds(self, form: Formulation):
         """Which solids' fi are constant (ground), an angle coordinate, or atan2 of the vector."""
+        return _kept(form, "angle_kinds", lambda: self._find_angle_kinds(form))
+
+    @staticmethod
+    def _find_angle_kinds(form: Formulation):
         fixed = [i for i, f in enumerate(form.frames) if f.fixed_angle is not None]
         coordinate = [i for i, f in enumerate(form.frames)
                       if f.fixed_angle is None and f.angle is not None]
@@ -201,8 +207,8 @@ class Natural(Backend):
     def to_rates(self, form: Formulation, mech, z, zd, zdd):
         """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
         (in chunks of steps: bounded memory; one row per quantity inside)."""
-        K = form.pose_forms()
-        Kz, K = _summing(K[:, :form.nz]), _summing(K)
+        K = _kept(form, "pose_sum", lambda: _summing(form.pose_forms()))
+        Kz = _kept(form, "pose_rate_sum", lambda: _summing(form.pose_forms()[:, :form.nz]))
         kind = self._angle_kinds(form)
         qdT, qddT = np.empty((mech.nq, len(z))), np.empty((mech.nq, len(z)))
         f, c = kind.free, kind.coordinate
@@ -226,6 +232,15 @@ class Natural(Backend):
 
 #: steps converted to x, y, fi at a time
 CONVERT_ROWS = 1 << 16
+
+
+def _kept(form: Formulation, name: str, make):
+    """What ``make()`` returns for this formulation, made once (it depends only on the
+    mechanism)."""
+    kept = form.__dict__.setdefault("_kept", {})
+    if name not in kept:
+        kept[name] = make()
+    return kept[name]
 
 
 def _ext(zT: np.ndarray) -> np.ndarray:

@@ -31,6 +31,10 @@ from ...batched import lu_factor, lu_solve
 #: from this many coordinates on, a chunk of steps is solved as one sparse block-diagonal
 #: system (cost linear in the mechanism's size) instead of dense batched solves
 SPARSE_FROM = 40
+#: a few steps of a larger system are still solved dense (LAPACK per step) while
+#: steps × coordinates² is at most this: a sparse LU's set-up costs more (measured: one
+#: step of 129 coordinates, 0.2 ms dense against 0.3 ms sparse)
+DENSE_WORK = 20_000
 #: intervals of the coarse pass (fewer when the run is short)
 COARSE = 100
 #: runs shorter than this are solved step by step
@@ -104,7 +108,8 @@ class Solver:
         n = data.shape[0]
         if terms.nz == 0:
             return np.zeros((n, 0))
-        if not self.least_squares and terms.nz < SPARSE_FROM and n < BATCHED_FROM:
+        if not self.least_squares and n < BATCHED_FROM and (
+                terms.nz < SPARSE_FROM or n * terms.nz ** 2 <= DENSE_WORK):
             try:                               # a diverged step gives NaN here too
                 return np.linalg.solve(terms.dense(data), b[..., None])[..., 0]
             except np.linalg.LinAlgError:

@@ -66,6 +66,7 @@ class Terms:
         self.row_index = np.r_[self.pr, self.sr]
         self.row_sum = _summer(self.row_index, self.m)
         self.law_rows = np.array([r for r, _, _ in self.laws], dtype=int)
+        self._last_times, self._last_laws = None, []
         # the terms' constants as columns, kept (evaluations broadcast them over the steps)
         self._pc, self._sc, self._alpha = self.pc[:, None], self.sc[:, None], self.salpha[:, None]
         self._apc, self._asc = np.abs(self._pc), np.abs(self._sc)
@@ -115,11 +116,21 @@ class Terms:
         flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
         return np.bincount(flat, weights=values.ravel(), minlength=size * n).reshape(size, n)
 
+    def _law_values(self, t: np.ndarray) -> list:
+        """[(f, f', f'')] of every law at the times t; for a few steps, the values at the
+        times last asked are kept (a step's Newton iteration, velocities and accelerations
+        ask for the same times)."""
+        if len(t) > BINCOUNT_STEPS:
+            return [law(t) for _, law, _ in self.laws]
+        key = np.asarray(t, dtype=float).tobytes()
+        if self._last_times != key:
+            self._last_times, self._last_laws = key, [law(t) for _, law, _ in self.laws]
+        return self._last_laws
+
     def targets(self, t: np.ndarray, order: int) -> np.ndarray:
         """g^(order)(t) (laws, n) of the rows with a law (``law_rows``): g = f or f²."""
         out = np.empty((len(self.laws), len(t)))
-        for k, (r, law, power) in enumerate(self.laws):
-            f, df, ddf = law(t)
+        for k, ((r, law, power), (f, df, ddf)) in enumerate(zip(self.laws, self._law_values(t))):
             if power == 1:
                 out[k] = (f, df, ddf)[order]
             else:
