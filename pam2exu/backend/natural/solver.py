@@ -37,6 +37,14 @@ SPARSE_FROM = 40
 DENSE_WORK = 20_000
 #: intervals of the coarse pass (fewer when the run is short)
 COARSE = 100
+#: the coarse pass's interval doubles where the predictor missed by less than
+#: COARSE_MISS / COARSE_GROW (the Taylor predictor's miss grows as the interval cubed: the
+#: doubled interval misses by about COARSE_MISS / 2), up to COARSE_LONGEST times its start:
+#: the run's own motion sets the coarse pass's size (a short run of a slow mechanism takes
+#: fewer sequential steps), within a bound that keeps the intervals short enough to stay
+#: on the branch
+COARSE_GROW = 16
+COARSE_LONGEST = 4
 #: runs shorter than this are solved step by step
 SHORT = 64
 #: the coarse predictor may miss by this much (relative: lengths / L, angles in rad)
@@ -376,8 +384,8 @@ class Solver:
             if miss > COARSE_MISS:             # a shorter interval
                 stride = max(1, stride // 4)
                 continue
-            if miss < COARSE_MISS / 64:
-                stride = min(base, 2 * stride)
+            if miss < COARSE_MISS / COARSE_GROW:
+                stride = min(COARSE_LONGEST * base, 2 * stride)
             z[j] = zj[0]
             self._keep_rates(t, z, j)
             intervals.append((k, j, miss))
