@@ -269,8 +269,10 @@ class Solver:
                 dz = self.solve(terms.jacobian_cols(zc).T, -phi[None])[0]
                 step = float(np.max(np.abs(dz) * w, initial=0.0))
                 small = step <= tol
-                floor = True                   # Φ within round-off of its terms
-                if not small or self.least_squares:
+                # Φ within round-off of its terms: it decides only a step that did not
+                # shrink (``stalled``) or a least-squares one
+                floor = True
+                if self.least_squares or (not small and step > 0.7 * last):
                     magnitude = np.maximum(terms.magnitude_cols(t, zc, g)[:, 0], self.floor[:, 0])
                     size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
                                      where=magnitude > 0)
