@@ -134,7 +134,7 @@ class Solver:
                 if x is not None:
                     return x
             elif n >= BATCHED_FROM:
-                A = terms.dense_cols(data.T)[self.order]
+                A = terms.dense_cols(data.T, self.order)
                 swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
                 x = lu_solve(A, swaps, b.T[self.order]).T
                 if not regular.all():              # singular: NaN (``_least_squares``)
@@ -474,7 +474,7 @@ class Solver:
         g = terms.targets(t, 0)
         with np.errstate(all="ignore"):
             for _ in range(iterations):
-                A = terms.dense_cols(terms.jacobian_cols(z))[order]
+                A = terms.dense_cols(terms.jacobian_cols(z), order)
                 rhs[:, 0] = -terms.residual_cols(t, z, g)[order]
                 swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
                 if not regular.all():

@@ -174,10 +174,16 @@ class Terms:
             self._jc_c * x[self._jc_a] * np.cos(x[self._jc_b] + self._jc_alpha)])
         return self._sum(values, self.entry_index, len(self.rows), self.entry_sum)
 
-    def dense_cols(self, data: np.ndarray) -> np.ndarray:
-        """Φ_z (m, nz, n) from its data (nnz, n)."""
+    def dense_cols(self, data: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
+        """Φ_z (m, nz, n) from its data (nnz, n); with ``order`` (m,), its rows in that
+        order (Φ_z[order], made in place)."""
         J = np.zeros((self.m, self.nz, data.shape[1]))
-        J[self.rows, self.cols] = data
+        rows = self.rows
+        if order is not None:
+            where = np.empty(self.m, dtype=int)
+            where[order] = np.arange(self.m)
+            rows = where[rows]
+        J[rows, self.cols] = data
         return J
 
     def velocity_rhs_cols(self, t: np.ndarray) -> np.ndarray:
