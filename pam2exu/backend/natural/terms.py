@@ -64,7 +64,6 @@ class Terms:
         self.sr, self.sa, self.sb = (s[:, k].astype(int) for k in range(3))
         self.salpha, self.sc = s[:, 3], s[:, 4]
         self.row_index = np.r_[self.pr, self.sr]
-        self.row_sum = _summer(self.row_index, self.m)
         self.law_rows = np.array([r for r, _, _ in self.laws], dtype=int)
         self._last_times, self._last_laws = None, []
         # the terms' constants as columns, kept (evaluations broadcast them over the steps)
@@ -84,7 +83,6 @@ class Terms:
         #: the Jacobian's nonzero pattern: Φ_z[:, rows[k], cols[k]] = data[:, k]
         self.rows, self.cols = pattern // max(nz, 1), pattern % max(nz, 1)
         self.entry_index = where
-        self.entry_sum = _summer(where, len(pattern))
         # the Jacobian's terms in the order of ``entries``: products c z_other (both
         # derivatives in one gather), then c sin(z_b + α) and c z_a cos(z_b + α)
         kb, ka = self.pa != nz, self.pb != nz
@@ -106,13 +104,18 @@ class Terms:
         out[self.nz] = 1.0
         return out
 
-    @staticmethod
-    def _sum(values: np.ndarray, index: np.ndarray, size: int, S) -> np.ndarray:
-        """The terms' values (k, n) summed per row or entry: out[index[k]] += values[k],
-        term after term (``numpy.bincount`` for a few steps, else S values, ``_summer``)."""
+    def _sum(self, values: np.ndarray, per: str) -> np.ndarray:
+        """The terms' values (k, n) summed per row (``per`` 'row') or per Jacobian entry
+        ('entry'): out[index[k]] += values[k], term after term (``numpy.bincount`` for a
+        few steps, else the sparse summing matrix of ``_summer``, made on first use)."""
+        index, size = (self.row_index, self.m) if per == "row" else \
+            (self.entry_index, len(self.rows))
         n = values.shape[1]
         if n > BINCOUNT_STEPS:
-            return np.asarray(S @ values)
+            summers = self.__dict__.setdefault("_summers", {})
+            if per not in summers:
+                summers[per] = _summer(index, size)
+            return np.asarray(summers[per] @ values)
         flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
         return np.bincount(flat, weights=values.ravel(), minlength=size * n).reshape(size, n)
 
@@ -143,7 +146,7 @@ class Terms:
         x = self._ext(z)
         values = np.concatenate([self._pc * x[self.pa] * x[self.pb],
                                  self._sc * x[self.sa] * np.sin(x[self.sb] + self._alpha)])
-        out = self._sum(values, self.row_index, self.m, self.row_sum)
+        out = self._sum(values, "row")
         if self.laws:
             out[self.law_rows] -= self.targets(t, 0) if g is None else g
         return out
@@ -154,7 +157,7 @@ class Terms:
         ``targets(t, 0)`` when already known."""
         x = np.abs(self._ext(z))
         values = np.concatenate([self._apc * x[self.pa] * x[self.pb], self._asc * x[self.sa]])
-        out = self._sum(values, self.row_index, self.m, self.row_sum)
+        out = self._sum(values, "row")
         if self.laws:
             out[self.law_rows] += np.abs(self.targets(t, 0) if g is None else g)
         return out
@@ -163,7 +166,7 @@ class Terms:
         """Σ |terms| per row (m,) with every coordinate at its scale (nz,)."""
         x = np.r_[scales, 1.0][:, None]
         values = np.concatenate([self._apc * x[self.pa] * x[self.pb], self._asc * x[self.sa]])
-        return self._sum(values, self.row_index, self.m, self.row_sum)[:, 0]
+        return self._sum(values, "row")[:, 0]
 
     def jacobian_cols(self, z: np.ndarray) -> np.ndarray:
         """Φ_z as data (nnz, n) on the pattern (``rows``, ``cols``)."""
@@ -172,7 +175,7 @@ class Terms:
             self._jp_c * x[self._jp_i],
             self._js_c * np.sin(x[self._js_b] + self._js_alpha),
             self._jc_c * x[self._jc_a] * np.cos(x[self._jc_b] + self._jc_alpha)])
-        return self._sum(values, self.entry_index, len(self.rows), self.entry_sum)
+        return self._sum(values, "entry")
 
     def dense_cols(self, data: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
         """Φ_z (m, nz, n) from its data (nnz, n); with ``order`` (m,), its rows in that
@@ -202,7 +205,7 @@ class Terms:
         values = np.concatenate([
             2.0 * self._pc * v[self.pa] * v[self.pb],
             self._sc * wb * (2.0 * v[self.sa] * np.cos(arg) - x[self.sa] * wb * np.sin(arg))])
-        out = -self._sum(values, self.row_index, self.m, self.row_sum)
+        out = -self._sum(values, "row")
         if self.laws:
             out[self.law_rows] += self.targets(t, 2)
         return out
