@@ -361,6 +361,8 @@ class Solver:
         self.zd[:1], self.zdd[:1] = self.rates(t[:1], z[:1])
         self.own_rates[0] = True
         intervals, end = self._coarse(t, z, 0, n - 1, stride)
+        #: the coarse pass's intervals (k, j, miss) of the last run
+        self.intervals = intervals
         bad = self._fill(t, z, intervals)
         for number in bad:                     # another branch, or no convergence
             k, j = intervals[number][:2]

@@ -1,0 +1,117 @@
+"""What keeps the natural backend's short runs and large mechanisms fast (issue 25), checked
+by what it computes, never by time: the laws evaluated once per step, a step of a larger
+system solved dense, the coarse pass sized by the run's motion, the few-step sums giving
+the same bits as the many-step ones. References: the four-bar's closed form
+(references/closed_form.py) and numpy's dense solve."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pam2exu
+from benchmarks.cases import chain_model
+from pam2exu.backend.natural import Natural
+from pam2exu.backend.natural.solver import SPARSE_FROM, NaturalSettings, Solver
+from references.closed_form import FOUR_BAR, four_bar
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def solver_of(mech):
+    backend = Natural()
+    form = backend.formulation(mech)
+    return form, Solver(form.terms, backend.weights(form, mech), NaturalSettings(), False)
+
+
+@pytest.fixture(scope="module")
+def four_bar_mech():
+    return pam2exu.load(ROOT / "examples" / "four_bar.toml").mechanism()
+
+
+class CountedLaw:
+    """A law that counts its calls."""
+
+    def __init__(self, law):
+        self.law, self.calls = law, 0
+
+    def __call__(self, t):
+        self.calls += 1
+        return self.law(t)
+
+
+def test_a_step_evaluates_its_law_once(four_bar_mech):
+    """Newton's iterations at one time, then its velocities and accelerations, ask the
+    actuator's law once (before: twice per iteration and once per rate)."""
+    form, solver = solver_of(four_bar_mech)
+    terms = form.terms
+    r, law, power = terms.laws[0]
+    counted = CountedLaw(law)
+    terms.laws[0] = (r, counted, power)
+    z0 = form.from_q(four_bar_mech.initial_q()[None])
+    t = np.array([0.03])
+    z, ok = solver.newton(t, z0)
+    solver.rates(t, z)
+    assert ok[0] and solver.iterations >= 3
+    assert counted.calls == 1
+
+
+def test_the_coarse_pass_follows_the_motion(four_bar_mech):
+    """A 100-step turn of the four-bar: the coarse pass's intervals grow from 4 steps to 8
+    where the predictor misses little (before: 25 intervals of 4 steps), and the run still
+    meets the closed form to 1e-12 of the link lengths."""
+    form, solver = solver_of(four_bar_mech)
+    n = 101
+    t = np.linspace(0.0, 1.0, n)
+    z0, ok = solver.newton(t[:1], form.from_q(four_bar_mech.initial_q()[None]))
+    z, solved = solver.run(t, z0[0])
+    assert solved == n
+    lengths = [j - k for k, j, _ in solver.intervals]
+    assert sum(lengths) == n - 1 and max(lengths) == 8 and len(lengths) < 16
+    q = Natural().to_q(form, four_bar_mech, z, four_bar_mech.initial_q())
+    a, b, c, d = (FOUR_BAR[key] for key in "abcd")
+    theta = 2 * np.pi * t
+    (phi, _, _), (psi, _, _) = four_bar(a, b, c, d, theta, 2 * np.pi + 0 * t, 0 * t)
+    names = [s.name for s in four_bar_mech.solids]
+    fi = lambda name: q[:, 3 * names.index(name) + 2]          # noqa: E731
+    turn = lambda x: (x + np.pi) % (2 * np.pi) - np.pi          # noqa: E731
+    assert np.max(np.abs(turn(fi("coupler") - phi))) < 1e-12
+    assert np.max(np.abs(turn(fi("rocker") - psi))) < 1e-12
+
+
+def test_a_step_of_a_larger_system_is_solved_dense():
+    """One step of the chain of 12 loops (49 coordinates, at least SPARSE_FROM) is solved by
+    a dense factorisation, not a sparse LU (before: ``_sparse``), to numpy's answer."""
+    form, solver = solver_of(chain_model(12).mechanism())
+    assert form.nz >= SPARSE_FROM
+
+    def refuse(*args):
+        raise AssertionError("sparse LU for one step")
+
+    solver._sparse = refuse
+    z = form.from_q(form.mech.initial_q()[None])
+    data = form.terms.jacobian(z)
+    b = np.linspace(-1.0, 1.0, form.terms.m)[None]
+    x = solver.solve(data, b)
+    expected = np.linalg.solve(form.terms.dense(data)[0], b[0])
+    assert np.max(np.abs(x[0] - expected)) <= 1e-12 * np.max(np.abs(expected))
+
+
+def test_few_steps_sum_to_the_same_bits_as_many(four_bar_mech):
+    """Φ, Φ_z and γ of one step (summed by bincount) equal, bit for bit, that step's column
+    of a 40-step evaluation (summed by the sparse matrix): a run's results do not depend
+    on how its steps are grouped."""
+    form, _ = solver_of(four_bar_mech)
+    terms = form.terms
+    rng = np.random.default_rng(7)
+    z = form.from_q(four_bar_mech.initial_q()[None]).T + 0.1 * rng.standard_normal((form.nz, 40))
+    zd = rng.standard_normal((form.nz, 40))
+    t = np.linspace(0.0, 0.5, 40)
+    many = (terms.residual_cols(t, z), terms.jacobian_cols(z), terms.gamma_cols(t, z, zd))
+    for k in (0, 17, 39):
+        s = slice(k, k + 1)
+        few = (terms.residual_cols(t[s], z[:, s]), terms.jacobian_cols(z[:, s]),
+               terms.gamma_cols(t[s], z[:, s], zd[:, s]))
+        for a, b in zip(many, few):
+            assert a[:, s].tobytes() == b.tobytes()
