@@ -271,8 +271,9 @@ class Solver:
         for _ in range(self.settings.max_iterations):
             zc = x[:, None]
             with np.errstate(all="ignore"):
-                phi = terms.residual_cols(t, zc, g)[:, 0]
-                dz = self.solve(terms.jacobian_cols(zc).T, -phi[None])[0]
+                phi, data = terms.residual_jacobian_cols(t, zc, g)
+                phi = phi[:, 0]
+                dz = self.solve(data.T, -phi[None])[0]
                 step = float(np.max(np.abs(dz) * w, initial=0.0))
                 small = step <= tol
                 # Φ within round-off of its terms: it decides only a step that did not
@@ -482,8 +483,9 @@ class Solver:
         g = terms.targets(t, 0)
         with np.errstate(all="ignore"):
             for _ in range(iterations):
-                A = terms.dense_cols(terms.jacobian_cols(z), order)
-                rhs[:, 0] = -terms.residual_cols(t, z, g)[order]
+                phi, data = terms.residual_jacobian_cols(t, z, g)
+                A = terms.dense_cols(data, order)
+                rhs[:, 0] = -phi[order]
                 swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
                 if not regular.all():
                     return None

@@ -92,6 +92,8 @@ class Terms:
         self._js_c, self._js_b, self._js_alpha = self._sc[ks], self.sb[ks], self._alpha[ks]
         self._jc_c, self._jc_a, self._jc_b = self._sc[kc], self.sa[kc], self.sb[kc]
         self._jc_alpha = self._alpha[kc]
+        self._keeps = (kb, ka, ks, kc)
+        self._jp_keep = np.r_[kb, ka]
 
     # ---- evaluation: one column per step --------------------------------------------------
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
@@ -176,6 +178,24 @@ class Terms:
             self._js_c * np.sin(x[self._js_b] + self._js_alpha),
             self._jc_c * x[self._jc_a] * np.cos(x[self._jc_b] + self._jc_alpha)])
         return self._sum(values, "entry")
+
+    def residual_jacobian_cols(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
+                               ) -> tuple[np.ndarray, np.ndarray]:
+        """(Φ (m, n), Φ_z data (nnz, n)) from one gather of the terms' coordinates: the same
+        values as ``residual_cols`` and ``jacobian_cols``."""
+        x = self._ext(z)
+        xa, xb = x[self.pa], x[self.pb]
+        arg = x[self.sb] + self._alpha
+        sin, xs = np.sin(arg), x[self.sa]
+        out = self._sum(np.concatenate([self._pc * xa * xb, self._sc * xs * sin]), "row")
+        if self.laws:
+            out[self.law_rows] -= self.targets(t, 0) if g is None else g
+        kb, ka, ks, kc = self._keeps
+        values = np.concatenate([
+            np.concatenate([self._pc * xb, self._pc * xa])[self._jp_keep],
+            self._js_c * sin[ks],
+            self._jc_c * xs[kc] * np.cos(arg[kc])])
+        return out, self._sum(values, "entry")
 
     def dense_cols(self, data: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
         """Φ_z (m, nz, n) from its data (nnz, n); with ``order`` (m,), its rows in that
