@@ -115,3 +115,18 @@ def test_few_steps_sum_to_the_same_bits_as_many(four_bar_mech):
                terms.gamma_cols(t[s], z[:, s], zd[:, s]))
         for a, b in zip(many, few):
             assert a[:, s].tobytes() == b.tobytes()
+
+
+def test_a_large_system_gets_its_rates_with_its_positions():
+    """The chain of 12 loops (49 coordinates, sparse block solves): every step's ż and z̈
+    come with its positions, from the last Newton iteration's factors (before: solved
+    again afterwards for the filled steps), and equal fresh solves at the answers."""
+    mech = chain_model(12).mechanism()
+    form, solver = solver_of(mech)
+    t = np.linspace(0.0, 0.5, 81)
+    z0, ok = solver.newton(t[:1], form.from_q(mech.initial_q()[None]))
+    z, solved = solver.run(t, z0[0])
+    assert solved == len(t) and solver.own_rates.all()
+    zd, zdd = solver.rates(t, z)
+    for mine, fresh in ((solver.zd, zd), (solver.zdd, zdd)):
+        assert np.max(np.abs(mine - fresh)) <= 1e-10 * np.max(np.abs(fresh))

@@ -161,6 +161,12 @@ class Solver:
         return x
 
     def _sparse(self, data, b):
+        lu = self._sparse_lu(data)
+        return None if lu is None else lu.solve(np.ascontiguousarray(b).ravel()).reshape(b.shape)
+
+    def _sparse_lu(self, data):
+        """The sparse LU of the block-diagonal Φ_z of the steps (data (n, nnz)); None where
+        it is singular."""
         from scipy.sparse import csc_matrix
         from scipy.sparse.linalg import splu
         t = self.terms
@@ -169,7 +175,7 @@ class Solver:
         A = csc_matrix((data.ravel(), ((step * m + t.rows).ravel(), (step * nz + t.cols).ravel())),
                        shape=(n * m, n * nz))
         try:
-            return splu(A).solve(np.ascontiguousarray(b).ravel()).reshape(n, nz)
+            return splu(A)
         except RuntimeError:
             return None
 
@@ -429,7 +435,10 @@ class Solver:
         for a, b, order in self._blocks(z, k, owner):
             part, at = steps[a:b], owner[a:b]
             guess = self._hermite(t, z, part, k[at], j[at])
-            found = self._bulk(t[part], guess, order) if order is not None else None
+            if order is not None:
+                found = self._bulk(t[part], guess, order)
+            else:
+                found = self._bulk_sparse(t[part], guess) if self._sparse_blocks() else None
             if found is None:
                 zi, ok = self.newton(t[part], guess.T)
                 zi = zi.T
@@ -502,6 +511,42 @@ class Solver:
                     break
             zd = x[:, 1]
             zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
+        return z, zd, zdd, step <= tol
+
+    def _sparse_blocks(self) -> bool:
+        """Whether the steps are solved by ``_bulk_sparse`` (large square systems)."""
+        return not self.least_squares and self.terms.nz >= SPARSE_FROM and self.terms.m > 0
+
+    def _bulk_sparse(self, t, z, iterations: int = 4):
+        """``_bulk`` for a large system: each Newton iteration one sparse LU of the steps'
+        block-diagonal Φ_z, the last one's factors also giving ż and z̈ (z (nz, n), one
+        column per step); None where a Jacobian is singular."""
+        terms, tol = self.terms, self.settings.tolerance
+        z = np.array(z, dtype=float)
+        n, w = len(t), self.w[:, None]
+        g = terms.targets(t, 0)
+
+        def solve(lu, b):                       # b (m, n) -> x (nz, n)
+            return lu.solve(np.ascontiguousarray(b.T).ravel()).reshape(n, terms.nz).T
+
+        with np.errstate(all="ignore"):
+            for _ in range(iterations):
+                phi, data = terms.residual_jacobian_cols(t, z, g)
+                if not (np.isfinite(phi).all() and np.isfinite(data).all()):
+                    return None
+                lu = self._sparse_lu(data.T)
+                if lu is None:
+                    return None
+                dz = solve(lu, -phi)
+                self.iterations += n
+                z += dz
+                step = np.max(np.abs(dz) * w, axis=0, initial=0.0)
+                if np.all(step <= tol):
+                    break
+            zd = solve(lu, terms.velocity_rhs_cols(t))
+            zdd = solve(lu, terms.gamma_cols(t, z, zd))
+        if not (np.isfinite(zd).all() and np.isfinite(zdd).all()):
+            return None
         return z, zd, zdd, step <= tol
 
     def _sequential(self, t, z, k: int, end: int):
