@@ -209,10 +209,10 @@ def test_chunked_solves_and_conversions_give_the_same_run(monkeypatch):
     the four-bar: 985 MB peak, docs/performance.md): chunks of a few hundred steps give the
     run of one chunk, bit for bit."""
     import pam2exu.backend.natural as natural
-    from pam2exu.backend.natural import solver
+    from pam2exu.backend.natural import linear, solver
     path = ROOT / "examples" / "four_bar.toml"
     whole = pam2exu.run(path, analysis="kinematic", steps=5000, backend="natural")
-    monkeypatch.setattr(solver, "CHUNK_BYTES", 200_000)
+    monkeypatch.setattr(linear, "CHUNK_BYTES", 200_000)
     monkeypatch.setattr(natural, "CONVERT_ROWS", 333)
     job = prepare(path, analysis="kinematic", steps=5000)
     assert Natural().formulation(job.mech) is not None

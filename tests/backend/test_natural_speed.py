@@ -13,7 +13,8 @@ import pytest
 import pam2exu
 from benchmarks.cases import chain_model
 from pam2exu.backend.natural import Natural
-from pam2exu.backend.natural.solver import SPARSE_FROM, NaturalSettings, Solver
+from pam2exu.backend.natural.linear import SPARSE_FROM
+from pam2exu.backend.natural.solver import NaturalSettings, Solver
 from references.closed_form import FOUR_BAR, four_bar
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -3,7 +3,8 @@
 A run is solved in two passes (vectorised over steps, sequential only where it must be):
 
 1. a coarse sequential pass: every ``stride``-th step from the previous one (COARSE
-   intervals, at least 4 steps long), Newton started from the Taylor predictor
+   intervals, at least 4 steps long; twice as long where the motion is slow, the run's
+   own predictor says: COARSE_GROW), Newton started from the Taylor predictor
    z + h ż + h²/2 z̈ (velocities and accelerations there are two linear solves); an interval
    whose predictor misses by more than ``COARSE_MISS`` (a fast or nearly singular motion)
    is cut shorter, down to step by step. Its steps stay close enough that Newton does not
@@ -12,7 +13,8 @@ A run is solved in two passes (vectorised over steps, sequential only where it m
 2. every step in between at once: Newton started from the cubic Hermite interpolation of
    z and ż at the ends of its interval (error O(h⁴)), Jacobians and solves batched over the
    steps (``batched``: blocks of BLOCK steps, the equations ordered as the pivots at the
-   start of their interval, so that rows are seldom exchanged). A step that does not
+   start of their interval, so that rows are seldom exchanged; a large system: one sparse
+   block-diagonal LU per iteration, ``linear``). A step that does not
    converge, or converges far from its guess (another branch), has its interval solved
    step by step.
 
@@ -26,15 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...batched import lu_factor, lu_solve
+from .linear import SPARSE_FROM, LinearSolves
 
-#: from this many coordinates on, a chunk of steps is solved as one sparse block-diagonal
-#: system (cost linear in the mechanism's size) instead of dense batched solves
-SPARSE_FROM = 40
-#: a few steps of a larger system are still solved dense (LAPACK per step) while
-#: steps × coordinates² is at most this: a sparse LU's set-up costs more (measured: one
-#: step of 129 coordinates, 0.2 ms dense against 0.3 ms sparse)
-DENSE_WORK = 20_000
 #: intervals of the coarse pass (fewer when the run is short)
 COARSE = 100
 #: the coarse pass's interval doubles where the predictor missed by less than
@@ -55,19 +50,12 @@ SHORT = 64
 #: the coarse predictor may miss by this much (relative: lengths / L, angles in rad)
 #: before its interval is solved step by step
 COARSE_MISS = 2e-2
-#: bytes of Jacobians kept at once (the steps are solved in chunks)
-CHUNK_BYTES = 64 * 2**20
 #: a row's magnitude (what its residual is measured against) is at least this fraction of
 #: its terms with the coordinates at their scales: a coordinate whose answer is 0 otherwise
 #: leaves a round-off residual as large as the row's terms, and no residual is ever small
 MAGNITUDE_FLOOR = 1e-6
 #: steps solved together by ``_bulk``: small enough for their arrays to stay in the cache
 BLOCK = 8192
-#: below this many steps, the dense solves are numpy's (LAPACK per step) rather than ``batched``
-BATCHED_FROM = 64
-#: rows are exchanged in the batched solves where a pivot is below this fraction of the
-#: largest in its column (``batched.lu_factor``)
-PIVOT_THRESHOLD = 0.5
 #: a step that failed is cut into at most this many sub-steps
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
@@ -94,7 +82,7 @@ class NaturalSettings:
     verbose: int = 0
 
 
-class Solver:
+class Solver(LinearSolves):
     """Newton's method for one ``Formulation`` (``terms``), with step weights ``w``."""
 
     def __init__(self, terms, weights: np.ndarray, settings: NaturalSettings,
@@ -107,121 +95,6 @@ class Solver:
         self.order = np.arange(terms.m)
         #: (z's bytes, its pivot orders) of the last ``pivot_orders``
         self._ordered = (None, None)
-
-    def rows_per_chunk(self) -> int:
-        """Steps solved at once: the Jacobians, their terms and the solves' copies of a
-        chunk take about CHUNK_BYTES."""
-        t = self.terms
-        per_step = 8 * (3 * t.m * t.nz + 3 * len(t.rows) + 3 * (len(t.pr) + len(t.sr)) + 8 * t.nz)
-        return max(1, CHUNK_BYTES // per_step)
-
-    # ---- linear algebra -------------------------------------------------------------------
-    def solve(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """x with Φ_z x = b per step (data: ``Terms.jacobian``); minimum-norm least squares
-        when the system is not square or is singular; NaN where it has lost rank."""
-        terms = self.terms
-        n = data.shape[0]
-        if terms.nz == 0:
-            return np.zeros((n, 0))
-        if not self.least_squares and n < BATCHED_FROM and (
-                terms.nz < SPARSE_FROM or n * terms.nz ** 2 <= DENSE_WORK):
-            try:                               # a diverged step gives NaN here too
-                return np.linalg.solve(terms.dense(data), b[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                pass
-        finite = np.isfinite(data).all(axis=1) & np.isfinite(b).all(axis=1)
-        if not finite.all():                   # a diverged step: NaN, the others solved
-            x = np.full((n, terms.nz), np.nan)
-            if finite.any():
-                x[finite] = self.solve(data[finite], b[finite])
-            return x
-        if not self.least_squares:
-            if terms.nz >= SPARSE_FROM:
-                x = self._sparse(data, b)
-                if x is not None:
-                    return x
-            elif n >= BATCHED_FROM:
-                A = terms.dense_cols(data.T, self.order)
-                swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
-                x = lu_solve(A, swaps, b.T[self.order]).T
-                if not regular.all():              # singular: NaN (``_least_squares``)
-                    x[~regular] = self._least_squares(data[~regular], b[~regular])
-                return x
-        return self._least_squares(data, b)
-
-    def _least_squares(self, data, b):
-        """The minimum-norm least-squares x of Φ_z x = b per step (SVD); NaN where a square
-        system is singular."""
-        U, s, Vt = np.linalg.svd(self.terms.dense(data), full_matrices=False)
-        keep = s > 1e-12 * s[:, :1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            coef = np.where(keep, np.einsum("nmk,nm->nk", U, b) / s, 0.0)
-        x = np.einsum("nkq,nk->nq", Vt, coef)
-        if not self.least_squares:           # square but singular: no unique answer
-            x[~keep.all(axis=1)] = np.nan
-        return x
-
-    def _sparse(self, data, b):
-        lu = self._sparse_lu(data)
-        return None if lu is None else lu.solve(np.ascontiguousarray(b).ravel()).reshape(b.shape)
-
-    def _sparse_lu(self, data):
-        """The sparse LU of the block-diagonal Φ_z of the steps (data (n, nnz)); None where
-        it is singular."""
-        from scipy.sparse import csc_matrix
-        from scipy.sparse.linalg import splu
-        t = self.terms
-        n, m, nz = data.shape[0], t.m, t.nz
-        step = np.arange(n)[:, None]
-        A = csc_matrix((data.ravel(), ((step * m + t.rows).ravel(), (step * nz + t.cols).ravel())),
-                       shape=(n * m, n * nz))
-        try:
-            return splu(A)
-        except RuntimeError:
-            return None
-
-    def pivot_orders(self, z: np.ndarray) -> np.ndarray:
-        """The equations' order (N, m) that partial pivoting gives at each configuration z
-        (N, nz), so that the batched solves near it (``batched.lu_factor`` with
-        PIVOT_THRESHOLD) rarely exchange rows (which is what costs); ``self.order`` where
-        Φ_z is singular."""
-        key = z.tobytes()
-        if key == self._ordered[0]:              # the run's start, asked again
-            return self._ordered[1]
-        m, N = self.terms.m, len(z)
-        A = self.terms.dense_cols(self.terms.jacobian_cols(z.T))
-        swaps, regular = lu_factor(A)
-        order = np.tile(np.arange(m)[:, None], (1, N))
-        each = np.arange(N)
-        for k in range(m):                       # the exchanges, in turn
-            p = swaps[k]
-            order[k], order[p, each] = order[p, each], order[k].copy()
-        order[:, ~regular] = self.order[:, None]
-        self._ordered = (key, order.T)
-        return order.T
-
-    def run_rates(self, t, z):
-        """(ż, z̈) at the steps of the last ``run`` (z its answer, solved rows only): those
-        found with the positions, the others solved now."""
-        n = len(t)
-        zd, zdd = self.zd[:n].copy(), self.zdd[:n].copy()
-        missing = np.nonzero(~self.own_rates[:n])[0]
-        if missing.size:
-            zd[missing], zdd[missing] = self.rates(t[missing], z[missing])
-        return zd, zdd
-
-    def rates(self, t, z):
-        """(ż, z̈) at the steps (z solved): Φ_z ż = g', Φ_z z̈ = γ; in chunks that bound
-        the memory of the Jacobians."""
-        terms = self.terms
-        zd, zdd = np.empty_like(z), np.empty_like(z)
-        rows = self.rows_per_chunk()
-        for a in range(0, len(t), rows):
-            s = slice(a, a + rows)
-            data = terms.jacobian(z[s])
-            zd[s] = self.solve(data, terms.velocity_rhs(t[s]))
-            zdd[s] = self.solve(data, terms.gamma(t[s], z[s], zd[s]))
-        return zd, zdd
 
     # ---- Newton -------------------------------------------------------------------------------
     def newton(self, t: np.ndarray, z: np.ndarray):
@@ -485,70 +358,9 @@ class Solver:
         """Whether the steps are solved by ``_bulk`` (small square systems)."""
         return not self.least_squares and self.terms.nz < SPARSE_FROM
 
-    def _bulk(self, t, z, order, iterations: int = 4):
-        """(z, ż, z̈, ok) for a block of steps of a small square system from good guesses
-        (z (nz, n), one column per step, as the answers): each Newton solve also solves
-        Φ_z ż = g' (two right-hand sides, one factorisation), and the last one's Jacobian
-        (at z within the tolerance) gives z̈; None where a Jacobian is singular."""
-        terms, tol = self.terms, self.settings.tolerance
-        z = np.array(z, dtype=float)
-        rhs = np.empty((terms.m, 2, len(t)))
-        rhs[:, 1] = terms.velocity_rhs_cols(t)[order]
-        w = self.w[:, None]
-        g = terms.targets(t, 0)
-        with np.errstate(all="ignore"):
-            for _ in range(iterations):
-                phi, data = terms.residual_jacobian_cols(t, z, g)
-                A = terms.dense_cols(data, order)
-                rhs[:, 0] = -phi[order]
-                swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
-                if not regular.all():
-                    return None
-                x = lu_solve(A, swaps, rhs)
-                self.iterations += len(t)
-                z += x[:, 0]
-                step = np.max(np.abs(x[:, 0]) * w, axis=0, initial=0.0)
-                if np.all(step <= tol):
-                    break
-            zd = x[:, 1]
-            zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
-        return z, zd, zdd, step <= tol
-
     def _sparse_blocks(self) -> bool:
         """Whether the steps are solved by ``_bulk_sparse`` (large square systems)."""
         return not self.least_squares and self.terms.nz >= SPARSE_FROM and self.terms.m > 0
-
-    def _bulk_sparse(self, t, z, iterations: int = 4):
-        """``_bulk`` for a large system: each Newton iteration one sparse LU of the steps'
-        block-diagonal Φ_z, the last one's factors also giving ż and z̈ (z (nz, n), one
-        column per step); None where a Jacobian is singular."""
-        terms, tol = self.terms, self.settings.tolerance
-        z = np.array(z, dtype=float)
-        n, w = len(t), self.w[:, None]
-        g = terms.targets(t, 0)
-
-        def solve(lu, b):                       # b (m, n) -> x (nz, n)
-            return lu.solve(np.ascontiguousarray(b.T).ravel()).reshape(n, terms.nz).T
-
-        with np.errstate(all="ignore"):
-            for _ in range(iterations):
-                phi, data = terms.residual_jacobian_cols(t, z, g)
-                if not (np.isfinite(phi).all() and np.isfinite(data).all()):
-                    return None
-                lu = self._sparse_lu(data.T)
-                if lu is None:
-                    return None
-                dz = solve(lu, -phi)
-                self.iterations += n
-                z += dz
-                step = np.max(np.abs(dz) * w, axis=0, initial=0.0)
-                if np.all(step <= tol):
-                    break
-            zd = solve(lu, terms.velocity_rhs_cols(t))
-            zdd = solve(lu, terms.gamma_cols(t, z, zd))
-        if not (np.isfinite(zd).all() and np.isfinite(zdd).all()):
-            return None
-        return z, zd, zdd, step <= tol
 
     def _sequential(self, t, z, k: int, end: int):
         """(z, solved): steps k+1 … end−1 one after the other from the solved step k,
