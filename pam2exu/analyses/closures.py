@@ -19,7 +19,7 @@ import numpy as np
 
 from ..kinematics import PER_SOLID, PointSet, State
 from ..model.solid import LineRef
-from ..laws import Law
+from ..laws import LAWS, Law
 from ..model.variation import COMPONENTS
 from .least_norm import Closure
 from .native import target_values
@@ -142,6 +142,16 @@ class Closures:
         return (reached * self._fixed[:, None] + ramp * half * cos,
                 half * (decay / tau * cos - ramp * omega * sin))
 
+    def _offsets_at(self, t: float, reached: float):
+        """``_offsets`` at one time t, (V, 3) each (fewer operations: the ODE's
+        right-hand sides)."""
+        x = t / self._tau
+        ramp = -np.expm1(-x)
+        phase = self._omega * t
+        cos = np.cos(phase)
+        return (reached * self._fixed + ramp * self._half * cos,
+                self._half * (np.exp(-x) / self._tau * cos - ramp * self._omega * np.sin(phase)))
+
     def evaluate(self, t: float, q: np.ndarray, lam: np.ndarray,
                  reached: float = 1.0) -> Closure:
         """C (without F_j j), F_q, F_j and W = Σ λ_i ∂²F_i/∂q² at (t, q), the fixed
@@ -172,13 +182,14 @@ class Closures:
         n = q.shape[0]
         lam = np.asarray(lam, dtype=float)
         fast = along is not None and n == 1 and self._linear.elements
+        if fast and len(self._linear.elements) == len(self.mech.constraints):
+            u, du = self._offsets_at(float(t), reached)
+            return self._linear.rate(float(t), q[0], lam[0], u,
+                                     du if along == "t" else self._fixed, along == "t")
         if fast:                                  # the ODE's right-hand sides
             moved = self._moved_offsets(t, reached, along)
             C, Fq, W, f_rate = self._linear.evaluate(np.array([t], dtype=float), q[0],
                                                      lam[0], moved)
-            if len(self._linear.elements) == len(self.mech.constraints):
-                return (C.real[None], Fq.real[None], W.real[None],
-                        (C.imag / STEP - f_rate)[None], (Fq.imag / STEP)[None])
         st = State(np.broadcast_to(t, (n,)), np.asarray(q, dtype=float), hessians=True)
         dtype = complex if along is not None else float
         if fast:
@@ -269,6 +280,21 @@ class Linear:
             else:
                 self.constant[rows] = target_values(target, np.zeros(1), d)[0]
         self.targets = laws
+        #: the laws as (rows, function, constants), called at a float time (``rate``)
+        self.laws = [(rows, LAWS[law.name].function, law.C) for rows, law in laws]
+        index = {id(v): i for i, v in enumerate(closures._variations)}
+        #: ``moves`` with the Variation's index in ``Closures._offsets`` and the fi column
+        self.indexed = [(rows, G, PER_SOLID * solid + 2, index[v])
+                        for rows, G, solid, v in self.moves]
+        #: (row, fi column, Variation index, ∂v/∂P (2,)) of every row of ``indexed``
+        self.move_rows = (
+            np.array([r for rows, *_ in self.indexed for r in rows], dtype=int),
+            np.array([col for rows, _, col, _ in self.indexed for _ in rows], dtype=int),
+            np.array([v for rows, _, _, v in self.indexed for _ in rows], dtype=int),
+            np.array([g for _, G, _, _ in self.indexed for g in G]).reshape(-1, 2))
+        self.local_x, self.local_y = s.local[:, 0].copy(), s.local[:, 1].copy()
+        self.A_points = np.ascontiguousarray(self.A[:, :2 * K])
+        self.diagonal = np.zeros(self.nq)
         #: ∂x/∂q but its angle columns of the points (``evaluate`` writes them)
         self.jac = np.zeros((2 * K + self.nq, self.nq))
         point = np.arange(K)[s.translate]
@@ -357,6 +383,54 @@ class Linear:
             W[PER_SOLID * solid + 2, PER_SOLID * solid + 2] -= lam[rows] @ (G @ Ad)
         return C, Fq, W, f_rate
 
+    def rate(self, t: float, q: np.ndarray, lam: np.ndarray, u: np.ndarray,
+             du: np.ndarray, laws: bool = True):
+        """(C, F_q, W, C_t, F_qt) (each with a leading axis of 1) at one (t, q, λ) when
+        ``elements`` are all the constraint elements, in real numbers: the varied points at
+        the offsets u (V, 3) moving at du (V, 3) (C_t += ∂v/∂P A(fi) du, F_qt its ∂/∂fi),
+        and C_t −= f′ of the laws where ``laws`` (a rate along the time). ``evaluate``'s
+        complex step, by hand."""
+        K = len(self.points.keys)
+        fi = q[self.fi]
+        c, sn = np.cos(fi), np.sin(fi)
+        ax = c * self.local_x - sn * self.local_y                    # A s
+        ay = sn * self.local_x + c * self.local_y
+        x = np.empty(2 * K + self.nq)
+        x[self.even], x[self.odd] = ax, ay
+        jac = self.jac.copy()
+        jac[self.even, self.fi] = -ay                               # ∂(A s)/∂fi = Ω A s
+        jac[self.odd, self.fi] = ax
+        weights = lam[self.rows] @ self.A_points
+        curvature = -(weights[self.even] * ax + weights[self.odd] * ay)
+        x[self.shift] += q[self.origin]                             # points: R + A s
+        x[2 * K:] = q
+        C = -self.constant
+        C[self.rows] += self.A @ x
+        Fq = np.zeros((self.m, self.nq))
+        Fq[self.rows] = self.A @ jac
+        W = np.diag(np.bincount(self.fi, curvature, minlength=self.nq))   # ∂²(A s)/∂fi²
+        C_t, F_qt = np.zeros(self.m), np.zeros((self.m, self.nq))
+        for rows, function, constants in self.laws:
+            f, df, _ = function(t, constants)
+            C[rows] -= f
+            if laws:
+                C_t[rows] -= df
+        if self.indexed:                    # every row of every varied point at once
+            row, col, v, G = self.move_rows
+            c, sn = np.cos(q[col]), np.sin(q[col])
+            ux, uy, rx, ry = u[v, 0], u[v, 1], du[v, 0], du[v, 1]
+            ax, ay = c * ux - sn * uy, sn * ux + c * uy              # A(fi) δ
+            bx, by = c * rx - sn * ry, sn * rx + c * ry              # A(fi) δ′
+            moved = G[:, 0] * ax + G[:, 1] * ay
+            at = row * self.nq + col
+            size = self.m * self.nq
+            C += np.bincount(row, moved, minlength=self.m)
+            Fq += np.bincount(at, G[:, 1] * ax - G[:, 0] * ay, minlength=size).reshape(Fq.shape)
+            W -= np.diag(np.bincount(col, lam[row] * moved, minlength=self.nq))
+            C_t += np.bincount(row, G[:, 0] * bx + G[:, 1] * by, minlength=self.m)
+            F_qt += np.bincount(at, G[:, 1] * bx - G[:, 0] * by,
+                                minlength=size).reshape(Fq.shape)
+        return C[None], Fq[None], W[None], C_t[None], F_qt[None]
 
 
 @dataclass(frozen=True)

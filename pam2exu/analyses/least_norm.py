@@ -300,11 +300,19 @@ def follow(evaluate: Evaluate, h_t: Callable | None, times: np.ndarray, y0: np.n
 
     max_steps = MAX_STEPS if max_steps is None else max_steps
 
+    jacobian = []                   # h_y's constant blocks (I, F_j, F_jᵀ), laid out once
+
     def rhs(t, y):
         j, q, lam = split(y, p, nq)
         c, rate_t = rate(t, q, lam) if rate is not None else (evaluate(t, q, lam),
                                                               h_t(t, q, lam))
-        return -np.linalg.solve(lagrange_jacobian(c), rate_t)
+        if not jacobian:
+            jacobian.append(lagrange_jacobian(c))
+        H = jacobian[0].copy()
+        H[p:p + nq, p:p + nq] = c.W
+        H[p:p + nq, p + nq:] = c.Fq.T
+        H[p + nq:, p:p + nq] = c.Fq
+        return -np.linalg.solve(H, rate_t)
 
     times = np.asarray(times, dtype=float)
     out = np.full((len(times), len(y0)), np.nan)
