@@ -179,6 +179,10 @@ def _first_lost(closures: Closures, times: np.ndarray, y: np.ndarray) -> int | N
 #: the rows of the straight path u0 + s δ at t = 0 where Newton corrects the clearance
 #: followed (s = 0, 1/4, …, 1); the integrator steps as it needs between them
 PATH_ROWS = 4
+#: an integration step along that path below this fraction of it: a fold (the steps of a
+#: smooth path are 10⁻³ to 10⁻¹ of it; towards a fold they halve at every step, down to
+#: round-off), where ``as_made`` stops
+FOLD_STEP = 1e-7
 
 
 def as_made(closures: "Closures", t0: float, y0: np.ndarray) -> np.ndarray:
@@ -195,7 +199,7 @@ def as_made(closures: "Closures", t0: float, y0: np.ndarray) -> np.ndarray:
     y, ok, stop = follow(along, None, path, y0, p, nq,
                          rate=lambda s, q, lam: closures.evaluate_rate(t0, q, lam, reached=s,
                                                                        along="s"),
-                         correct=corrector(closures, t0))
+                         correct=corrector(closures, t0), min_step=FOLD_STEP)
     for k, s in enumerate(path):
         at, there = (float(s), y[k]) if ok[k] else (stop.time, stop.y)
         found = applicability(along(at, *split(there, p, nq)[1:]))

@@ -282,7 +282,7 @@ class Followed(NamedTuple):
 def follow(evaluate: Evaluate, h_t: Callable | None, times: np.ndarray, y0: np.ndarray,
            p: int, nq: int, rtol: float = 1e-10, atol: float = 1e-12,
            max_steps: int | None = None, rate: Callable | None = None,
-           correct: Callable | None = None) -> Followed:
+           correct: Callable | None = None, min_step: float | None = None) -> Followed:
     """The slides' ODE y' = −h_y⁻¹ h_t from y0 at times[0], integrated by scipy's DOP853
     step by step through every output time (its dense output there, as ``solve_ivp`` with
     ``t_eval``), then Newton on h = 0 at each output time from the integrated value.
@@ -291,14 +291,16 @@ def follow(evaluate: Evaluate, h_t: Callable | None, times: np.ndarray, y0: np.n
     ``correct(times, ys)`` -> (ys, converged) corrects the rows reached all at once
     (``newton_rows``); None: ``newton`` at each.
 
-    It stops at the first of: h_y singular or the step size fallen to round-off
-    (``Stop.SINGULAR``), more than ``max_steps`` steps in one output interval
+    It stops at the first of: h_y singular or the step size fallen to round-off, or
+    below ``min_step`` times the interval (``Stop.SINGULAR``: the steps of a fold shrink
+    geometrically towards it), more than ``max_steps`` steps in one output interval
     (``Stop.WORK``; None: ``MAX_STEPS``), Newton not converging at an output time
     (``Stop.NEWTON``); the rows before are kept.
     """
     from scipy.integrate import DOP853
 
     max_steps = MAX_STEPS if max_steps is None else max_steps
+    floor = 0.0 if min_step is None else min_step * float(times[-1] - times[0])
 
     jacobian = []                   # h_y's constant blocks (I, F_j, F_jᵀ), laid out once
 
@@ -338,6 +340,9 @@ def follow(evaluate: Evaluate, h_t: Callable | None, times: np.ndarray, y0: np.n
             stop = Stop(t, Stop.SINGULAR, y, steps)
             break
         steps += 1
+        if floor and solver.step_size < floor and solver.t < times[-1]:
+            stop = Stop(float(solver.t), Stop.SINGULAR, solver.y, steps)
+            break
         if times[k] <= solver.t:
             passed = np.searchsorted(times, solver.t, side="right")
             predicted[k:passed] = solver.dense_output()(times[k:passed]).T

@@ -151,3 +151,30 @@ def test_varied_points_of_linear_elements_move_by_their_rate(request):
         for name in ("F", "Fq", "W"):
             np.testing.assert_allclose(getattr(c, name), getattr(plain, name), rtol=0,
                                        atol=1e-14)
+
+
+def test_a_fold_on_the_path_to_the_dimensions_as_made_is_met_in_few_steps(monkeypatch):
+    """The locomotive with axle 3 0.3 m across the frame: the least-norm clearance folds at
+    s = 0.3565 of the straight path of dimensions (the steps halve towards it); the run
+    stops there with the message of deviations that cannot be absorbed once a step falls
+    below ``FOLD_STEP`` of the path, after about 1050 right-hand sides (1745 when it crawled
+    to round-off)."""
+    from pathlib import Path
+    from pam2exu.analyses import closures as closures_module
+    text = (Path(__file__).parents[2] / "examples/clearance/locomotive.toml").read_text(
+        encoding="utf-8").replace("steps = 400", "steps = 2").replace(
+        "t_end = 9.66643893412244", "t_end = 0.2")
+    head, _, tail = text.partition("[analysis]")
+    model = pam2exu.loads(f'{head}[[variation]]\nanchor = "frame.O3"\nfixed_dy = 0.3\n\n'
+                          f'[analysis]{tail}')
+    counted = []
+    rate = closures_module.Closures.evaluate_rate
+    monkeypatch.setattr(closures_module.Closures, "evaluate_rate",
+                        lambda self, *a, **k: counted.append(1) or rate(self, *a, **k))
+    with pytest.raises(pam2exu.SolverError) as error:
+        pam2exu.run(model)
+    assert ("cannot absorb the fixed deviations of its [[variation]] entries (fixed_dx, "
+            "fixed_dy, fixed_dangle): followed from the nominal assembly along the straight "
+            "path of dimensions u0 + s δ, it stops at s = 0.3565 (of 0 … 1)") in str(error.value)
+    assert "close to branching" in str(error.value) and error.value.partial is None
+    assert len(counted) < 1200
