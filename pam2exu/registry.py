@@ -75,6 +75,9 @@ class AnalysisOption:
     doc : str
         What the value is, in full, for its entry in ``model.Analysis``'s docstring (and
         docs/api.md); ``meaning`` when empty.
+    choices : tuple of str
+        The values allowed of an option that is a choice (its default one of them; ``low``
+        and ``high`` then unused); empty for a number.
     """
 
     name: str
@@ -87,19 +90,27 @@ class AnalysisOption:
     brief: str
     metavar: str = "VALUE"
     doc: str = ""
+    choices: tuple[str, ...] = ()
 
     def parameter_doc(self) -> str:
         """Its entry in the Parameters section of ``model.Analysis``'s docstring."""
         readers = " and ".join(f"``{a}``" for a in analyses_reading(self.name))
+        allowed = (f"one of {', '.join(repr(c) for c in self.choices)}, default "
+                   f"{self.default!r}" if self.choices else
+                   f"{self.low:g} < {self.name} ≤ {self.high:g}, default {self.default:g}")
         text = (f"An analysis option (``registry.OPTIONS``) of {readers}, which the other "
-                f"analyses ignore: {self.doc or self.meaning}; {self.low:g} < {self.name} ≤ "
-                f"{self.high:g}, default {self.default:g}.")
+                f"analyses ignore: {self.doc or self.meaning}; {allowed}.")
         return (f"    {self.name} : {type(self.default).__name__}\n"
                 + textwrap.fill(text, 92, initial_indent=" " * 8, subsequent_indent=" " * 8)
                 + "\n")
 
     def problem(self, value) -> str | None:
         """What is wrong with ``value`` (one message), None when it is allowed."""
+        if self.choices:
+            if isinstance(value, str) and value in self.choices:
+                return None
+            return (f"{self.name} must be one of {', '.join(repr(c) for c in self.choices)}, "
+                    f"{self.meaning}, got {echo(value)}")
         if is_number(value) and self.low < value <= self.high:
             return None
         return (f"{self.name} must be a number in ({self.low:g}, {self.high:g}], "
@@ -117,6 +128,19 @@ OPTIONS: dict[str, AnalysisOption] = {o.name: o for o in (
                    brief="the dynamic analysis's tolerance", metavar="TOL",
                    doc="the accuracy required of the time integration: its error at most "
                        "tolerance · (1 + |value|) on every coordinate and rate, SI units [-]"),
+    AnalysisOption("method", "ode", 0.0, 0.0, choices=("ode", "newton"),
+                   meaning="how the clearance of least norm is followed",
+                   owner="the clearance analysis's",
+                   help="clearance: how the least-norm clearance is followed: 'ode' (the "
+                        "slides' differential equation, corrected by Newton at every row; "
+                        "the default) or 'newton' (Newton on the Lagrange conditions at "
+                        "every row from the previous one: the reference, slower)",
+                   brief="the clearance analysis's method", metavar="METHOD",
+                   doc="how the clearance of least norm is followed from row to row: "
+                       "'ode', the slides' differential equation y′ = −h_y⁻¹ h_t corrected "
+                       "by Newton at every row, or 'newton', Newton's method on the "
+                       "Lagrange conditions at every row from the previous row's solution "
+                       "(they agree to 1e-9)"),
 )}
 
 
@@ -250,7 +274,7 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
                  summary="the clearance of least norm of an over-constrained mechanism as "
                  "its dimensions vary",
                  function="pam2exu.analyses.clearance:clearance", element_outputs=False,
-                 in_studies=True),
+                 options=("method",), in_studies=True),
     AnalysisType("equilibrium", "equilibri", frozenset({POSITION, FORCE}), driven=False,
                  at_start=True,
                  summary="the free degrees of freedom in stable static equilibrium at t = 0",

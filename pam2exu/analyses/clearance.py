@@ -20,9 +20,9 @@ from ..errors import MobilityError, ModelError, SolverError
 from ..kinematics import PER_SOLID, State
 from .closures import Closures
 from .job import Job, check_mobility, collect
-from .least_norm import (RANK, Applicability, Closure, Stop, applicability, follow,
-                         lagrange_jacobian, lagrange_jacobian_rows, newton_rows, split,
-                         strict_minimum_rows)
+from .least_norm import (RANK, Applicability, Closure, Followed, Stop, applicability,
+                         follow, lagrange_jacobian, lagrange_jacobian_rows, newton_rows, split,
+                         step_by_step, strict_minimum_rows)
 from . import native
 from .positions import GUESS_STIFFNESS, assemble, positions
 
@@ -59,8 +59,12 @@ def clearance(job: Job):
     if closures.has_fixed:
         job.stage = "following the clearance of least norm to the dimensions as made (t = 0)"
         y0 = as_made(closures, t0, y0)
-    y, ok, stop = follow(closures.evaluate, None, job.times, y0, p, nq,
-                         rate=closures.evaluate_rate, correct=corrector(closures))
+    if job.options["method"] == NEWTON:
+        job.info["clearance_method"] = BY_NEWTON
+        y, ok, stop = step_by_step_rows(closures, job.times, y0)
+    else:
+        y, ok, stop = follow(closures.evaluate, None, job.times, y0, p, nq,
+                             rate=closures.evaluate_rate, correct=corrector(closures))
     job.stage = "checking the clearance is a strict minimum at every row"
     rows = range(0, len(job.times), job.every)
     checked = np.array([k for k in rows if ok[k]], dtype=int)
@@ -84,6 +88,10 @@ def clearance(job: Job):
 
 #: ``RunInfo.clearance_method`` of a run that follows the least-norm clearance
 FOLLOWED = "the slides' ODE, Newton on the Lagrange conditions at every row"
+#: the ``method`` option's value (``registry.OPTIONS``) of Newton at every row
+NEWTON = "newton"
+#: ``RunInfo.clearance_method`` of a run with ``method = "newton"``
+BY_NEWTON = "Newton on the Lagrange conditions at every row, from the previous row's solution"
 #: ``RunInfo.clearance_method`` of a run with no clearance joint and no varied anchor
 KINEMATIC = ("no clearance joint and no varied anchor: no clearance (no column), the "
              "positions those of the kinematic analysis (the backend's, refined by Newton on "
@@ -114,6 +122,20 @@ def kinematic_closure(job: Job, closures: "Closures"):
         except SolverError as error:
             raise _with_rows(error, job, closures, np.asarray(q), k) from None
     return collect(job, q, extra={})
+
+
+def step_by_step_rows(closures: Closures, times: np.ndarray, y0: np.ndarray) -> Followed:
+    """``least_norm.step_by_step`` (``method = "newton"``) as ``follow`` reports it: the
+    rows up to the first where Newton does not converge (``Stop.NEWTON`` there, NaN
+    after)."""
+    y, ok = step_by_step(closures.evaluate, times, y0, closures.p, closures.nq)
+    failed = np.nonzero(~ok)[0]
+    if not failed.size:
+        return Followed(y, ok, None)
+    row = int(failed[0])
+    stop = Stop(float(times[row]), Stop.NEWTON, y[row - 1])
+    y[row:], ok[row:] = np.nan, False
+    return Followed(y, ok, stop)
 
 
 def refine(mech, times: np.ndarray, q: np.ndarray, tolerance: float = 1e-13,

@@ -22,6 +22,7 @@ def add_parser(sub) -> None:
                      "type; dynamic (a DOF free): the SolveDynamic script")
     for option in OPTIONS.values():              # the analysis options, as declared
         exp.add_argument(f"--{option.name}", type=type(option.default),
+                         choices=option.choices or None,
                          metavar=option.metavar, help=f"{option.brief} (default: the model's)")
 
 

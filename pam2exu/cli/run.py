@@ -24,6 +24,7 @@ def add_parser(sub) -> None:
     run.add_argument("--steps", type=int, metavar="N", help="number of intervals (N + 1 rows)")
     for option in OPTIONS.values():              # the analysis options, as declared
         run.add_argument(f"--{option.name}", type=type(option.default),
+                         choices=option.choices or None,
                          metavar=option.metavar, help=option.help)
     run.add_argument("--outputs", nargs="+", metavar="PAT",
                      help="columns to keep: names, 'solid.*', '*.Fx' or bare 'Fx'")
