@@ -77,6 +77,10 @@ def run(model, analysis=None, **settings):
         ``'dynamic'`` only: the error allowed in the time integration, per unit of each
         coordinate and rate (tolerance · (1 + |value|), SI units); default 1e-8. The
         estimate achieved is ``res.info["integration_error"]``.
+    method : str, optional
+        ``'clearance'`` only: how the least-norm clearance is followed, ``'ode'`` (the
+        slides' differential equation, the default) or ``'newton'`` (Newton at every row
+        from the previous one); ``res.info["clearance_method"]`` says which.
 
     Returns
     -------

@@ -61,8 +61,9 @@ class RunInfo(MutableMapping):
     integration_steps : int
         dynamic: the steps of the finest run of a segment (of the backend's integrator).
     clearance_method : str
-        clearance: how the clearance of least norm was computed (the slides' ODE, or, with
-        no clearance joint and no varied anchor, the kinematic positions).
+        clearance: how the clearance of least norm was computed (the slides' ODE, Newton
+        at every row with ``method = "newton"``, or, with no clearance joint and no varied
+        anchor, the kinematic positions).
     undefined : str
         Columns asked for that are NaN by definition at some rows, and why (an
         instantaneous centre where its solid translates: ``points.columns``).
