@@ -286,15 +286,7 @@ class Linear:
         #: ``moves`` with the Variation's index in ``Closures._offsets`` and the fi column
         self.indexed = [(rows, G, PER_SOLID * solid + 2, index[v])
                         for rows, G, solid, v in self.moves]
-        #: (row, fi column, Variation index, ∂v/∂P (2,)) of every row of ``indexed``
-        self.move_rows = (
-            np.array([r for rows, *_ in self.indexed for r in rows], dtype=int),
-            np.array([col for rows, _, col, _ in self.indexed for _ in rows], dtype=int),
-            np.array([v for rows, _, _, v in self.indexed for _ in rows], dtype=int),
-            np.array([g for _, G, _, _ in self.indexed for g in G]).reshape(-1, 2))
         self.local_x, self.local_y = s.local[:, 0].copy(), s.local[:, 1].copy()
-        self.A_points = np.ascontiguousarray(self.A[:, :2 * K])
-        self.diagonal = np.zeros(self.nq)
         #: ∂x/∂q but its angle columns of the points (``evaluate`` writes them)
         self.jac = np.zeros((2 * K + self.nq, self.nq))
         point = np.arange(K)[s.translate]
@@ -306,6 +298,7 @@ class Linear:
         self.shift = np.r_[2 * point, 2 * point + 1]
         self.origin = np.r_[PER_SOLID * s.solids[s.translate],
                             PER_SOLID * s.solids[s.translate] + 1]
+        self._rate_layout(K)
 
     @staticmethod
     def _moves(closures: "Closures", el, rows: slice) -> list[tuple]:
@@ -383,6 +376,32 @@ class Linear:
             W[PER_SOLID * solid + 2, PER_SOLID * solid + 2] -= lam[rows] @ (G @ Ad)
         return C, Fq, W, f_rate
 
+    def _rate_layout(self, K: int) -> None:
+        """``rate``'s x: the K points and directions, then each varied point's offset δ and
+        its rate δ′ as two directions of its solid (E of each: ``indexed``), then q; its
+        A (the offsets' columns ∂v/∂P) and A′ (the rates' columns ∂v/∂P, C_t = A′ x)."""
+        E = len(self.indexed)
+        self.rate_K = K + 2 * E
+        cols = np.array([col for _, _, col, _ in self.indexed], dtype=int)
+        self.rate_fi = np.r_[self.fi, cols, cols]
+        self.rate_v = np.array([v for *_, v in self.indexed], dtype=int)
+        self.rate_even = 2 * np.arange(self.rate_K)
+        self.rate_odd = self.rate_even + 1
+        width, R = 2 * self.rate_K + self.nq, len(self.rows)
+        self.rate_A, self.rate_A1 = np.zeros((R, width)), np.zeros((R, width))
+        self.rate_A[:, :2 * K], self.rate_A[:, 2 * self.rate_K:] = self.A[:, :2 * K], \
+            self.A[:, 2 * K:]
+        position = {int(r): i for i, r in enumerate(self.rows)}
+        for i, (rows, G, _, _) in enumerate(self.indexed):
+            at = [position[int(r)] for r in rows]
+            for A, entry in ((self.rate_A, K + i), (self.rate_A1, K + E + i)):
+                A[at, 2 * entry] += G[:, 0]
+                A[at, 2 * entry + 1] += G[:, 1]
+        self.rate_points = np.ascontiguousarray(self.rate_A[:, :2 * self.rate_K])
+        self.rate_jac = np.zeros((width, self.nq))
+        self.rate_jac[:2 * K] = self.jac[:2 * K]
+        self.rate_jac[2 * self.rate_K:] = np.eye(self.nq)
+
     def rate(self, t: float, q: np.ndarray, lam: np.ndarray, u: np.ndarray,
              du: np.ndarray, laws: bool = True):
         """(C, F_q, W, C_t, F_qt) (each with a leading axis of 1) at one (t, q, λ) when
@@ -390,46 +409,35 @@ class Linear:
         the offsets u (V, 3) moving at du (V, 3) (C_t += ∂v/∂P A(fi) du, F_qt its ∂/∂fi),
         and C_t −= f′ of the laws where ``laws`` (a rate along the time). ``evaluate``'s
         complex step, by hand."""
-        K = len(self.points.keys)
-        fi = q[self.fi]
+        K, v = self.rate_K, self.rate_v
+        fi = q[self.rate_fi]
         c, sn = np.cos(fi), np.sin(fi)
-        ax = c * self.local_x - sn * self.local_y                    # A s
-        ay = sn * self.local_x + c * self.local_y
+        lx = np.concatenate((self.local_x, u[v, 0], du[v, 0]))
+        ly = np.concatenate((self.local_y, u[v, 1], du[v, 1]))
+        ax, ay = c * lx - sn * ly, sn * lx + c * ly                 # A s, A δ, A δ′
         x = np.empty(2 * K + self.nq)
-        x[self.even], x[self.odd] = ax, ay
-        jac = self.jac.copy()
-        jac[self.even, self.fi] = -ay                               # ∂(A s)/∂fi = Ω A s
-        jac[self.odd, self.fi] = ax
-        weights = lam[self.rows] @ self.A_points
-        curvature = -(weights[self.even] * ax + weights[self.odd] * ay)
+        x[self.rate_even], x[self.rate_odd] = ax, ay
+        jac = self.rate_jac.copy()
+        jac[self.rate_even, self.rate_fi] = -ay                     # ∂(A s)/∂fi = Ω A s
+        jac[self.rate_odd, self.rate_fi] = ax
+        weights = lam[self.rows] @ self.rate_points
+        curvature = -(weights[self.rate_even] * ax + weights[self.rate_odd] * ay)
         x[self.shift] += q[self.origin]                             # points: R + A s
         x[2 * K:] = q
         C = -self.constant
-        C[self.rows] += self.A @ x
+        C[self.rows] += self.rate_A @ x
         Fq = np.zeros((self.m, self.nq))
-        Fq[self.rows] = self.A @ jac
-        W = np.diag(np.bincount(self.fi, curvature, minlength=self.nq))   # ∂²(A s)/∂fi²
+        Fq[self.rows] = self.rate_A @ jac
+        W = np.diag(np.bincount(self.rate_fi, curvature, minlength=self.nq))  # ∂²(A s)/∂fi²
         C_t, F_qt = np.zeros(self.m), np.zeros((self.m, self.nq))
+        if self.indexed:                                            # ∂v/∂P A(fi) δ′
+            C_t[self.rows] = self.rate_A1 @ x
+            F_qt[self.rows] = self.rate_A1 @ jac
         for rows, function, constants in self.laws:
             f, df, _ = function(t, constants)
             C[rows] -= f
             if laws:
                 C_t[rows] -= df
-        if self.indexed:                    # every row of every varied point at once
-            row, col, v, G = self.move_rows
-            c, sn = np.cos(q[col]), np.sin(q[col])
-            ux, uy, rx, ry = u[v, 0], u[v, 1], du[v, 0], du[v, 1]
-            ax, ay = c * ux - sn * uy, sn * ux + c * uy              # A(fi) δ
-            bx, by = c * rx - sn * ry, sn * rx + c * ry              # A(fi) δ′
-            moved = G[:, 0] * ax + G[:, 1] * ay
-            at = row * self.nq + col
-            size = self.m * self.nq
-            C += np.bincount(row, moved, minlength=self.m)
-            Fq += np.bincount(at, G[:, 1] * ax - G[:, 0] * ay, minlength=size).reshape(Fq.shape)
-            W -= np.diag(np.bincount(col, lam[row] * moved, minlength=self.nq))
-            C_t += np.bincount(row, G[:, 0] * bx + G[:, 1] * by, minlength=self.m)
-            F_qt += np.bincount(at, G[:, 1] * bx - G[:, 0] * by,
-                                minlength=size).reshape(Fq.shape)
         return C[None], Fq[None], W[None], C_t[None], F_qt[None]
 
 
