@@ -76,7 +76,7 @@ FOUR_BAR_PARAMETERS = ("coupler.B.x", "rocker.B.y", "ground.O4.x", "coupler.P.y"
                        "coupler.cog.x", "crank.mass", "motor.C2")
 
 
-def _agree(d, fd, res, eps, tolerance=1e-6):
+def _agree(d, fd, res, eps, tolerance=1e-6, rows=slice(None)):
     """|∂y/∂p − central difference| ≤ tolerance · max |difference| of the column, plus the
     difference's own round-off, 100 u S / ε (u: the unit round-off; S: the largest |y| of
     the columns in the same unit, the scale of a solver's error in y: the runs are solved
@@ -88,7 +88,7 @@ def _agree(d, fd, res, eps, tolerance=1e-6):
     for c in fd:
         bound = (tolerance * np.max(np.abs(fd[c]))
                  + 100 * 2.2e-16 * scale[res.units[c]] / eps + 1e-300)
-        worst = max(worst, np.max(np.abs(d[c] - fd[c])) / bound)
+        worst = max(worst, np.max(np.abs(d[c] - fd[c])[rows]) / bound)
     assert worst <= 1.0, worst
 
 
@@ -122,8 +122,12 @@ def test_every_parameter_agrees_with_central_differences(path):
         except ModelError:                 # p − ε not allowed (a mass or gravity of 0)
             continue
         d, res, job = _sensitivity(model, "kinetostatic", name, steps=13)
+        # a law's start or end time at an output row (t = 0, t_end): the law has no
+        # derivative there with respect to that time (one-sided), the difference straddles it
+        breaks = [b for el in job.mech.drivers for b in el.time_law().breakpoints()]
+        rows = ~np.isin(np.round(res.t, 12), np.round(breaks, 12))
         try:
-            _agree(d, fd, res, eps)
+            _agree(d, fd, res, eps, rows=rows)
         except AssertionError as exc:
             raise AssertionError(f"{path} {name}: {exc}") from None
         checked += 1
