@@ -29,10 +29,6 @@ HISTORY = 3
 #: pay for a pre-step call (about 1 µs of a 20 µs step), after it only the predictor's way
 MARGIN = 0.05
 
-#: weights of the history rows, newest ×3, the one before ×−3, the oldest ×1, by the slot
-#: (count mod 3) the next solution goes to
-_WEIGHTS = [np.roll([1.0, -3.0, 3.0], j) for j in range(3)]
-
 
 def extrapolate(q1: np.ndarray, q2: np.ndarray, q3: np.ndarray) -> np.ndarray:
     """q_k ≈ 3 q_{k−1} − 3 q_{k−2} + q_{k−3}: the parabola through three equally spaced steps, one step on."""
@@ -46,26 +42,31 @@ class Predictor:
     Called once per load step with the step's grid index, or None for a step Exudyn made
     smaller after a failure; the coordinates at a call are the previous step's solution, so
     only an unbroken run of grid steps k−3, k−2, k−1 feeds the extrapolation. The last three
-    solutions are kept in a ring of rows and combined by one product (few NumPy calls: this
-    runs once per step).
+    solutions are kept in a ring and combined in place (few NumPy calls: this runs once per
+    step).
     """
 
     def __init__(self, system_data):
         self.get, self.set = system_data.GetODE2Coordinates, system_data.SetODE2Coordinates
-        self.last, self.count, self.history = None, 0, None
+        self.last, self.count, self.history = None, 0, [None, None, None]
+        self.guess = None
 
     def __call__(self, k: int | None) -> None:
         if k is None or self.last is None or k != self.last + 1:
             self.count = 0
         else:
-            q = self.get()
-            if self.history is None:
-                self.history = np.empty((3, len(q)))
-            slot = self.count % 3
-            self.history[slot] = q
+            history, slot = self.history, self.count % 3
+            history[slot] = self.get()
             self.count += 1
             if self.count >= 3:
-                self.set(_WEIGHTS[(slot + 1) % 3] @ self.history)
+                # extrapolate(q1, q2, q3) in place, operation for operation (same rounding)
+                q1, q2, q3 = history[slot], history[slot - 1], history[slot - 2]
+                if self.guess is None:
+                    self.guess = np.empty_like(q1)
+                guess = np.subtract(q1, q2, out=self.guess)
+                guess *= 3.0
+                guess += q3
+                self.set(guess.tolist())      # a list: Exudyn converts it faster
         self.last = k
 
 

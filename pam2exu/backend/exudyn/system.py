@@ -57,7 +57,8 @@ class SolveSettings:
         per step (docs/performance.md). False: from the previous step's solution. "auto"
         (the default): a run of ``PROBE_FROM`` steps or more first times blocks of steps
         each way (``predictor.Probe``) and goes on with the predictor only if its steps
-        were the faster; shorter runs predict. Not used with redundant constraints, which Exudyn solves with a singular Jacobian:
+        were clearly the faster (``predictor.predictor_pays``); shorter runs predict.
+        Not used with redundant constraints, which Exudyn solves with a singular Jacobian:
         there one iteration from the prediction can stop on the tolerance with a position
         error of ~5e-12 rad after a change point (the redundant parallelogram), where two
         from the previous step reach round-off.
