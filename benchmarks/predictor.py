@@ -31,6 +31,7 @@ if __package__ in (None, ""):          # python benchmarks/predictor.py: the clo
 import pam2exu  # noqa: E402
 from pam2exu.backend import SolveSettings  # noqa: E402
 from pam2exu.backend.exudyn import system  # noqa: E402
+from pam2exu.backend.exudyn.predictor import PROBE_FROM  # noqa: E402
 
 from benchmarks.measure import ROOT, log, machine  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
@@ -44,23 +45,28 @@ LABEL = {"auto": 'default (`"auto"`)', "on": "predictor always", "off": "predict
 
 
 class Recorder:
-    """Wraps ``ExudynSystem.solve_positions`` to keep, of every long solve, (predictor used,
-    Newton iterations per step)."""
+    """Wraps ``ExudynSystem.solve_positions`` to keep, of every solve of ``PROBE_FROM`` steps
+    or more (a run of over 50,000 steps is solved in parts, each probed), whether the
+    predictor was used and the Newton iterations."""
 
-    def __init__(self, min_steps):
-        self.min_steps, self.calls = min_steps, []
+    def __init__(self):
+        self.calls = []
         self.original = system.ExudynSystem.solve_positions
 
         def wrapped(ex, times, *args, **kwargs):
             out = self.original(ex, times, *args, **kwargs)
-            if len(times) >= self.min_steps:
-                self.calls.append((ex.predicted, ex.newton_iterations / len(times)))
+            if len(times) >= PROBE_FROM:
+                self.calls.append((ex.predicted, ex.newton_iterations, len(times)))
             return out
         system.ExudynSystem.solve_positions = wrapped
 
     def take(self):
+        """(parts solved with the predictor, parts, Newton iterations per step) since the
+        last call."""
         calls, self.calls = self.calls, []
-        return calls[-1] if calls else (None, float("nan"))
+        steps = sum(n for *_, n in calls)
+        return (sum(bool(p) for p, *_ in calls), len(calls),
+                sum(i for _, i, _ in calls) / steps if steps else float("nan"))
 
     def close(self):
         system.ExudynSystem.solve_positions = self.original
@@ -77,7 +83,7 @@ def pam_seconds(model, steps, t_end, predictor):
 
 
 def measure(rounds, steps, slow_steps):
-    """{config: [(seconds, predicted, iterations per step), one per round]}."""
+    """{config: [(seconds, parts predicted, parts, iterations per step), one per round]}."""
     model = pam2exu.load(ROOT / "examples" / "four_bar.toml")
     slow = pam2exu.load(ROOT / "examples" / "four_bar.toml")
     slow["motor"].C = [0.0, 10.0, 0.0, 0.0]
@@ -89,7 +95,7 @@ def measure(rounds, steps, slow_steps):
         jobs[f"fast {key}"] = (lambda s=setting: pam_seconds(model, steps, 1.0, s))
         jobs[f"slow {key}"] = (lambda s=setting: pam_seconds(slow, slow_steps, slow_t_end, s))
     out = {key: [] for key in jobs}
-    recorder = Recorder(min(steps, slow_steps))
+    recorder = Recorder()
     try:
         for r in range(rounds):
             order = list(jobs) if r % 2 == 0 else list(reversed(jobs))
@@ -144,12 +150,13 @@ def section(out, steps, slow_steps, slow_t_end, info, load_before, load_after, m
                         ("slow", f"θ = 10 t, {slow_steps:,} steps over {slow_t_end:.1f} s")):
         for key in SETTINGS:
             runs = out[f"{case} {key}"]
-            used = sum(bool(p) for _, p, _ in runs)
-            its = np.mean([i for *_, i in runs])
+            used = sum(r[1] for r in runs)
+            parts = sum(r[2] for r in runs)
+            its = np.mean([r[3] for r in runs])
             detail.append([label, LABEL[key], f"{1e6 * best[f'{case} {key}']:.1f}",
                            f"{1e6 * cpu_best[f'{case} {key}']:.1f}",
                            f"{best[f'{case} {key}'] / best[f'{case} off']:.2f}×",
-                           f"{its:.2f}", f"{used} of {len(runs)}"])
+                           f"{its:.2f}", f"{used} of {parts}"])
     detail.append([f"θ = 2π t, {steps:,} steps over 1 s", "plain Exudyn script (symbolic)",
                    f"{1e6 * best['plain']:.1f}", f"{1e6 * cpu_best['plain']:.1f}", "–",
                    f"{plain_iterations:.2f}", "–"])
@@ -182,11 +189,12 @@ def section(out, steps, slow_steps, slow_t_end, info, load_before, load_after, m
         "",
         table(["what", "measured", "target", "verdict"], rows),
         "",
-        table(["motion", "predictor", "µs/step (best)", "CPU µs/step (best)", "/ predictor never",
+        table(["motion", "predictor", "µs/step (best)", "CPU µs/step (best)",
+               "/ predictor never",
                "Newton it./step (mean)", "predictor kept"], detail),
         "",
-        "*Predictor kept*: in how many of the rounds' runs the probe chose the predictor "
-        "(always for *predictor always*); *CPU*: the process's CPU time (`time.process_time`), "
+        "*Predictor kept*: in how many of the rounds' solves the predictor was used (a run of "
+        "more than 50,000 steps is solved in parts of 50,000, each with its own probe); *CPU*: the process's CPU time (`time.process_time`), "
         "which leaves out the time the process waited for a core. Positions only: "
         "kinematic with `outputs=[\"x\", "
         "\"y\", \"fi\"]`, the whole `pam2exu.run` with a loaded model.",
