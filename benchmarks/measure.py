@@ -17,6 +17,7 @@ import subprocess
 import time
 import warnings
 from dataclasses import dataclass, field
+from datetime import datetime, timezone
 from pathlib import Path
 
 import exudyn as exu
@@ -262,9 +263,12 @@ def machine():
                                          else "")
     except (OSError, subprocess.CalledProcessError):
         pass
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     return {"CPU": cpu, "cores": str(os.cpu_count()), "RAM": ram, "OS": os_name,
             "Python": platform.python_version(), "NumPy": np.__version__,
-            "Exudyn": exu.__version__, "pam2exu": version}
+            "Exudyn": exu.__version__, "pam2exu": version,
+            "date (UTC)": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M"),
+            "load averages at the start (1, 5, 15 min)": load}
 
 
 def log(text):

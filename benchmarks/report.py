@@ -224,7 +224,9 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
     pos_off_us = 1e6 * cmp10["positions_no_predictor"][0] / s
     add(f"- **The predictor.** pam2exu sets Exudyn's coordinates before each load step to "
         "the parabola through the last three steps (`SolveSettings.predictor`, a Python "
-        "pre-step function): Newton then takes "
+        "pre-step function; by default, on runs of 4,096 steps or more, only if a probe of "
+        "200 steps at the start finds its steps the shorter: the section on the predictor "
+        "below): Newton then takes "
         + ", ".join(f"{r['pam_iterations']:.2f} iterations per step at {r['steps']:,} steps "
                     f"(without it {r['pam_iterations_no_predictor']:.2f})" for r in plain_rows)
         + f". At {s:,} steps the positions-only run takes {pos_us:.1f} µs/step with it and "

@@ -170,7 +170,7 @@ class AgainstPlain:
     per step (plain script, pam2exu with and without predictor) and the plain script's
     error."""
 
-    PAM = {"positions": ("kinematic", ["x", "y", "fi"], True, False),
+    PAM = {"positions": ("kinematic", ["x", "y", "fi"], "auto", False),
            "positions_no_predictor": ("kinematic", ["x", "y", "fi"], False, False),
            "kinematic": ("kinematic", None, True, False),
            "kinematic_csv": ("kinematic", None, True, True),

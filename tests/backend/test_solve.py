@@ -6,6 +6,7 @@ predictor (the same configurations to the solver's tolerance).
 """
 import logging
 
+import exudyn as exu
 import numpy as np
 import pytest
 
@@ -13,7 +14,9 @@ import pam2exu
 from pam2exu.analyses.quasi_static import checked_steps
 from pam2exu.analyses.job import prepare
 from pam2exu.backend import ExudynSystem, SolveSettings
-from pam2exu.backend.exudyn import system
+from pam2exu.backend.exudyn import predictor, system
+from pam2exu.kinematics import column
+from references.closed_form import four_bar_angles
 
 
 @pytest.fixture(scope="module")
@@ -115,3 +118,97 @@ def test_long_runs_stay_on_the_grid(request):
     expected = driver.time_law()(res.t)[0]
     assert np.max(np.abs(res["Solid1.fi"] - expected)) < 1e-12 * max(1.0, np.max(np.abs(expected)))
     assert system.ON_GRID * 64 < 1.0     # a cut step (≥ 1/64 of a step off the grid) never is
+
+
+# ---- the predictor decided by measurement (predictor = "auto") -------------------------------
+
+def test_predictor_pays_when_its_median_step_is_clearly_shorter():
+    """The median, not the mean: one step slowed by the machine does not decide; and shorter
+    by more than MARGIN (the pre-step call only the predictor's way pays after the probe)."""
+    assert predictor.predictor_pays([1.0, 1.0, 1.0], [2.0, 2.0, 2.0])
+    assert not predictor.predictor_pays([1.0, 3.0, 3.0], [2.0, 2.0, 2.0])
+    assert predictor.predictor_pays([1.0, 1.0, 50.0], [2.0, 2.0, 2.0])
+    assert not predictor.predictor_pays([], [2.0])
+    just = 1.0 - predictor.MARGIN
+    assert predictor.predictor_pays([0.99 * just], [1.0])
+    assert not predictor.predictor_pays([1.01 * just], [1.0])
+
+
+def test_probe_alternates_blocks_and_ends_predicting():
+    """Warm-up predicted and not timed; blocks of BLOCK steps, off, on, off, …, the last on;
+    a predicted block's first HISTORY steps (no three-step history yet) not timed."""
+    P = predictor.Probe
+    modes = [P.predicting(i) for i in range(predictor.PROBE_STEPS)]
+    assert all(modes[:predictor.WARM_UP]) and modes[-1]
+    blocks = [modes[predictor.WARM_UP + b * predictor.BLOCK:
+                    predictor.WARM_UP + (b + 1) * predictor.BLOCK]
+              for b in range(predictor.BLOCKS)]
+    assert [set(b) for b in blocks] == [{b % 2 == 1} for b in range(predictor.BLOCKS)]
+    timed = [P.timed(i) for i in range(predictor.PROBE_STEPS)]
+    on = predictor.WARM_UP + predictor.BLOCK          # the first predicted block
+    assert not any(timed[:predictor.WARM_UP]) and all(timed[predictor.WARM_UP:on])
+    assert timed[on:on + predictor.BLOCK] == [False] * predictor.HISTORY + [True] * (
+        predictor.BLOCK - predictor.HISTORY)
+
+
+def fake_clock(cost_on, cost_off):
+    """A clock for ``Probe`` in which probe step i takes cost_on with the predictor and
+    cost_off without: its j-th reading is the sum of the costs of steps 0 … j − 1."""
+    state = {"calls": 0, "now": 0.0}
+
+    def clock():
+        j = state["calls"]
+        if j:
+            state["now"] += cost_on if predictor.Probe.predicting(j - 1) else cost_off
+        state["calls"] += 1
+        return state["now"]
+    return clock
+
+
+@pytest.fixture(scope="module")
+def long_four_bar(request):
+    return prepare(request.config.rootpath / "examples" / "four_bar.toml",
+                   analysis="kinematic", steps=predictor.PROBE_FROM)
+
+
+@pytest.mark.parametrize("cost_on, cost_off, predicted", [(1.0, 2.0, True), (3.0, 2.0, False)])
+def test_auto_keeps_the_faster_way_and_the_positions(long_four_bar, cost_on, cost_off,
+                                                     predicted):
+    """Timings injected: the run goes on with the predictor (Newton: 1 iteration per step)
+    when its probe steps were the shorter, without it (2 per step) otherwise; every row solved
+    across the probe's end, the crank's angle 2π t and the rocker's the closed form's (to the
+    solver's tolerance) either way, and the initial configuration left as it was."""
+    job = long_four_bar
+    ex = ExudynSystem(job.mech)
+    ex.clock = fake_clock(cost_on, cost_off)
+    initial = ex.mbs.systemData.GetODE2Coordinates(configuration=exu.ConfigurationType.Initial)
+    q, solved = ex.solve_positions(job.times)      # the default: predictor = "auto"
+    assert solved == len(job.times) and ex.error is None and ex.predicted is predicted
+    per_step = ex.newton_iterations / len(job.times)         # the probe's 200 steps too
+    assert per_step < 1.1 if predicted else per_step > 1.9, per_step
+    names = [s.name for s in job.mech.solids]
+    crank, rocker = names.index("crank"), names.index("rocker")
+    theta = 2 * np.pi * job.times
+    _, psi = np.array([four_bar_angles(0.1, 0.35, 0.3, 0.4, th) for th in theta]).T
+    np.testing.assert_allclose(q[:, column(crank, 2)], theta, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(q[:, column(rocker, 2)], psi, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(
+        ex.mbs.systemData.GetODE2Coordinates(configuration=exu.ConfigurationType.Initial),
+        initial)
+
+
+def test_auto_keeps_the_multipliers_across_the_probe(long_four_bar):
+    """With the forces (the static multipliers of a kinetostatic run) and the predictor
+    found slower: every step's multipliers kept, the same as a run without the predictor."""
+    job = long_four_bar
+    runs = {}
+    for setting in ("auto", False):
+        ex = ExudynSystem(job.mech, forces=True, velocity_forces=False)
+        ex.clock = fake_clock(3.0, 2.0)
+        q, solved = ex.solve_positions(job.times, SolveSettings(predictor=setting),
+                                       multipliers=True)
+        assert solved == len(job.times) and np.isfinite(ex.multipliers).all()
+        runs[setting] = q, ex.multipliers
+    np.testing.assert_allclose(runs["auto"][0], runs[False][0], rtol=0, atol=1e-12)
+    scale = np.max(np.abs(runs[False][1]))
+    np.testing.assert_allclose(runs["auto"][1], runs[False][1], rtol=0, atol=1e-10 * scale)

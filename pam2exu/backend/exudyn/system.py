@@ -13,6 +13,7 @@ the items of each solid and element start.
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +22,7 @@ import exudyn as exu
 from exudyn import itemInterface as items
 
 from ...kinematics import State, column, pose
+from .predictor import PROBE_FROM, PROBE_STEPS, Predictor, Probe, extrapolate  # noqa: F401
 from .symbolic import ON_GRID, offset_function
 
 log = logging.getLogger("pam2exu")
@@ -48,10 +50,14 @@ class SolveSettings:
         Dense linear solver (None: dense up to DENSE_UP_TO coordinates, sparse above).
     verbose : int
         Exudyn's solver output (0: quiet).
-    predictor : bool
-        Start each step's Newton iteration from the quadratic extrapolation of the last
-        three solved steps (``extrapolate``) instead of the previous step's solution: one
-        Newton iteration per step instead of two on smooth motions (docs/performance.md).
+    predictor : bool | str
+        True: start each step's Newton iteration from the quadratic extrapolation of the
+        last three solved steps (``extrapolate``) instead of the previous step's solution:
+        one Newton iteration per step instead of two on smooth motions, for a Python call
+        per step (docs/performance.md). False: from the previous step's solution. "auto"
+        (the default): a run of ``PROBE_FROM`` steps or more first times blocks of steps
+        each way (``predictor.Probe``) and goes on with the predictor only if its steps
+        were clearly the faster (``predictor.predictor_pays``); shorter runs predict.
         Not used with redundant constraints, which Exudyn solves with a singular Jacobian:
         there one iteration from the prediction can stop on the tolerance with a position
         error of ~5e-12 rad after a change point (the redundant parallelogram), where two
@@ -62,36 +68,7 @@ class SolveSettings:
     max_iterations: int = 25
     dense: bool | None = None
     verbose: int = 0
-    predictor: bool = True
-
-
-def extrapolate(q1: np.ndarray, q2: np.ndarray, q3: np.ndarray) -> np.ndarray:
-    """q_k ≈ 3 q_{k−1} − 3 q_{k−2} + q_{k−3}: the parabola through three equally spaced steps, one step on."""
-    return 3.0 * (q1 - q2) + q3
-
-
-class Predictor:
-    """Sets Exudyn's coordinates, before each load step, to ``extrapolate`` of the last three
-    steps solved on the grid.
-
-    Called once per load step with the step's grid index, or None for a step Exudyn made
-    smaller after a failure; the coordinates at a call are the previous step's solution, so
-    only an unbroken run of grid steps k−3, k−2, k−1 feeds the extrapolation.
-    """
-
-    def __init__(self, system_data):
-        self.get, self.set = system_data.GetODE2Coordinates, system_data.SetODE2Coordinates
-        self.last, self.solved = None, []
-
-    def __call__(self, k: int | None) -> None:
-        if k is None or self.last is None or k != self.last + 1:
-            self.solved = []
-        else:
-            self.solved = [*self.solved[-2:], self.get()]
-            if len(self.solved) == 3:
-                q3, q2, q1 = self.solved
-                self.set(extrapolate(q1, q2, q3))
-        self.last = k
+    predictor: bool | str = "auto"
 
 
 def solver_options(mech, settings: SolveSettings, redundant: bool,
@@ -146,6 +123,8 @@ class ExudynSystem:
     """
 
     items = items
+    #: the clock that times the predictor's probe (``predictor.Probe``)
+    clock = staticmethod(time.perf_counter)
 
     def __init__(self, mech, forces: bool = False, velocity_forces: bool = True,
                  anchor_stiffness: float = 0.0, start=None, start_rates=None,
@@ -356,6 +335,7 @@ class ExudynSystem:
         times = np.asarray(times, dtype=float)
         n = len(times)
         self.error, self.multipliers, self.newton_iterations = None, None, 0
+        self.predicted = False
         if not self.sensors:                     # every solid is fixed: nothing to solve
             return np.tile(self.mech.initial_q(), (n, 1)), n
         # one time alone (an assembly, a restart at the last step) is step k0 = 1 of a grid
@@ -392,6 +372,10 @@ class ExudynSystem:
 
         predict = (Predictor(mbs.systemData) if settings.predictor and n > 3 and not redundant
                    else None)
+        probe = None
+        if predict is not None and settings.predictor == "auto" and n >= PROBE_FROM:
+            probe = Probe(predict, self.clock)
+        self.predicted = predict is not None
 
         def pre_step(mbs, t):
             tau = t - dt
@@ -400,12 +384,10 @@ class ExudynSystem:
             for obj, par, law, shift, values in self.stepped:
                 mbs.SetObjectParameter(obj, par, float(values[k]) if on_grid
                                        else law.value(tau) + shift)
-            if predict is not None:
-                predict(k if on_grid else None)
+            if guess is not None:
+                guess(k if on_grid else None)
             return True
 
-        if self.stepped or predict is not None:
-            mbs.SetPreStepUserFunction(pre_step)
         if multipliers:
             lam = self.multipliers = np.full((n, mbs.systemData.AEsize()), np.nan)
             get = mbs.systemData.GetAECoordinates
@@ -418,12 +400,46 @@ class ExudynSystem:
 
             mbs.SetPostStepUserFunction(post_step)
         ss = self.simulation_settings(settings, redundant, self.roundoff(times))
-        ss.staticSolver.numberOfLoadSteps = n
-        ss.staticSolver.loadStepStart = k0 * dt
-        ss.staticSolver.loadStepDuration = n * dt
         # where Newton fails, Exudyn retries with smaller steps: at most MIN_STEP_FRACTION
         # of a step (its default, 1e-8 s, lets a long step be cut into ~1e15 pieces)
         ss.staticSolver.minimumStepSize = MIN_STEP_FRACTION * dt
+        q = np.full((n, self.mech.nq), np.nan)
+        done, error = 0, None
+        if probe is not None:
+            # the probe's steps first (the predictor in some blocks, not in others, each
+            # step timed), then the rest from where it stopped, with the predictor only if
+            # its steps were the faster
+            guess = probe
+            error = self._static_steps(ss, q, 0, PROBE_STEPS, k0, dt, pre_step, settings)
+            done = PROBE_STEPS
+            self.predicted = probe.pays()
+        if error is None and done < n:
+            guess = predict if self.predicted else None
+            sd, initial = mbs.systemData, None
+            if done:                  # go on from the probe's last step
+                initial = sd.GetSystemState(exu.ConfigurationType.Initial)
+                sd.SetSystemState(sd.GetSystemState(), exu.ConfigurationType.Initial)
+            error = self._static_steps(ss, q, done, n - done, k0, dt,
+                                       pre_step if self.stepped or guess else None, settings)
+            if initial is not None:
+                sd.SetSystemState(initial, exu.ConfigurationType.Initial)
+        solved = int(np.argmin(np.isfinite(q).all(axis=1))) if not np.isfinite(q).all() else n
+        if error is None and solved < n:
+            error = RuntimeError("the static solver stopped early")
+        self.error = error
+        return q, solved
+
+    def _static_steps(self, ss, q, first: int, count: int, k0: int, dt: float, pre_step,
+                      settings: SolveSettings):
+        """Solve the load steps of rows first … first+count−1 of q (times (k0 + row)·dt) in
+        one SolveStatic from the initial configuration, with ``pre_step`` (None: no pre-step
+        function), into q's rows; adds to ``self.newton_iterations``; returns Exudyn's
+        exception or None."""
+        mbs = self.mbs
+        mbs.SetPreStepUserFunction(pre_step if pre_step is not None else 0)
+        ss.staticSolver.numberOfLoadSteps = count
+        ss.staticSolver.loadStepStart = (k0 + first) * dt
+        ss.staticSolver.loadStepDuration = count * dt
         error = None
         exu.config.printToConsole = settings.verbose > 0
         try:
@@ -433,23 +449,17 @@ class ExudynSystem:
         finally:
             exu.config.printToConsole = False
         solver = mbs.sys.get("staticSolver")      # SolveStatic keeps it (storeSolver=True)
-        self.newton_iterations = int(solver.it.newtonStepsCount) if solver else 0
+        self.newton_iterations += int(solver.it.newtonStepsCount) if solver else 0
         data = {i: np.asarray(mbs.GetSensorStoredData(s)) for i, s in self.sensors.items()}
-        q = np.full((n, self.mech.nq), np.nan)
-        first = next(iter(data.values()), None)
-        if first is not None and len(first) > 1:
-            t_rows = first[1:, 0] - dt          # row 0 is the unsolved initial state
+        sample = next(iter(data.values()), None)
+        if sample is not None and len(sample) > 1:
+            t_rows = sample[1:, 0] - dt          # row 0 is the unsolved initial state
             k_rows = np.rint(t_rows / dt).astype(int)
             on_grid = np.abs(t_rows - k_rows * dt) <= ON_GRID * dt
             k_rows -= k0
-            on_grid &= (k_rows >= 0) & (k_rows < n)
+            on_grid &= (k_rows >= first) & (k_rows < first + count)
             for i, d in data.items():
                 q[k_rows[on_grid], pose(i)] = d[1:, 1:4][on_grid]
             for i in self.grounded:
                 q[k_rows[on_grid], pose(i)] = self.mech.initial_q()[pose(i)]
-        solved = int(np.argmin(np.isfinite(q).all(axis=1))) if not np.isfinite(q).all() else n
-        if error is None and solved < n:
-            error = RuntimeError("the static solver stopped early")
-        self.error = error
-        return q, solved
-
+        return error
