@@ -1016,7 +1016,8 @@ RATES = (0.1, -2.0, 10.0, 0.0, -0.0, NAN, INF, -INF, 1e300, 1e13, 10**400, "1.0"
          {"x": 1.0})
 EXTREME_RATES = (1e3, 1e6, 1e12, -1e12)
 CLEARANCE_FLAGS = (True, True, False, "true", 1, 0, "yes", NAN, [True], {"on": True})
-VARIATION_KEYS = ("anchor", "dx", "dy", "dangle", "w", "wx", "wy", "wangle", "tau")
+VARIATION_KEYS = ("anchor", "dx", "dy", "dangle", "w", "wx", "wy", "wangle", "tau", "fixed_dx",
+                  "fixed_dy", "fixed_dangle")
 VARIATION_VALUES = (1e-4, -3e-4, 0.0, 2.0, NAN, INF, -INF, 1e300, -1e300, 5e-324, 1e-300,
                     10**400, "1e-4", True, [1e-4], -1.0, 1e6)
 ANGLE_UNITS = ("deg", "deg", "rad", "DEG", "degrees", "grad", "", " deg", 1, True, ["deg"],
