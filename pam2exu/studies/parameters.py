@@ -14,6 +14,8 @@ which the clearance analysis reaches from the nominal assembly.
 """
 from __future__ import annotations
 
+import copy
+import functools
 import re
 from dataclasses import dataclass
 
@@ -185,6 +187,14 @@ def write_deviation(model: Model, target: Target, value: float) -> None:
     setattr(entry, key, float(getattr(entry, key)) + (float(value) - target.nominal))
 
 
+@functools.lru_cache(maxsize=4)
+def _parsed(text: str, source: str) -> tuple[Model, dict[str, Target]]:
+    """The model of ``text`` parsed once per process, with its targets (a worker runs many
+    variants of one model: each gets a deep copy, as if its text had been parsed again)."""
+    model = loads(text, source=source)
+    return model, targets(model)
+
+
 def varied(text: str, values: dict[str, float], source: str = "<string>",
            as_made: bool = False) -> Model:
     """The model of ``text`` with a variant's ``values`` written in (what a worker builds).
@@ -214,8 +224,8 @@ def varied(text: str, values: dict[str, float], source: str = "<string>",
     ModelError
         The values make the model invalid (a negative mass, …).
     """
-    model = loads(text, source=source)
-    found = targets(model)
+    parsed, found = _parsed(text, source)       # the targets are frozen: shared
+    model = copy.deepcopy(parsed)
     for name, value in values.items():
         target = found[name]
         (write_deviation if as_made and is_dimension(target) else write)(model, target,
