@@ -31,6 +31,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..version import __version__
+
 #: a part file's name: its rows start … stop − 1
 PART = "chunk-{start:09d}-{stop:09d}.npz"
 PART_PATTERN = re.compile(r"chunk-(\d+)-(\d+)\.npz")
@@ -113,10 +115,16 @@ def plan_chunks(variants: int, seconds_per_variant: float, workers: int = 1
     return list(zip(bounds[:-1], bounds[1:]))
 
 
+#: what a chunk holds and how, with pam2exu's version, in every key: a part another version
+#: wrote (its columns or its numbers may differ, e.g. one without the variants' warnings)
+#: is not this study's, and is run again rather than merged
+PART_FORMAT = ("pam2exu", __version__, 2)
+
+
 def fingerprint(*items) -> str:
-    """SHA-256 of the items' pickle: the default key of a study's parts (the task's module
-    and name, and its payload)."""
-    return hashlib.sha256(pickle.dumps(items, protocol=4)).hexdigest()
+    """SHA-256 of the items' pickle with ``PART_FORMAT``: the default key of a study's parts
+    (the task's module and name, and its payload)."""
+    return hashlib.sha256(pickle.dumps((PART_FORMAT, *items), protocol=4)).hexdigest()
 
 
 def part_path(folder: Path, start: int, stop: int) -> Path:

@@ -159,6 +159,19 @@ def test_resume_computes_only_the_missing_and_unreadable_parts(tmp_path, payload
     assert other.columns["x"].tobytes() != reference["x"].tobytes()
 
 
+def test_parts_another_version_wrote_are_run_again_not_merged(tmp_path, payload,
+                                                              monkeypatch):
+    """The key holds ``parts.PART_FORMAT`` (pam2exu's version and the chunks' layout): a
+    part of the same study written by another version is not reused."""
+    folder = tmp_path / "OUT.parts"
+    run_chunks(chunk_tasks.rows, payload, CHUNKS, folder)
+    monkeypatch.setattr(parts, "PART_FORMAT", ("pam2exu", "another version", 2))
+    forget_calls(payload)
+    again = run_chunks(chunk_tasks.rows, payload, CHUNKS, folder, resume=True)
+    assert calls(payload) == list(CHUNKS) and again.reused == ()
+    assert_same_bytes(again.columns, expected(payload))
+
+
 def test_a_worker_lost_mid_chunk_is_retried_on_the_pool(tmp_path, payload):
     reference = expected(payload)
     folder = tmp_path / "OUT.parts"
