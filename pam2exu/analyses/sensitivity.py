@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -48,20 +49,39 @@ def analytic_solve(J: np.ndarray, b: np.ndarray, redundant: bool) -> np.ndarray:
     return np.linalg.solve(J, b[..., None])[..., 0]
 
 
-def position_derivative(mech, mech_p, t, q, redundant: bool, step: float = STEP,
+class Nominal(NamedTuple):
+    """The nominal run at its output rows, and what every parameter's derivative reuses
+    there: the moving rows and columns of Cq (``native.moving``) and Cq itself, real."""
+
+    t: np.ndarray
+    q: np.ndarray
+    redundant: bool
+    rows: np.ndarray
+    cols: np.ndarray
+    jacobian: np.ndarray
+
+
+def nominal(job: Job, t, q, redundant: bool) -> Nominal:
+    """``Nominal`` of the rows (t, q) of a run of ``job`` (Cq evaluated once, for every
+    parameter)."""
+    rows, cols = native.moving(job.mech)
+    J = native.equations(job.mech, State(t, q)).jacobian[:, rows[:, None], cols]
+    return Nominal(np.asarray(t), np.asarray(q), redundant, rows, cols, J)
+
+
+def position_derivative(at: Nominal, mech_p, step: float = STEP,
                         parameter: str = "the parameter") -> np.ndarray:
-    """∂q/∂p (n, nq) from Cq ∂q/∂p = −∂C/∂p at the positions q (n, nq) of ``mech``;
-    ``mech_p``: the mechanism with p + i·step. SolverError naming the parameter when an
-    over-constrained mechanism cannot follow it (its assembly would break)."""
-    rows, cols = native.moving(mech)
+    """∂q/∂p (n, nq) from Cq ∂q/∂p = −∂C/∂p at the nominal positions; ``mech_p``: the
+    mechanism with p + i·step. SolverError naming the parameter when an over-constrained
+    mechanism cannot follow it (its assembly would break)."""
+    t, q, rows, cols, J = at.t, at.q, at.rows, at.cols, at.jacobian
     dq = np.zeros_like(q)
     if not len(cols):
         return dq
     dC = native.equations(mech_p, State(t, q.astype(complex)), jacobian=False).residual
     dC = dC.imag[:, rows] / step
-    J = native.equations(mech, State(t, q)).jacobian[:, rows[:, None], cols]
-    dq[:, cols] = -analytic_solve(J, dC, redundant)
-    if redundant:
+    dq[:, cols] = -analytic_solve(J, dC, at.redundant)
+    if at.redundant:
         left = np.einsum("nmk,nk->nm", J, dq[:, cols]) + dC
         scale = np.max(np.abs(dC), axis=1) + 1e-300
         worst = np.max(np.abs(left), axis=1) / scale
@@ -77,21 +97,20 @@ def position_derivative(mech, mech_p, t, q, redundant: bool, step: float = STEP,
     return dq
 
 
-def derivatives(job: Job, t, q, model_p, redundant: bool, step: float = STEP,
+def derivatives(job: Job, at: Nominal, model_p, step: float = STEP,
                 parameter: str = "the parameter") -> dict[str, np.ndarray]:
-    """∂y/∂p of every column of ``job.columns`` at the rows (t, q) of a nominal run of
+    """∂y/∂p of every column of ``job.columns`` at the output rows of a nominal run of
     ``job``; ``model_p``: a copy of the model with p + i·step written in.
 
     Parameters
     ----------
     job : Job
         The nominal analysis (its mechanism, columns, levels and type).
-    t, q : numpy.ndarray
-        The output rows' times (n,) and the nominal positions there (n, nq).
+    at : Nominal
+        The nominal run's rows (``nominal``: times, positions, whether the mechanism has
+        redundant constraints, its Jacobian there).
     model_p : Model
         The model with the parameter at p + i·step (not validated: complex numbers).
-    redundant : bool
-        The mechanism has redundant constraints (its mobility check).
     step : float
         The complex step h.
     parameter : str
@@ -104,16 +123,15 @@ def derivatives(job: Job, t, q, model_p, redundant: bool, step: float = STEP,
     """
     with warnings.catch_warnings():      # an imaginary part dropped is a fault, never a 0
         warnings.simplefilter("error", np.exceptions.ComplexWarning)
-        return _derivatives(job, t, q, model_p, redundant, step, parameter)
+        return _derivatives(job, at, model_p, step, parameter)
 
 
-def _derivatives(job: Job, t, q, model_p, redundant: bool, step: float, parameter: str):
+def _derivatives(job: Job, at: Nominal, model_p, step: float, parameter: str):
     """``derivatives`` (a complex number cast to a float raises)."""
-    mech, mech_p = job.mech, Mechanism(model_p)
-    dq = position_derivative(mech, mech_p, t, q, redundant, step, parameter)
-    qc = q + 1j * step * dq
+    mech_p = Mechanism(model_p)
+    t, rows, cols, redundant = at.t, at.rows, at.cols, at.redundant
+    qc = at.q + 1j * step * position_derivative(at, mech_p, step, parameter)
     qdc = qddc = None
-    rows, cols = native.moving(mech)
     if VELOCITY in job.levels:
         eq = native.equations(mech_p, State(t, qc))
         J = eq.jacobian[:, rows[:, None], cols]

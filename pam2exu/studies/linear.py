@@ -5,7 +5,7 @@ At the nominal variant: ∂y/∂p of every output series to every parameter, fro
 equations themselves (``analyses.sensitivity``: the implicit-function theorem through the
 positions, velocities, accelerations and forces, by the complex step, never a difference
 of runs); σ_y(t) = sqrt(Σ_p (∂y/∂p σ_p)²) with σ_p the parameter's standard deviation;
-and the same for each reduced output, ∂y_r/∂p from ``reduce.FIRST_ORDER``.
+and the same for each reduced output, ∂y_r/∂p from each reduction's ``derivative`` (``reduce.REDUCTIONS``).
 
 A linear study's table (``OUT.parquet`` or ``.csv``) has one row per output time: ``t``,
 then for each output ``<output>`` (nominal), ``<output>.std`` (σ_y(t)) and
@@ -27,7 +27,7 @@ from ..results import Results
 from ..results.units import angle_factor, in_angles
 from . import plots
 from .parameters import targets, write
-from .reduce import (FIRST_ORDER, LINEAR_STD, OK, REDUCTIONS, reduced_name, status)
+from .reduce import LINEAR_STD, OK, REDUCTIONS, status
 from .result import Yield, check_out, summary_path
 from .summary import SummaryRow, write_summary
 
@@ -74,7 +74,8 @@ class Sensitivities:
     def reduced(self, column: str, reduction: str) -> tuple[float, np.ndarray]:
         """(y_r, ∂y_r/∂p (P,)) of a reduced output at the nominal variant."""
         y, dy = self.nominal[column], self.derivative[column]
-        return REDUCTIONS[reduction](y), FIRST_ORDER[reduction](y, dy)
+        reduce = REDUCTIONS[reduction]
+        return reduce(y), reduce.derivative(y, dy)
 
     def contributions(self, column: str, reduction: str) -> dict[str, float]:
         """∂y_r/∂p σ_p of every parameter (signed): the bars of a tornado plot."""
@@ -129,8 +130,7 @@ def sensitivities(study) -> Sensitivities:
     """
     from ..analyses import run
     from ..analyses.job import check_mobility, prepare
-    from ..analyses.sensitivity import derivatives
-    from ..analyses.sensitivity import STEP
+    from ..analyses.sensitivity import STEP, derivatives, nominal
     model = study.model
     job = prepare(model, study.analysis, t_end=study.t_end, steps=study.steps,
                   outputs=study.outputs)
@@ -146,6 +146,7 @@ def sensitivities(study) -> Sensitivities:
         warnings.simplefilter("ignore")
         res = run(model, study.analysis, t_end=study.t_end, steps=study.steps, outputs=wanted)
     t, q = res.t, mech.coordinates(in_angles(res, "rad"))    # the passes work in radians
+    at = nominal(job, t, q, mobility.redundant > 0)          # Cq there, for every parameter
     # ∂y/∂p in the result's units: an angular output in degrees in a degrees model
     factor = {c: angle_factor(job.units.get(c, ""), model.angles)[0] for c in job.columns}
     found = targets(model)
@@ -156,8 +157,7 @@ def sensitivities(study) -> Sensitivities:
         shifted = copy.deepcopy(model)
         write(shifted, target, complex(target.nominal, STEP))
         try:
-            d = derivatives(job, t, q, shifted, mobility.redundant > 0, STEP,
-                            parameter=f"parameter '{name}'")
+            d = derivatives(job, at, shifted, STEP, parameter=f"parameter '{name}'")
         except Pam2ExuError as exc:
             problems.append(Problem(f"[[parameter]] '{name}'", str(exc)))
             continue

@@ -2,9 +2,10 @@
 
 A variant's result is reduced over its rows (t = 0 … t_end, each row weighted equally) to
 one value per output column and reduction, named ``<output>.<reduction>``
-(``motor.Mz.absmax``): ``REDUCTIONS`` holds the seven, one small function each. A
-clearance component (``A.jx``, ``A.jr``, ``G.jn``: the clearance analysis's clearance
-parameters, ``results.extremes.clearance_columns``) is reduced as its absolute value, so
+(``motor.Mz.absmax``): ``REDUCTIONS`` holds the seven, one small function each with its
+first-order derivative (the linear method). A clearance component (``A.jx``, ``A.jr``,
+``G.jn``: the clearance analysis's clearance parameters,
+``results.extremes.clearance_columns``) is reduced as its absolute value, so
 ``A.jx.max`` is the largest |jx| the variant needs over the motion.
 
 A value that is not a number (NaN) makes every reduction of its column NaN: it is never
@@ -17,7 +18,7 @@ each parameter, each reduced output (a variant in error: NaN outputs).
 """
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -62,12 +63,6 @@ def spread(y: np.ndarray) -> float:
     return float(np.max(y) - np.min(y))
 
 
-#: the reductions of a variant's output column, by the name a study file gives them, in
-#: the contract's order
-REDUCTIONS = {"min": minimum, "max": maximum, "absmax": absmax, "mean": mean, "rms": rms,
-              "final": final, "range": spread}
-
-
 # ---- first order: ∂(reduction)/∂p from the series' ∂y/∂p (the linear method) -------------
 # Each takes y (n,) and dy = ∂y/∂p (n, P) and gives the reduction's derivative (P,). On the
 # rows of a run a max is a max over finitely many values: where it is attained at one row
@@ -109,9 +104,24 @@ def d_spread(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
     return dy[int(np.argmax(y))] - dy[int(np.argmin(y))]
 
 
-#: the first-order derivative of each reduction, by the same names as ``REDUCTIONS``
-FIRST_ORDER = {"min": d_minimum, "max": d_maximum, "absmax": d_absmax, "mean": d_mean,
-               "rms": d_rms, "final": d_final, "range": d_spread}
+class Reduction(NamedTuple):
+    """One reduction: its value over a run's rows, and its first-order derivative from
+    the series' ∂y/∂p (the linear method). Called, it gives its value."""
+
+    value: Callable[[np.ndarray], float]
+    derivative: Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+    def __call__(self, y: np.ndarray) -> float:
+        """The reduction of the rows y."""
+        return self.value(y)
+
+
+#: the reductions of a variant's output column, by the name a study file gives them, in
+#: the contract's order, each with its derivative
+REDUCTIONS = {"min": Reduction(minimum, d_minimum), "max": Reduction(maximum, d_maximum),
+              "absmax": Reduction(absmax, d_absmax), "mean": Reduction(mean, d_mean),
+              "rms": Reduction(rms, d_rms), "final": Reduction(final, d_final),
+              "range": Reduction(spread, d_spread)}
 #: the reductions whose first-order σ is the summary's ``linear_std`` (the contract's)
 LINEAR_STD = ("final", "mean")
 

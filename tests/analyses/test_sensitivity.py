@@ -15,7 +15,7 @@ import pytest
 
 import pam2exu
 from pam2exu.analyses.job import check_mobility, prepare
-from pam2exu.analyses.sensitivity import STEP, derivatives
+from pam2exu.analyses.sensitivity import STEP, derivatives, nominal
 from pam2exu.errors import ModelError, SolverError
 from pam2exu.model import load
 from pam2exu.studies.parameters import targets, write
@@ -37,7 +37,7 @@ def _sensitivity(model, analysis, name, steps):
     target = targets(model)[name]
     shifted = copy.deepcopy(model)
     write(shifted, target, complex(target.nominal, STEP))
-    return derivatives(job, res.t, mech.coordinates(res), shifted, redundant,
+    return derivatives(job, nominal(job, res.t, mech.coordinates(res), redundant), shifted,
                        parameter=name), res, job
 
 
