@@ -27,6 +27,7 @@ if __name__ == "__main__":
 import pam2exu  # noqa: E402
 from pam2exu.analyses import closures as closures_module  # noqa: E402
 
+from benchmarks.dynamics import replace_section  # noqa: E402
 from benchmarks.measure import ROOT, log  # noqa: E402
 
 BEGIN = ("<!-- clearance at kinematic speed: written by benchmarks/clearance_speed.py (python "
@@ -159,14 +160,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     log("clearance at kinematic speed")
     lines = section()
-    page = args.out / "performance.md"
-    text = page.read_text(encoding="utf-8") if page.exists() else ""
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + "\n".join(lines) + rest.split(END, 1)[1]
-    else:
-        text = text.rstrip("\n") + "\n\n" + "\n".join(lines) + "\n"
-    page.write_text(text, encoding="utf-8")
+    replace_section(args.out / "performance.md", lines, BEGIN, END)
     print("\n".join(lines))
 
 

@@ -26,6 +26,7 @@ if __package__ in (None, ""):          # python benchmarks/natural_speed.py: the
 import pam2exu  # noqa: E402
 
 from benchmarks.cases import chain_model  # noqa: E402
+from benchmarks.dynamics import replace_section  # noqa: E402
 from benchmarks.measure import ROOT, log, machine  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
 
@@ -148,18 +149,6 @@ WHAT_CHANGED = [
 ]
 
 
-def replace_section(page: Path, lines: list[str]) -> None:
-    """Put ``lines`` (BEGIN … END) in place of the page's section, or at its end."""
-    text = page.read_text(encoding="utf-8")
-    block = "\n".join(lines)
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + block + rest.split(END, 1)[1]
-    else:
-        text = text.rstrip("\n") + "\n\n" + block + "\n"
-    page.write_text(text, encoding="utf-8")
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
@@ -169,7 +158,7 @@ def main(argv=None):
     if args.quick:
         print("\n".join(lines))
     else:
-        replace_section(ROOT / "docs" / "performance.md", lines)
+        replace_section(ROOT / "docs" / "performance.md", lines, BEGIN, END)
         log("wrote the natural backend's section of docs/performance.md")
 
 

@@ -33,6 +33,7 @@ from pam2exu.backend import SolveSettings  # noqa: E402
 from pam2exu.backend.exudyn import system  # noqa: E402
 from pam2exu.backend.exudyn.predictor import PROBE_FROM  # noqa: E402
 
+from benchmarks.dynamics import replace_section  # noqa: E402
 from benchmarks.measure import ROOT, log, machine  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
 from benchmarks.report import table, verdict  # noqa: E402
@@ -228,18 +229,6 @@ def section(out, steps, slow_steps, slow_t_end, info, load_before, load_after, m
     ]
 
 
-def replace_section(page: Path, lines: list[str]) -> None:
-    """Put ``lines`` (BEGIN … END) in place of the page's predictor section, or at its end."""
-    text = page.read_text(encoding="utf-8")
-    block = "\n".join(lines)
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + block + rest.split(END, 1)[1]
-    else:
-        text = text.rstrip("\n") + "\n\n" + block + "\n"
-    page.write_text(text, encoding="utf-8")
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="one round of 10,000 steps")
@@ -259,7 +248,7 @@ def main(argv=None):
     if args.quick:
         print("\n".join(lines))
         return
-    replace_section(args.out, lines)
+    replace_section(args.out, lines, BEGIN, END)
     log(f"wrote the predictor section of {args.out}")
 
 
