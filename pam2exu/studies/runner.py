@@ -219,6 +219,13 @@ def linear_estimate(run_as: Study, names: list[str], asked: bool = False):
     why) when the study has no use for them or they cannot be given; ``ModelError`` when
     they were asked for and cannot be given."""
     kind = analysis_type(run_as.analysis)
+    if asked and run_as.method not in SAMPLED:
+        raise ModelError([Problem("[study]", f"no sensitivities for a {run_as.method} study: "
+                                             "the tornado weighs them by the parameters' "
+                                             "distributions; sample the study "
+                                             "(monte_carlo, latin_hypercube, sobol) or use "
+                                             "method = 'linear'")],
+                         run_as.source, kind="study")
     if run_as.method not in SAMPLED or not (asked or any(r in LINEAR_STD
                                                          for r in run_as.reduce)):
         return None, ""

@@ -221,3 +221,14 @@ tol = 0.1
         fd = (runs[0][c] - runs[1][c]) / 2e-4
         assert np.allclose(result.table[f"{c}.d.ground.rail.angle"], fd, rtol=1e-6,
                            atol=1e-9 * np.max(np.abs(fd)))
+
+
+def test_a_tornado_of_a_grid_study_is_refused_before_any_variant_runs(tmp_path, capsys):
+    """A grid has no distributions to weigh the sensitivities by: exit 2, nothing written
+    (it used to run every variant, write the files, then fail on the picture)."""
+    out = tmp_path / "sweep.csv"
+    assert main(["study", str(EXAMPLES / "studies" / "four_bar_coupler_sweep.toml"), "-o",
+                 str(out), "--tornado", "coupler.transmission_angle.min",
+                 "--workers", "1"]) == 2
+    assert "no sensitivities for a grid study" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
