@@ -197,6 +197,10 @@ class AnalysisType:
         The first-order method of a study (``method = "linear"``) differentiates it
         (``analyses.sensitivity``): its positions follow from the constraints alone and its
         rates and forces from the native passes.
+    one_pass : bool
+        A study may solve its variants' positions in one pass (``Backend.solved_variants``):
+        it solves the constraints on its grid from the model's guess, which the backend's
+        answers then give each variant's run.
     """
 
     name: str
@@ -211,6 +215,7 @@ class AnalysisType:
     options: tuple = ()
     in_studies: bool = False
     first_order: bool = False
+    one_pass: bool = False
 
     def run(self, job):
         """Run the analysis on a prepared ``Job``."""
@@ -255,20 +260,20 @@ ANALYSES: dict[str, AnalysisType] = {a.name: a for a in (
     AnalysisType("assembly", "ensamblatge", frozenset({POSITION}), driven=False,
                  at_start=True, summary="the constraints solved at t = 0 from the guess",
                  function="pam2exu.analyses.assembly:assembly", element_outputs=False,
-                 in_studies=True, first_order=True),
+                 in_studies=True, first_order=True, one_pass=True),
     AnalysisType("quasi_static", "quasi_estatica", frozenset({POSITION, FORCE}), driven=True,
                  at_start=False, summary="positions and static equilibrium, no rates",
                  function="pam2exu.analyses.quasi_static:quasi_static", in_studies=True,
-                 first_order=True),
+                 first_order=True, one_pass=True),
     AnalysisType("kinematic", "cinematica", frozenset({POSITION, VELOCITY, ACCELERATION}),
                  driven=True, at_start=False,
                  summary="positions, velocities and accelerations",
                  function="pam2exu.analyses.kinematic:kinematic", in_studies=True,
-                 first_order=True),
+                 first_order=True, one_pass=True),
     AnalysisType("kinetostatic", "cinetostatica", _ALL, driven=True, at_start=False,
                  summary="the kinematic analysis, then every force (inverse dynamics)",
                  function="pam2exu.analyses.kinetostatic:kinetostatic", in_studies=True,
-                 first_order=True),
+                 first_order=True, one_pass=True),
     AnalysisType("clearance", "joc", frozenset({POSITION, CLEARANCE}), driven=False,
                  at_start=False,
                  summary="the clearance of least norm of an over-constrained mechanism as "

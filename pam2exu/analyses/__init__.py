@@ -38,9 +38,10 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
         Names or patterns of the columns to compute and keep.
     solver : optional
         The backend's settings (``backend.SolveSettings`` for Exudyn); default: its defaults.
-    backend : str, optional
-        What solves the positions (``registry.BACKENDS``: 'exudyn'); default: the model's
-        [analysis] backend.
+    backend : str or Backend, optional
+        What solves the positions (``registry.BACKENDS``: 'exudyn', 'natural'; or a
+        ``Backend`` instance, such as the natural backend holding a study's batched
+        answers); default: the model's [analysis] backend.
     angles : str, optional
         The unit of the angular columns (fi, Dfi, DDfi, f(t) of an angular actuator,
         fi_rel, …): ``'rad'`` or ``'deg'`` (deg, deg/s, deg/s²); default: the model's

@@ -94,10 +94,14 @@ def derived_columns(mech) -> list[tuple[str, Var]]:
 def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
             backend=None, **options) -> Job:
     """Load and validate the model, apply the overrides, choose the columns and the backend
-    (``solver``: the backend's settings, default ``backend.Settings()``); ``options``: the
+    (``solver``: the backend's settings, default ``backend.Settings()``; ``backend``: a
+    name of ``registry.BACKENDS``, or a ``Backend`` instance to use); ``options``: the
     analysis options (``registry.OPTIONS``, e.g. ``tolerance``), TypeError for another
     keyword."""
     registry.refuse_unknown_options(options)
+    engine = backend if isinstance(backend, Backend) else None
+    if engine is not None:                       # an instance (one holding answers)
+        backend = engine.name
     if not isinstance(model, Model):
         model = load(model)
     settings = replace(model.analysis, **{k: v for k, v in
@@ -132,7 +136,7 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
         levels.add(ACCELERATION)                 # the inertia forces need qdd
     if ACCELERATION in levels:
         levels.add(VELOCITY)
-    engine = registry.BACKENDS[settings.backend].create()
+    engine = engine or registry.BACKENDS[settings.backend].create()
     job = Job(mech, kind, plan.times, columns, {c: available[c].unit for c in columns},
               levels, engine, solver if solver is not None else engine.Settings(),
               every=plan.every, motion=plan.motion,

@@ -128,6 +128,9 @@ class Backend(ABC):
            ``integrator = NONE``          the dynamic analysis refuses free degrees of
                                           freedom on this backend (a fully driven model
                                           runs as kinetostatic)
+           ``solves_variants = True``     a study solves a chunk's variants together by
+                                          ``solved_variants`` and runs each variant's
+                                          analysis on the backend it returns for it
            =============================  =================================================
 
         5. Keep the console quiet unless ``settings.verbose`` (or ``verbose``) is > 0.
@@ -158,6 +161,8 @@ class Backend(ABC):
     integrator_name : str
         With ``FIXED_STEP``: how messages name its integrator ("Exudyn's generalized-α
         stops improving here").
+    solves_variants : bool
+        It implements ``solved_variants`` (many variants in one pass). Default False.
     """
 
     name: ClassVar[str]
@@ -168,6 +173,7 @@ class Backend(ABC):
     moves_free_solids: ClassVar[bool] = False
     integrator: ClassVar[Integrator] = Integrator.NONE
     integrator_name: ClassVar[str] = ""
+    solves_variants: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs):
         """A subclass declares its identity, and a method for each capability it declares."""
@@ -178,7 +184,8 @@ class Backend(ABC):
                             "(Backend's identity attributes)")
         needs = {"static_equilibrium": cls.moves_free_solids,
                  "integrate": cls.integrator is Integrator.FIXED_STEP,
-                 "motion": cls.integrator is Integrator.ADAPTIVE}
+                 "motion": cls.integrator is Integrator.ADAPTIVE,
+                 "solved_variants": cls.solves_variants}
         for method, declared in needs.items():
             if declared and vars(Backend)[method] is _own(cls, method):
                 raise TypeError(f"backend class {cls.__name__} declares what "
@@ -347,6 +354,29 @@ class Backend(ABC):
         """
         raise NotImplementedError(f"the {self.name} backend has no adaptive integrator "
                                   f"(integrator is {self.integrator.name})")
+
+    def solved_variants(self, mechs: list, times: np.ndarray, settings) -> list:
+        """Many variants of one mechanism solved together over ``times`` from each one's
+        guess (with ``solves_variants``): what a study calls for a chunk of variants.
+
+        Parameters
+        ----------
+        mechs : list of Mechanism
+            The variants (one model's, their dimensions varied).
+        times : numpy.ndarray
+            The solve grid of their runs (``analyses.grid.plan``), the same for all.
+        settings
+            The backend's settings.
+
+        Returns
+        -------
+        list
+            For each variant, a backend (of this class) that answers the position solves
+            of its run from what was found, or None where the variant is to be solved
+            alone (it did not fit the pass, or failed in it: its own run says why).
+        """
+        raise NotImplementedError(f"the {self.name} backend does not solve variants "
+                                  "together (solves_variants is False)")
 
 
 def _own(cls: type, method: str):

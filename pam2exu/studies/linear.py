@@ -144,7 +144,8 @@ def sensitivities(study) -> Sensitivities:
     wanted = list(dict.fromkeys([*job.columns, *mech.coordinate_columns("")]))
     with warnings.catch_warnings():                  # the nominal run warned in ``nominal``
         warnings.simplefilter("ignore")
-        res = run(model, study.analysis, t_end=study.t_end, steps=study.steps, outputs=wanted)
+        res = run(model, study.analysis, t_end=study.t_end, steps=study.steps, outputs=wanted,
+                  backend=study.backend)
     t, q = res.t, mech.coordinates(in_angles(res, "rad"))    # the passes work in radians
     at = nominal(job, t, q, mobility.redundant > 0)          # Cq there, for every parameter
     # ∂y/∂p in the result's units: an angular output in degrees in a degrees model

@@ -59,9 +59,12 @@ class Part(NamedTuple):
     columns: dict
 
 
-def chunk_size(seconds_per_variant: float, variants: int, workers: int) -> int:
+def chunk_size(seconds_per_variant: float, variants: int, workers: int, least: int = 1
+               ) -> int:
     """Variants per chunk: n / (PER_WORKER · workers), held between MIN_SECONDS and
-    MAX_SECONDS of estimated work (and between 1 and n).
+    MAX_SECONDS of estimated work (and between 1 and n); at least ``least`` (a study whose
+    chunks are solved in one pass: larger passes cost less per variant) while every worker
+    still gets a chunk.
 
     Examples
     --------
@@ -71,14 +74,20 @@ def chunk_size(seconds_per_variant: float, variants: int, workers: int) -> int:
     100
     >>> chunk_size(1.0, 10_000, 2)       # at most 60 s
     60
+    >>> chunk_size(0.01, 2_000, 2, least=400)     # 400 a chunk: each worker has chunks
+    400
+    >>> chunk_size(0.01, 600, 2, least=400)       # 300: both workers have one
+    300
     """
     seconds = max(float(seconds_per_variant), 1e-9)
-    balanced = math.ceil(variants / (PER_WORKER * max(int(workers), 1)))
+    workers = max(int(workers), 1)
+    balanced = math.ceil(variants / (PER_WORKER * workers))
     size = max(math.ceil(MIN_SECONDS / seconds), min(balanced, math.floor(MAX_SECONDS / seconds)))
+    size = max(size, min(int(least), math.ceil(variants / workers)))
     return max(1, min(size, variants))
 
 
-def plan_chunks(variants: int, seconds_per_variant: float, workers: int = 1
+def plan_chunks(variants: int, seconds_per_variant: float, workers: int = 1, least: int = 1
                 ) -> list[tuple[int, int]]:
     """The chunks ``(start, stop)`` of a study of ``variants`` variants, in row order:
     k = ⌈n / chunk_size⌉ chunks of near-equal size (fewer if one would then hold less than
@@ -97,6 +106,9 @@ def plan_chunks(variants: int, seconds_per_variant: float, workers: int = 1
         Estimated work of one variant [s].
     workers : int
         Processes that run chunks at once.
+    least : int
+        Variants a chunk holds at least, while every worker still gets one
+        (``chunk_size``).
 
     Examples
     --------
@@ -108,9 +120,9 @@ def plan_chunks(variants: int, seconds_per_variant: float, workers: int = 1
     variants = int(variants)
     if variants <= 0:
         return []
-    least = math.ceil(MIN_SECONDS / max(float(seconds_per_variant), 1e-9))
-    count = min(math.ceil(variants / chunk_size(seconds_per_variant, variants, workers)),
-                max(1, variants // least))          # no chunk under MIN_SECONDS of work
+    fewest = math.ceil(MIN_SECONDS / max(float(seconds_per_variant), 1e-9))
+    count = min(math.ceil(variants / chunk_size(seconds_per_variant, variants, workers, least)),
+                max(1, variants // fewest))         # no chunk under MIN_SECONDS of work
     bounds = [j * variants // count for j in range(count + 1)]
     return list(zip(bounds[:-1], bounds[1:]))
 

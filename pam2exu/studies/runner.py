@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import (InputWarning, ModelError, OutputError, Pam2ExuError, Problem,
                       warn_outside)
 from ..registry import ANALYSES, analysis_type
+from .batch import answered, one_pass, one_pass_of
 from .execute import open_executor, run_chunks, workers_of
 from .messages import WARNINGS, kind
 from .parameters import varied
@@ -43,6 +44,9 @@ STUDY_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.in_studies)
 FIRST_ORDER_ANALYSES = tuple(a.name for a in ANALYSES.values() if a.first_order)
 #: the methods a study runs: sampled, a grid, and first order (``linear.py``)
 STUDY_METHODS = SAMPLED + ("grid", "linear")
+#: variants a chunk holds at least when they are solved in one pass (``batch``): the pass
+#: costs about 7 µs per variant-step for 400 four-bars against 55 for 50 (in-process, idle)
+ONE_PASS_VARIANTS = 400
 #: what an error row's message says of an exception that is not a pam2exu error
 FAULT = "fault of pam2exu (please report it with the study)"
 #: the estimate of a variant's work per row of its result [s] (for the chunks' size; no
@@ -57,27 +61,45 @@ def error_text(exc: BaseException) -> str:
     return f"{head}: {exc}"
 
 
-def run_variant(payload: dict, values: np.ndarray):
+def run_variant(payload: dict, values: np.ndarray, made=None, backend=None):
     """One variant's (reduced outputs, status, warnings, series), or (None, error text,
     warnings, None): an ``Exception`` of the variant is never raised (KeyboardInterrupt and
     SystemExit pass), its warnings are not issued but returned (``warned``). The series
     (``series.variant_series``: t, then each output) only when the payload asks for them,
-    else None."""
+    else None. ``made``: (its model, the warnings making it gave) from ``made_variant``
+    (None: made here); ``backend``: the one its run uses (``batch.answered``; None: the
+    payload's backend by name)."""
     from ..analyses import run
+    model, early = made if made is not None else (None, [])
     with warnings.catch_warnings(record=True) as caught:   # each variant's: not the study's
         warnings.simplefilter("always")
         try:
-            model = varied(payload["model_text"], dict(zip(payload["names"], values)),
-                           payload["source"], as_made=payload.get("as_made", False))
+            if model is None:
+                model = varied(payload["model_text"], dict(zip(payload["names"], values)),
+                               payload["source"], as_made=payload.get("as_made", False))
             res = run(model, payload["analysis"], t_end=payload["t_end"],
-                      steps=payload["steps"], outputs=payload["outputs"])
+                      steps=payload["steps"], outputs=payload["outputs"],
+                      backend=backend or payload.get("backend"))
             reduced = reduce_run(res, payload["outputs"], payload["reduce"])
             kept = None if payload.get("series") is None else \
                 variant_series(res, output_columns(res.columns, payload["outputs"]),
                                payload.get("series"))
-            return reduced, status(reduced, payload["requirements"]), warned(caught), kept
+            return (reduced, status(reduced, payload["requirements"]),
+                    warned(early + caught), kept)
         except Exception as exc:                      # noqa: BLE001 (a failure is data)
-            return None, error_text(exc), warned(caught), None
+            return None, error_text(exc), warned(early + caught), None
+
+
+def made_variant(payload: dict, values: np.ndarray):
+    """(the variant's model, the warnings making it gave), or (None, []) when it cannot be
+    made (its ``run_variant`` then makes it again and reports why)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            return varied(payload["model_text"], dict(zip(payload["names"], values)),
+                          payload["source"], as_made=payload.get("as_made", False)), caught
+        except Exception:                             # noqa: BLE001 (its run reports it)
+            return None, []
 
 
 def warned(caught: list) -> str:
@@ -106,9 +128,14 @@ def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
         The rows.
     """
     rows, warned_rows, kept = [], [], []
+    made = backends = [None] * (stop - start)
+    if one_pass(payload):                  # the chunk's positions in one pass
+        made = [made_variant(payload, payload["values"][i]) for i in range(start, stop)]
+        backends = answered(payload, [model for model, _ in made])
     for i in range(start, stop):
         values = payload["values"][i]
-        reduced, outcome, warned_text, series = run_variant(payload, values)
+        reduced, outcome, warned_text, series = run_variant(payload, values, made[i - start],
+                                                            backends[i - start])
         rows.append(Variant(i, ERROR, outcome, tuple(values), None) if reduced is None
                     else Variant(i, outcome, "", tuple(values), reduced))
         warned_rows.append(warned_text)
@@ -130,7 +157,8 @@ def payload(study: Study, reduced: list[str]) -> dict:
             "reduced": reduced, "values": study.variants(),
             "series": series_rows(analysis_type(study.analysis).at_start, study.steps)
             if study.series else None,
-            "as_made": analysis_type(study.analysis).parts_as_made}
+            "as_made": analysis_type(study.analysis).parts_as_made,
+            "backend": study.backend, "batched": study.batched}
 
 
 def prepared(study: Study, samples: int | None = None) -> Study:
@@ -172,7 +200,7 @@ def nominal(study: Study):
     from ..analyses import run
     try:
         res = run(study.model, study.analysis, t_end=study.t_end, steps=study.steps,
-                  outputs=study.outputs)
+                  outputs=study.outputs, backend=study.backend)
     except ModelError as exc:
         raise ModelError([Problem(f"[study] model '{study.model_path}'", str(exc))],
                          study.source, kind="study") from None
@@ -209,8 +237,10 @@ def check_series_memory(study: Study, rows: int, outputs: int) -> None:
 
 def chunks_of(study: Study, workers: int) -> list[tuple[int, int]]:
     """The chunks of the study's variants (``parts.plan_chunks``), from an estimate of a
-    variant's work that does not depend on timing (its rows × ``SECONDS_PER_ROW``)."""
-    return plan_chunks(study.samples, (study.steps + 1) * SECONDS_PER_ROW, workers)
+    variant's work that does not depend on timing (its rows × ``SECONDS_PER_ROW``); at
+    least ``ONE_PASS_VARIANTS`` a chunk when its variants are solved in one pass."""
+    least = ONE_PASS_VARIANTS if one_pass_of(study) else 1
+    return plan_chunks(study.samples, (study.steps + 1) * SECONDS_PER_ROW, workers, least)
 
 
 def linear_estimate(run_as: Study, names: list[str], asked: bool = False):

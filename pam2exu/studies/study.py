@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import InputWarning, ModelError, Problem, closest, echo, warn_outside
 from ..limits import is_number, shown
 from ..model import Analysis, Model, load
+from ..registry import DEFAULT_BACKEND
 from ..model.loader import decode
 from ..results.names import select_columns, spelled
 from .parameters import Target, targets
@@ -27,7 +28,7 @@ MAX_SAMPLES = 10_000_000
 
 _TABLES = ("study", "parameter", "requirement")
 _STUDY_KEYS = ("model", "analysis", "t_end", "steps", "method", "samples", "seed", "outputs",
-               "reduce", "series")
+               "reduce", "series", "backend", "batched")
 _PARAMETER_KEYS = ("name", "distribution", "mean", "tol", "std", "low", "high", "values")
 _REQUIREMENT_KEYS = ("output", "min", "max")
 
@@ -63,6 +64,13 @@ class Study:
     parameters : list of Parameter
     requirements : list of Requirement
         ``reduce.Requirement`` (output, min, max), what ``reduce.status`` reads.
+    backend : str
+        What solves each variant's positions (``registry.BACKENDS``; default the model's
+        [analysis] backend).
+    batched : bool
+        Solve a chunk's variants in one pass where the backend can
+        (``Backend.solves_variants``) and the analysis allows (``AnalysisType.one_pass``);
+        False: each variant alone (the reference the pass is tested against).
     """
 
     source: str
@@ -80,6 +88,8 @@ class Study:
     series: bool
     parameters: list[Parameter] = field(default_factory=list)
     requirements: list[Requirement] = field(default_factory=list)
+    backend: str = DEFAULT_BACKEND
+    batched: bool = True
 
     @property
     def names(self) -> list[str]:
@@ -203,7 +213,8 @@ def loads_study(text: str, source: str = "<string>", folder: str | Path = ".") -
                      f"{2 * below}); the study runs the first {samples} points", InputWarning)
     return Study(source, model_path, model_text, model, settings["analysis"],
                  settings["t_end"], settings["steps"], method, samples, settings["seed"],
-                 settings["outputs"], reduce, settings["series"], parameters, requirements)
+                 settings["outputs"], reduce, settings["series"], parameters, requirements,
+                 backend=settings["backend"], batched=settings["batched"])
 
 
 def _model(head: dict, folder: Path, problems: list[Problem]):
@@ -240,9 +251,11 @@ def _settings(head: dict, model: Model, problems: list[Problem]) -> dict:
            "outputs": head.get("outputs", model.analysis.outputs),
            "method": head.get("method", "monte_carlo"), "samples": head.get("samples"),
            "seed": head.get("seed", 0), "reduce": head.get("reduce", list(REDUCTIONS)),
-           "series": head.get("series", False)}
+           "series": head.get("series", False),
+           "backend": head.get("backend", model.analysis.backend),
+           "batched": head.get("batched", True)}
     settings = Analysis(out["analysis"], t_end=out["t_end"], steps=out["steps"],
-                        outputs=out["outputs"])
+                        outputs=out["outputs"], backend=out["backend"])
     problems += [Problem(where, m) for m in settings.problems()]
     out["analysis"] = settings.type
     if out["method"] not in METHODS:
@@ -277,9 +290,10 @@ def _settings(head: dict, model: Model, problems: list[Problem]) -> dict:
                 problems.append(Problem(where, f"unknown reduction {echo(r)}"
                                                f"{closest(str(r), REDUCTIONS)}; known: "
                                                f"{', '.join(REDUCTIONS)}"))
-    if not isinstance(out["series"], bool):
-        problems.append(Problem(where, f"series must be true or false, got "
-                                       f"{echo(out['series'])}"))
+    for key in ("series", "batched"):
+        if not isinstance(out[key], bool):
+            problems.append(Problem(where, f"{key} must be true or false, got "
+                                           f"{echo(out[key])}"))
     return out
 
 

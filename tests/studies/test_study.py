@@ -119,7 +119,7 @@ min = 0.5
 ''')
     expected = [
         "[study]: unknown key 'sed' (did you mean 'seed'?); allowed keys: model, analysis, "
-        "t_end, steps, method, samples, seed, outputs, reduce, series",
+        "t_end, steps, method, samples, seed, outputs, reduce, series, backend, batched",
         "[study]: samples must be a whole number ≥ 1, got 0",
         "[study]: unknown reduction 'maen' (did you mean 'mean'?); known: min, max, absmax, "
         "mean, rms, final, range",

@@ -22,6 +22,7 @@ from .dynamics import motion
 from .loads import multipliers
 from .anchored import anchored
 from .solver import MAX_SUBSTEPS, NaturalSettings, Solver
+from .variants import Answered, Stack, solve, stackable, structure
 from .statics import Statics, pose_distance
 
 __all__ = ["Natural", "NaturalSettings", "Formulation", "Frame", "Coordinate"]
@@ -40,9 +41,14 @@ class Natural(Backend):
     moves_free_solids = True
     #: their motion: ``motion`` (``dynamics``), to the tolerance by its own error control
     integrator = Integrator.ADAPTIVE
+    #: a chunk of variants in one pass: ``solved_variants`` (``variants``)
+    solves_variants = True
 
-    def __init__(self):
+    def __init__(self, answered: "Answered | None" = None):
         self._forms: dict = {}
+        #: a run solved beforehand with other variants (``variants.Answered``): the positions
+        #: it asks for exactly are read from it, not solved again
+        self.answered = answered
 
     def formulation(self, mech, all_angles: bool = False) -> Formulation:
         """The mechanism's formulation (made once per mechanism and kind)."""
@@ -65,6 +71,11 @@ class Natural(Backend):
         start = np.asarray(start, dtype=float)
         form = self.formulation(mech, all_angles=anchor_stiffness > 0)
         w = self.weights(form, mech)
+        if self.answered is not None and not (redundant or anchor_stiffness):
+            given = self.answered.positions(form, times, start, w, settings.tolerance)
+            if given is not None:
+                z, zd, zdd = given
+                return self._found(form, mech, times, start, z, forces, rates, zd, zdd)
         solver = Solver(form.terms, w, settings, least_squares=redundant)
         n = len(times)
         q = np.full((n, mech.nq), np.nan)
@@ -91,19 +102,53 @@ class Natural(Backend):
         error = None
         if solved < n:
             error = self._failed(form, solver, times[solved], z[solved - 1], settings)
-        q[:solved] = self.to_q(form, mech, z[:solved], start)
-        found = Positions(q, solved, error, q[solved - 1], iterations=solver.iterations)
+        zd = zdd = None
         if rates and solved:
             zd, zdd = (solver.run_rates(times[:solved], z[:solved]) if form.nz
                        else (z[:solved], z[:solved]))
-            qd, qdd = self.to_rates(form, mech, z[:solved], zd, zdd)
-            del zd, zdd
+        return self._found(form, mech, times, start, z[:solved], forces, rates, zd, zdd,
+                           error, solver.iterations)
+
+    def _found(self, form, mech, times, start, z, forces, rates, zd, zdd, error=None,
+               iterations=0) -> Positions:
+        """The ``Positions`` of the solved steps z (the first len(z) of ``times``): x, y,
+        fi, with ``rates`` their rates from ż, z̈, with ``forces`` the multipliers."""
+        n, solved = len(times), len(z)
+        q = np.full((n, mech.nq), np.nan)
+        q[:solved] = self.to_q(form, mech, z, start)
+        found = Positions(q, solved, error, q[solved - 1], iterations=iterations)
+        if rates and solved:
+            qd, qdd = self.to_rates(form, mech, z, zd, zdd)
             if solved < n:                     # NaN after the last solved step, as q
                 qd, qdd = (np.r_[x, np.full((n - solved, mech.nq), np.nan)] for x in (qd, qdd))
             found.qd, found.qdd = qd, qdd
         if forces and solved:
-            found.multipliers = multipliers(form, times[:solved], z[:solved], q[:solved])
+            found.multipliers = multipliers(form, times[:solved], z, q[:solved])
         return found
+
+    def solved_variants(self, mechs, times, settings) -> list:
+        """See ``Backend.solved_variants``: the variants whose equations have one structure
+        (and are square) stacked and solved step by step all at once (``variants``); each
+        one solved to the last step gets a ``Natural`` holding its answers."""
+        times = np.asarray(times, dtype=float)
+        out: list = [None] * len(mechs)
+        groups: dict = {}
+        for i, mech in enumerate(mechs):
+            terms = self.formulation(mech).terms
+            if stackable(terms):
+                groups.setdefault(structure(terms), []).append(i)
+        for members in groups.values():
+            forms = [self.formulation(mechs[i]) for i in members]
+            guesses = [mechs[i].initial_q() for i in members]
+            stack = Stack([f.terms for f in forms],
+                          [self.weights(f, mechs[i]) for f, i in zip(forms, members)], times)
+            z0 = np.stack([f.from_q(g)[0] for f, g in zip(forms, guesses)], axis=1)
+            found = solve(stack, z0, settings.tolerance, settings.max_iterations)
+            for j, i in enumerate(members):
+                if found.solved[j] == len(times):
+                    z, zd, zdd = (np.ascontiguousarray(a) for a in found.variant(j))
+                    out[i] = Natural(Answered(times, guesses[j], z, zd, zdd))
+        return out
 
     def _anchored(self, form, mech, t0, z_start, settings, w):
         """The assembly with free degrees of freedom: nearest the model's x, y, fi (the same

@@ -1,0 +1,123 @@
+"""A study's variants in one pass (pam2exu/studies/batch.py, ``[study] batched``).
+
+Reference: the same study with ``batched = false``, every variant solved alone by the
+same backend (the per-variant runs the pass is held against). Every reduced output agrees
+to 1e-12 of its column's largest value; status, error and warnings are the same text.
+"""
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pam2exu.errors import ModelError
+from pam2exu.studies import loads_study
+from pam2exu.studies.batch import answered, one_pass
+from pam2exu.studies.runner import made_variant, nominal, payload, study
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+FOUR_BAR = """
+[study]
+model = "four_bar.toml"
+analysis = "kinetostatic"
+backend = "natural"
+steps = 30
+method = "grid"
+outputs = ["motor.Mz", "coupler.fi", "A.F*", "coupler.P.DDx"]
+reduce = ["min", "max", "absmax", "mean", "rms", "final", "range"]
+[[parameter]]
+name = "coupler.B.x"          # 0.10 m: non-Grashof, fails part-way
+values = [0.35, 0.10, 0.352]
+[[parameter]]
+name = "rocker.B.x"           # 0.12 m: non-Grashof too
+values = [0.30, 0.12]
+[[requirement]]
+output = "motor.Mz.absmax"
+max = 0.5
+"""
+
+SLIDER = """
+[study]
+model = "slider_crank.toml"
+analysis = "kinematic"
+backend = "natural"
+steps = 80
+method = "latin_hypercube"
+samples = 6
+seed = 4
+outputs = ["slider.x", "slider.DDx", "rod.Dfi"]
+reduce = ["absmax", "mean", "final"]
+[[parameter]]
+name = "crank.A.x"
+distribution = "normal"
+tol = 2e-3
+[[parameter]]
+name = "rod.B.x"
+distribution = "uniform"
+tol = 3e-3
+"""
+
+
+def _both(text: str):
+    """The study run in one pass, and with every variant alone."""
+    s = loads_study(text, folder=EXAMPLES)
+    return study(s, workers=1), study(dataclasses.replace(s, batched=False), workers=1)
+
+
+def _same(a, b):
+    assert list(a.table) == list(b.table)
+    for c in a.table:
+        x, y = np.asarray(a.table[c]), np.asarray(b.table[c])
+        if x.dtype.kind == "f":
+            assert np.array_equal(np.isnan(x), np.isnan(y)), c
+            scale = np.nanmax(np.abs(y), initial=0.0) or 1.0
+            assert np.nanmax(np.abs(x - y), initial=0.0) <= 1e-12 * scale, c
+        else:
+            assert x.tolist() == y.tolist(), c
+    assert a.warnings.tolist() == b.warnings.tolist()
+
+
+@pytest.fixture(scope="module")
+def four_bar():
+    return _both(FOUR_BAR)
+
+
+def test_four_bar_variants_in_one_pass_equal_their_own_runs(four_bar):
+    batched, alone = four_bar
+    _same(batched, alone)
+    status = batched.table["status"].tolist()
+    assert status.count("error") == 4 and status.count("rejected") == 2   # in one chunk
+
+
+def test_the_pass_solves_the_variants_it_can(four_bar):
+    s = loads_study(FOUR_BAR, folder=EXAMPLES)
+    p = payload(s, nominal(s)[0])
+    assert one_pass(p)
+    made = [made_variant(p, v) for v in p["values"]]
+    found = answered(p, [m for m, _ in made])
+    # the non-Grashof variants fail in the pass (their runs say why); the others are solved
+    assert [b is not None for b in found] == [True, False, False, False, True, False]
+
+
+def test_slider_crank_variants_in_one_pass_equal_their_own_runs():
+    _same(*_both(SLIDER))
+
+
+def test_which_studies_take_the_pass():
+    s = loads_study(SLIDER, folder=EXAMPLES)
+    p = payload(s, nominal(s)[0])
+    assert one_pass(p)
+    assert not one_pass({**p, "batched": False})
+    assert not one_pass({**p, "backend": "exudyn"})        # it solves one run at a time
+    assert not one_pass({**p, "analysis": "dynamic"})      # it integrates, no grid solve
+
+
+@pytest.mark.parametrize("line, says", [
+    ('backend = "natral"', "natral"),
+    ("batched = 1", "batched must be true or false"),
+])
+def test_bad_backend_or_batched_is_named(line, says):
+    text = SLIDER.replace('backend = "natural"', line)
+    with pytest.raises(ModelError, match=says):
+        loads_study(text, folder=EXAMPLES)
