@@ -22,7 +22,7 @@ FOUR_BAR = """
 model = "four_bar.toml"
 analysis = "kinetostatic"
 backend = "natural"
-steps = 30
+steps = 16
 method = "grid"
 outputs = ["motor.Mz", "coupler.fi", "A.F*", "coupler.P.DDx"]
 reduce = ["min", "max", "absmax", "mean", "rms", "final", "range"]
@@ -121,3 +121,76 @@ def test_bad_backend_or_batched_is_named(line, says):
     text = SLIDER.replace('backend = "natural"', line)
     with pytest.raises(ModelError, match=says):
         loads_study(text, folder=EXAMPLES)
+
+
+def _chain_text(N: int) -> str:
+    """The model file of ``benchmarks.cases.chain_model(N)`` (N four-bar loops in a chain),
+    written as TOML with the same solids, guesses and elements."""
+    from benchmarks.cases import CHAIN, CHAIN_LAW, COUPLER, LINK, chain_kinematics
+    a, b, c, d = (CHAIN[key] for key in "abcd")
+    solids, _ = chain_kinematics(N, np.zeros(1))
+
+    def solid(name, points, inertial):
+        (r, _, _), (fi, _, _) = solids[name]
+        pts = ", ".join(f"{k} = [{x!r}, {y!r}]" for k, (x, y) in points.items())
+        return (f'[[solid]]\nname = "{name}"\nx = {float(r[0, 0])!r}\ny = {float(r[1, 0])!r}\n'
+                f'fi = {float(fi[0])!r}\nmass = {inertial["mass"]!r}\n'
+                f'inertia = {inertial["inertia"]!r}\ncog = {list(inertial["cog"])!r}\n'
+                f'points = {{ {pts} }}\n')
+
+    def element(kind, name, anc1, anc2=None):
+        return (f'[[element]]\ntype = "{kind}"\nname = "{name}"\nanc1 = "{anc1}"\n'
+                + (f'anc2 = "{anc2}"\n' if anc2 else ""))
+
+    ground = ", ".join(f"P{i} = [{i * d!r}, 0.0]" for i in range(N + 1))
+    out = [f'[model]\nname = "chain of {N}"\ngravity = 9.81\n',
+           f'[[solid]]\nname = "ground"\npoints = {{ {ground} }}\n', element("fixed", "base",
+                                                                            "ground")]
+    for i in range(N + 1):
+        points = {"O": (0.0, 0.0)}
+        if i < N:
+            points["A"] = (a, 0.0) if i == 0 else (-a, 0.0)
+        if i > 0:
+            points["B"] = (c, 0.0)
+        out += [solid(f"L{i}", points, LINK), element("revolute", f"O{i}", f"ground.P{i}",
+                                                      f"L{i}.O")]
+    for j in range(1, N + 1):
+        out += [solid(f"K{j}", {"A": (0.0, 0.0), "B": (b, 0.0)}, COUPLER),
+                element("revolute", f"A{j}", f"L{j - 1}.A", f"K{j}.A"),
+                element("revolute", f"B{j}", f"K{j}.B", f"L{j}.B")]
+    out.append(element("angular_actuator", "motor", "ground", "L0")
+               + f'law = "polynomial"\nC = [{CHAIN_LAW[0]!r}, {CHAIN_LAW[1]!r}, 0.0, 0.0]\n')
+    return "\n".join(out)
+
+
+def test_chain_of_four_loops_in_one_pass_equals_its_own_runs(tmp_path):
+    (tmp_path / "chain4.toml").write_text(_chain_text(4))
+    text = """
+[study]
+model = "chain4.toml"
+analysis = "kinetostatic"
+backend = "natural"
+t_end = 0.25
+steps = 20
+method = "monte_carlo"
+samples = 3
+seed = 2
+outputs = ["motor.Mz", "L4.fi", "B4.F*"]
+reduce = ["absmax", "mean", "final"]
+[[parameter]]
+name = "K2.B.x"
+distribution = "normal"
+tol = 2e-3
+[[parameter]]
+name = "L3.B.x"
+distribution = "uniform"
+tol = 2e-3
+"""
+    s = loads_study(text, folder=tmp_path)
+    p = payload(s, nominal(s)[0])
+    assert all(b is not None for b in answered(p, [m for m, _ in
+                                                   (made_variant(p, v) for v in p["values"])]))
+    batched, alone = study(s, workers=1), study(dataclasses.replace(s, batched=False),
+                                                 workers=1)
+    _same(batched, alone)
+    assert batched.table["status"].tolist() == ["ok"] * 3
