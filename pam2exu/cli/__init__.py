@@ -6,13 +6,14 @@ missing optional library; ``run`` checks these before it runs anything).
 ``compare``: 0 every variable within the tolerance, 1 some outside, 2 bad input.
 ``verify``: 0 the two backends agree, 1 they differ or a run fails, 2 bad input.
 ``study``: 0 the study ran (even with variants in error), 2 bad input (nothing written).
+``exam``: 0 the exam was written, 2 bad input or too few variants could be checked.
 ``plot``, ``draw``, ``animate``: 2 also for a picture that cannot be made as asked (an
 unknown image format, no ffmpeg for .mp4, a variable that matches nothing).
 Errors are printed to stderr as one paragraph; ``--debug`` shows the traceback.
 
 Each command is a module of this package with its parser (``add_parser``) and its function
 (``command(args, warnings) -> exit code``): ``run``, ``check``, ``elements``, ``compare``,
-``verify``, ``export``, ``study``, and ``pictures`` for plot, draw and animate.
+``verify``, ``export``, ``study``, ``exam``, and ``pictures`` for plot, draw and animate.
 """
 from __future__ import annotations
 
@@ -23,13 +24,13 @@ import warnings
 from ..console import UsageError, Warnings
 from ..errors import ModelError, OutputError, Pam2ExuError, SolverError
 from ..version import __version__
-from . import check, compare, elements, export, pictures, run, study, verify
+from . import check, compare, elements, exam, export, pictures, run, study, verify
 
 #: each command's function, ``f(args, warnings) -> exit code``
 COMMANDS = {"run": run.command, "check": check.command, "elements": elements.command,
             "compare": compare.command, "verify": verify.command, "export": export.command,
             "plot": pictures.plot, "draw": pictures.draw, "animate": pictures.animate,
-            "study": study.command}
+            "study": study.command, "exam": exam.command}
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -38,7 +39,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"pam2exu {__version__}")
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for command in (run, check, elements, compare, verify, export, study):
+    for command in (run, check, elements, compare, verify, export, study, exam):
         command.add_parser(sub)
     pictures.add_parsers(sub)
     for sub_parser in sub.choices.values():     # --debug after the subcommand, too
