@@ -24,8 +24,9 @@ def run(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
 
     Parameters
     ----------
-    model : Model or path
-        A model, or the path of a model file.
+    model : Model, Mechanism or path
+        A model, the path of a model file, or a model's ``Mechanism`` (``Model.mechanism()``:
+        validated already, not again).
     analysis : str, optional
         'assembly', 'quasi_static', 'kinematic', 'kinetostatic', 'clearance',
         'equilibrium' or 'dynamic' (``registry.ANALYSES``; default: the model's [analysis]

@@ -13,7 +13,7 @@ from ..elements import ACCELERATION, CLEARANCE, FORCE, POSITION, VELOCITY, Var
 from ..errors import (InputWarning, ModelError, Problem, RedundancyWarning, SolverError,
                       warn_outside)
 from ..kinematics import State, column
-from ..model import Model, load
+from ..model import Mechanism, Model, load
 from ..model.mistakes import input_warnings
 from ..model.solid import SOLID_OUTPUTS
 from ..model.variation import pace_problems
@@ -93,7 +93,8 @@ def derived_columns(mech) -> list[tuple[str, Var]]:
 
 def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=None,
             backend=None, **options) -> Job:
-    """Load and validate the model, apply the overrides, choose the columns and the backend
+    """Load and validate the model (a ``Mechanism``: the model it was made of, validated
+    already), apply the overrides, choose the columns and the backend
     (``solver``: the backend's settings, default ``backend.Settings()``; ``backend``: a
     name of ``registry.BACKENDS``, or a ``Backend`` instance to use); ``options``: the
     analysis options (``registry.OPTIONS``, e.g. ``tolerance``), TypeError for another
@@ -102,7 +103,10 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
     engine = backend if isinstance(backend, Backend) else None
     if engine is not None:                       # an instance (one holding answers)
         backend = engine.name
-    if not isinstance(model, Model):
+    mech = model if isinstance(model, Mechanism) else None
+    if mech is not None:                         # validated and resolved already
+        model = mech.model
+    elif not isinstance(model, Model):
         model = load(model)
     settings = replace(model.analysis, **{k: v for k, v in
                                           dict(type=analysis, t_end=t_end, steps=steps,
@@ -112,7 +116,7 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
     problems = [Problem("[analysis]", m) for m in settings.problems()]
     if problems:
         raise ModelError(problems, model.source)
-    mech = model.mechanism()
+    mech = mech or model.mechanism()
     kind = registry.ANALYSES[settings.type]
     if CLEARANCE in kind.levels:                 # the analysis that reads the variations
         too_fast = pace_problems(mech.variations, settings.t_end, settings.steps)

@@ -38,10 +38,10 @@ def takes_one_pass(backend: str | None, analysis: str, batched) -> bool:
 
 
 def answered(payload: dict, models: list) -> list:
-    """For each variant's model (None: it could not be made), the backend its run uses:
-    one holding its answers from the pass, or None (its run solves it alone). Variants are
-    solved together with those of the same solve grid (sub-steps may differ), so that a
-    variant's answers do not depend on the others in its chunk."""
+    """For each variant's model (None: it could not be made), (its mechanism, the backend
+    holding its answers from the pass) for its run, or None (its run makes and solves it
+    alone). Variants are solved together with those of the same solve grid (sub-steps may
+    differ), so that a variant's answers do not depend on the others in its chunk."""
     from ..analyses.grid import plan
     kind = analysis_type(payload["analysis"])
     engine = resolve(BACKENDS[payload["backend"]].implementation)()
@@ -62,7 +62,7 @@ def answered(payload: dict, models: list) -> list:
             group[2].append(mech)
         out: list = [None] * len(models)
         for times, members, mechs in groups.values():
-            for i, backend in zip(members, engine.solved_variants(mechs, times,
-                                                                  engine.Settings())):
-                out[i] = backend
+            for i, mech, backend in zip(members, mechs,
+                                        engine.solved_variants(mechs, times, engine.Settings())):
+                out[i] = None if backend is None else (mech, backend)
     return out

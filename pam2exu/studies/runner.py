@@ -61,14 +61,14 @@ def error_text(exc: BaseException) -> str:
     return f"{head}: {exc}"
 
 
-def run_variant(payload: dict, values: np.ndarray, made=None, backend=None):
+def run_variant(payload: dict, values: np.ndarray, made=None, solved=None):
     """One variant's (reduced outputs, status, warnings, series), or (None, error text,
     warnings, None): an ``Exception`` of the variant is never raised (KeyboardInterrupt and
     SystemExit pass), its warnings are not issued but returned (``warned``). The series
     (``series.variant_series``: t, then each output) only when the payload asks for them,
     else None. ``made``: (its model, the warnings making it gave) from ``made_variant``
-    (None: made here); ``backend``: the one its run uses (``batch.answered``; None: the
-    payload's backend by name)."""
+    (None: made here); ``solved``: (its mechanism, the backend holding its answers) from
+    ``batch.answered`` (None: the payload's backend by name solves it)."""
     from ..analyses import run
     model, early = made if made is not None else (None, [])
     with warnings.catch_warnings(record=True) as caught:   # each variant's: not the study's
@@ -77,9 +77,10 @@ def run_variant(payload: dict, values: np.ndarray, made=None, backend=None):
             if model is None:
                 model = varied(payload["model_text"], dict(zip(payload["names"], values)),
                                payload["source"], as_made=payload.get("as_made", False))
-            res = run(model, payload["analysis"], t_end=payload["t_end"],
-                      steps=payload["steps"], outputs=payload["outputs"],
-                      backend=backend or payload.get("backend"))
+            subject, backend = solved if solved is not None else (model,
+                                                                  payload.get("backend"))
+            res = run(subject, payload["analysis"], t_end=payload["t_end"],
+                      steps=payload["steps"], outputs=payload["outputs"], backend=backend)
             reduced = reduce_run(res, payload["outputs"], payload["reduce"])
             kept = None if payload.get("series") is None else \
                 variant_series(res, output_columns(res.columns, payload["outputs"]),
@@ -128,14 +129,14 @@ def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
         The rows.
     """
     rows, warned_rows, kept = [], [], []
-    made = backends = [None] * (stop - start)
+    made = solved = [None] * (stop - start)
     if one_pass(payload):                  # the chunk's positions in one pass
         made = [made_variant(payload, payload["values"][i]) for i in range(start, stop)]
-        backends = answered(payload, [model for model, _ in made])
+        solved = answered(payload, [model for model, _ in made])
     for i in range(start, stop):
         values = payload["values"][i]
         reduced, outcome, warned_text, series = run_variant(payload, values, made[i - start],
-                                                            backends[i - start])
+                                                            solved[i - start])
         rows.append(Variant(i, ERROR, outcome, tuple(values), None) if reduced is None
                     else Variant(i, outcome, "", tuple(values), reduced))
         warned_rows.append(warned_text)

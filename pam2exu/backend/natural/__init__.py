@@ -148,6 +148,7 @@ class Natural(Backend):
                 if found.solved[j] == len(times):
                     z, zd, zdd = (np.ascontiguousarray(a) for a in found.variant(j))
                     out[i] = Natural(Answered(times, guesses[j], z, zd, zdd))
+                    out[i]._forms[(id(mechs[i]), False)] = (mechs[i], forms[j])
         return out
 
     def _anchored(self, form, mech, t0, z_start, settings, w):
