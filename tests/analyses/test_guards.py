@@ -224,3 +224,18 @@ def test_a_singular_position_names_what_the_analysis_would_give(analysis, undefi
     job = SimpleNamespace(times=np.array([0.0, 0.5]), mech=SimpleNamespace(drivers=[]),
                           analysis_type=ANALYSES[analysis])
     assert undefined in str(singular_error(job, 1))
+
+
+def test_a_run_of_a_mechanism_is_the_run_of_its_model():
+    """``run`` takes a model's ``Mechanism`` (validated already, as a study's one-pass
+    variants give it): the same table, bit for bit, and the same warnings."""
+    model = pam2exu.load(Path(__file__).resolve().parents[2] / "examples" / "slider_crank.toml")
+    with warnings.catch_warnings(record=True) as a:
+        warnings.simplefilter("always")
+        by_model = pam2exu.run(model, "kinetostatic", steps=12)
+    with warnings.catch_warnings(record=True) as b:
+        warnings.simplefilter("always")
+        by_mech = pam2exu.run(model.mechanism(), "kinetostatic", steps=12)
+    assert by_model.columns == by_mech.columns
+    assert np.array_equal(by_model.to_numpy(), by_mech.to_numpy())
+    assert [str(w.message) for w in a] == [str(w.message) for w in b]
