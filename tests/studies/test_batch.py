@@ -194,3 +194,13 @@ tol = 2e-3
                                                  workers=1)
     _same(batched, alone)
     assert batched.table["status"].tolist() == ["ok"] * 3
+
+
+def test_the_shipped_one_pass_study_runs_its_first_variants_as_their_own_runs():
+    """examples/studies/four_bar_tolerance.toml: 2,000 variants on the natural backend; its
+    first 6 (``--samples 6``), in one pass and each alone."""
+    from pam2exu.studies import load_study
+    from pam2exu.studies.runner import prepared
+    s = prepared(load_study(EXAMPLES / "studies" / "four_bar_tolerance.toml"), 6)
+    assert s.backend == "natural" and s.batched
+    _same(study(s, workers=1), study(dataclasses.replace(s, batched=False), workers=1))
