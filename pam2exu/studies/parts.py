@@ -62,9 +62,10 @@ class Part(NamedTuple):
 def chunk_size(seconds_per_variant: float, variants: int, workers: int, least: int = 1
                ) -> int:
     """Variants per chunk: n / (PER_WORKER · workers), held between MIN_SECONDS and
-    MAX_SECONDS of estimated work (and between 1 and n); at least ``least`` (a study whose
-    chunks are solved in one pass: larger passes cost less per variant) while every worker
-    still gets a chunk.
+    MAX_SECONDS of estimated work (and between 1 and n). With ``least`` > 1 (a study whose
+    chunks are solved in one pass: a larger pass costs less per variant), the fewest chunks
+    of at least ``least`` variants that keep every worker equally busy: their number a
+    multiple of the workers, at least one each.
 
     Examples
     --------
@@ -74,16 +75,18 @@ def chunk_size(seconds_per_variant: float, variants: int, workers: int, least: i
     100
     >>> chunk_size(1.0, 10_000, 2)       # at most 60 s
     60
-    >>> chunk_size(0.01, 2_000, 2, least=400)     # 400 a chunk: each worker has chunks
-    400
-    >>> chunk_size(0.01, 600, 2, least=400)       # 300: both workers have one
+    >>> chunk_size(0.01, 2_000, 2, least=400)     # 4 chunks of 500: 2 for each worker
+    500
+    >>> chunk_size(0.01, 600, 2, least=400)       # 2 chunks of 300: one each
     300
     """
-    seconds = max(float(seconds_per_variant), 1e-9)
     workers = max(int(workers), 1)
+    if least > 1:
+        count = max(workers, (variants // int(least)) // workers * workers)
+        return max(1, min(math.ceil(variants / count), variants))
+    seconds = max(float(seconds_per_variant), 1e-9)
     balanced = math.ceil(variants / (PER_WORKER * workers))
     size = max(math.ceil(MIN_SECONDS / seconds), min(balanced, math.floor(MAX_SECONDS / seconds)))
-    size = max(size, min(int(least), math.ceil(variants / workers)))
     return max(1, min(size, variants))
 
 

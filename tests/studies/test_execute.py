@@ -263,3 +263,17 @@ def test_a_local_cluster_is_started_and_stopped_by_the_run(tmp_path, payload):
             run_chunks(chunk_tasks.always_dies, payload, CHUNKS, tmp_path / "lost.parts",
                        executor=client)
     assert client.status == "closed"
+
+
+@pytest.mark.parametrize("variants, workers, sizes", [
+    (2000, 2, [500] * 4),          # 5 chunks of 400 would leave one worker idle at the end
+    (2000, 1, [400] * 5),
+    (600, 2, [300] * 2),           # every worker gets one
+    (100, 4, [25] * 4),
+])
+def test_one_pass_chunks_are_large_and_shared_equally(variants, workers, sizes):
+    """A one-pass study's chunks hold at least ``least`` variants (its pass costs less per
+    variant the larger it is), and their number is a multiple of the workers."""
+    chunks = plan_chunks(variants, 0.15, workers, least=400)
+    assert [b - a for a, b in chunks] == sizes
+    assert chunks[0][0] == 0 and chunks[-1][1] == variants
