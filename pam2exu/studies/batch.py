@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 
 from ..errors import Pam2ExuError
+from ..model import Mechanism
 from ..registry import BACKENDS, analysis_type, resolve
 
 
@@ -38,7 +39,8 @@ def takes_one_pass(backend: str | None, analysis: str, batched) -> bool:
 
 
 def answered(payload: dict, models: list) -> list:
-    """For each variant's model (None: it could not be made), (its mechanism, the backend
+    """For each variant's model (``runner.made_variant``: validated; None: it could not be
+    made), (its mechanism, the backend
     holding its answers from the pass) for its run, or None (its run makes and solves it
     alone). Variants are solved together with those of the same solve grid (sub-steps may
     differ), so that a variant's answers do not depend on the others in its chunk."""
@@ -52,7 +54,7 @@ def answered(payload: dict, models: list) -> list:
             if model is None:
                 continue
             try:
-                mech = model.mechanism()
+                mech = Mechanism(model)         # validated by ``varied`` already
                 times = np.zeros(1) if kind.at_start else plan(
                     mech, payload["t_end"], payload["steps"], 1).times
             except Pam2ExuError:                # its run says why
