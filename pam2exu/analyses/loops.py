@@ -54,12 +54,14 @@ def edges(mech) -> list[Edge]:
             for el in mech.constraints if el.ties]
 
 
-def cycle_through(mech, element) -> list[tuple[Edge, bool]] | None:
+def cycle_through(mech, element, graph: list[Edge] | None = None
+                  ) -> list[tuple[Edge, bool]] | None:
     """The shortest loop through ``element``: its edges in order, each with True when it
-    is walked from its solid a to its solid b; None when the element closes no loop."""
+    is walked from its solid a to its solid b; None when the element closes no loop.
+    ``graph``: the edges to walk (default: every tie, ``edges``)."""
     frame = mech.held
     node = (lambda s: FRAME if s in frame else s)
-    graph = edges(mech)
+    graph = edges(mech) if graph is None else graph
     start = next((e for e in graph if e.element is element), None)
     if start is None or node(start.a) == node(start.b):
         return None
@@ -342,7 +344,7 @@ def _mask(mech, elements) -> np.ndarray:
     return keep
 
 
-def _rigid(mech, jac, elements, new: set[int]) -> bool:
+def rigid(mech, jac, elements, new: set[int]) -> bool:
     """Whether the equations of ``elements`` fix the solids ``new`` once the others they
     touch are placed: their Jacobian columns (angles times the length scale) have full rank."""
     if not new:
@@ -402,7 +404,7 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
             inside = placed | new
             rules = [el for el in setters if el.ref1.solid in inside
                      and (el.ref2 is None or el.ref2.solid in inside)]
-            if _rigid(mech, jac, [*unit.ties, *rules], new):
+            if rigid(mech, jac, [*unit.ties, *rules], new):
                 choices.append((len(new), len(unit.ties), order, unit, new))
         if not choices:
             return None

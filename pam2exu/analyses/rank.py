@@ -79,9 +79,12 @@ def require_defined(mech, t: float, q: np.ndarray) -> None:
             mech.model.source)
 
 
-def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
-    """Rank test of Cq at (q, t): free degrees of freedom and redundant equations."""
-    svd = _rank(mech, t, q, rtol)
+def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None) -> Mobility:
+    """Rank test of Cq at (q, t): free degrees of freedom and redundant equations (of the
+    equations ``rows`` only, a mask of C's rows, when given: ``classify`` leaves out the
+    actuators')."""
+    keep = np.ones(mech.n_equations, dtype=bool) if rows is None else np.asarray(rows)
+    svd = _rank(mech, t, q, rtol, None if rows is None else keep)
     if svd is None:
         return Mobility(mech.nq, 0, [s.name for s in mech.solids], [], np.inf)
     U, s, Vt, rank = svd
@@ -93,10 +96,10 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9) -> Mobility:
         free = [sv.name for sv, w in zip(mech.solids, weight) if w > 1e-6]
     dependent = []
     if redundant:
-        left = U[:, rank:]                           # (m, redundant)
-        weight = np.linalg.norm(left, axis=1)
-        for el, rows in zip(mech.constraints, mech.rows):
-            if np.max(weight[rows]) > 1e-6:
+        weight = np.zeros(mech.n_equations)
+        weight[keep] = np.linalg.norm(U[:, rank:], axis=1)    # (m, redundant) → (m,)
+        for el, own in zip(mech.constraints, mech.rows):
+            if np.max(weight[own]) > 1e-6:
                 dependent.append(el.name)
     condition = float(condition_numbers(mech, [t], q[None, :])[0])
     return Mobility(dof, redundant, free, dependent, condition)

@@ -13,7 +13,8 @@ Errors are printed to stderr as one paragraph; ``--debug`` shows the traceback.
 
 Each command is a module of this package with its parser (``add_parser``) and its function
 (``command(args, warnings) -> exit code``): ``run``, ``check``, ``elements``, ``compare``,
-``verify``, ``export``, ``study``, ``exam``, and ``pictures`` for plot, draw and animate.
+``verify``, ``export``, ``study``, ``exam``, ``classify``, and ``pictures`` for plot, draw and
+animate.
 """
 from __future__ import annotations
 
@@ -24,13 +25,13 @@ import warnings
 from ..console import UsageError, Warnings
 from ..errors import ModelError, OutputError, Pam2ExuError, SolverError
 from ..version import __version__
-from . import check, compare, elements, exam, export, pictures, run, study, verify
+from . import check, classify, compare, elements, exam, export, pictures, run, study, verify
 
 #: each command's function, ``f(args, warnings) -> exit code``
 COMMANDS = {"run": run.command, "check": check.command, "elements": elements.command,
             "compare": compare.command, "verify": verify.command, "export": export.command,
             "plot": pictures.plot, "draw": pictures.draw, "animate": pictures.animate,
-            "study": study.command, "exam": exam.command}
+            "study": study.command, "exam": exam.command, "classify": classify.command}
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -39,7 +40,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"pam2exu {__version__}")
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for command in (run, check, elements, compare, verify, export, study, exam):
+    for command in (run, check, classify, elements, compare, verify, export, study, exam):
         command.add_parser(sub)
     pictures.add_parsers(sub)
     for sub_parser in sub.choices.values():     # --debug after the subcommand, too

@@ -1,0 +1,143 @@
+"""Where the driver meets a singular position of the mechanism (``pam2exu classify``): the
+square constraint Jacobian Cq (actuators included) loses rank.
+
+Two kinds, told apart by the path of positions through them:
+
+- a *dead point* (a fold: the path turns back in time, no position exists beyond it: the
+  driver can go no further, e.g. a rocker-driven crank-rocker with its crank and coupler in
+  line). Located by Newton on the extended system of Moore and Spence,
+  C(q, t) = 0, Cq(q, t) v = 0, v₀ · v = 1, for (q, t, v): regular at a simple fold, so t is
+  found to round-off;
+- a *change point* (the path goes on through it, the sign of det Cq changes, e.g. a
+  change-point four-bar with its links in line): the root of det Cq(q(t), t) along the
+  path, by Brent's method, each q(t) by Newton from the step before.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..kinematics import State
+from .native import equations
+
+#: Newton's iterations in ``fold`` and ``position``
+ITERATIONS = 40
+#: the time tolerance of the located points [s]
+TIME_TOL = 1e-12
+#: the finite-difference step of the second derivatives in ``fold`` (times the scale)
+STEP = 1e-6
+
+
+@dataclass(frozen=True)
+class Singular:
+    """A singular position met at time ``t``: ``kind`` "dead point" or "change point", its
+    coordinates ``q`` and the motion ``v`` the constraints allow there (Cq v = 0)."""
+
+    kind: str
+    t: float
+    q: np.ndarray
+    v: np.ndarray
+
+
+def _jacobian(mech, t: float, q: np.ndarray):
+    """(C, Cq, ∂C/∂t) at one configuration."""
+    eq = equations(mech, State([t], q[None, :]))
+    return eq.residual[0], eq.jacobian[0], eq.c_t[0]
+
+
+def null_motion(jac: np.ndarray) -> np.ndarray:
+    """The unit right singular vector of Cq's smallest singular value: v with Cq v ≈ 0."""
+    return np.linalg.svd(jac)[2][-1]
+
+
+def fold(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | None:
+    """The dead point near (t0, q0): Newton on C = 0, Cq v = 0, v₀ · v = 1 (v₀ the motion
+    Cq nearly allows at q0); None when it does not converge. ∂(Cq v)/∂(q, t) by central
+    differences, step ``STEP`` · ``scale`` (the residuals stay exact, so the point does)."""
+    nq = mech.nq
+    v0 = null_motion(_jacobian(mech, t0, q0)[1])
+    x = np.concatenate([q0, [t0], v0])
+    h = STEP * scale
+    for _ in range(ITERATIONS):
+        q, t, v = x[:nq], x[nq], x[nq + 1:]
+        ts = np.concatenate([[t], np.full(2 * nq, t), [t + h, t - h]])
+        qs = np.repeat(q[None], 2 * nq + 3, axis=0)
+        qs[1:nq + 1] += h * np.eye(nq)
+        qs[nq + 1:2 * nq + 1] -= h * np.eye(nq)
+        eq = equations(mech, State(ts, qs))
+        C, J, Ct = eq.residual[0], eq.jacobian[0], eq.c_t[0]
+        Jv = eq.jacobian @ v                                   # (2 nq + 3, m)
+        d_q = ((Jv[1:nq + 1] - Jv[nq + 1:2 * nq + 1]) / (2 * h)).T
+        d_t = (Jv[-2] - Jv[-1]) / (2 * h)
+        m = len(C)
+        F = np.concatenate([C, J @ v, [v0 @ v - 1.0]])
+        A = np.zeros((2 * m + 1, 2 * nq + 1))
+        A[:m, :nq], A[:m, nq] = J, Ct
+        A[m:2 * m, :nq], A[m:2 * m, nq], A[m:2 * m, nq + 1:] = d_q, d_t, J
+        A[-1, nq + 1:] = v0
+        step = np.linalg.lstsq(A, -F, rcond=None)[0]
+        x = x + step
+        if not np.all(np.isfinite(x)):
+            return None
+        if abs(step[nq]) < TIME_TOL and np.max(np.abs(step[:nq])) < 1e-12 * scale:
+            q, v = x[:nq], x[nq + 1:]
+            return Singular("dead point", float(x[nq]), q, v / np.linalg.norm(v))
+    return None
+
+
+def position(mech, t: float, q: np.ndarray, scale: float) -> np.ndarray | None:
+    """q with C(q, t) = 0 by Newton from q (least squares with redundant equations); None
+    when it does not converge."""
+    q = q.copy()
+    for _ in range(ITERATIONS):
+        C, J, _ = _jacobian(mech, t, q)
+        step = np.linalg.lstsq(J, -C, rcond=None)[0]
+        q += step
+        if np.max(np.abs(step)) < 1e-13 * scale:
+            return q
+    return None
+
+
+def sign_change(mech, t0: float, t1: float, q0: np.ndarray, scale: float) -> Singular | None:
+    """The change point between t0 and t1 where det Cq(q(t), t) changes sign (Brent's
+    method; q(t) by Newton from q0, the position at t0); None if Newton fails."""
+    def det(t):
+        q = position(mech, t, q0, scale)
+        if q is None:
+            raise ArithmeticError
+        return float(np.linalg.det(_jacobian(mech, t, q)[1]))
+    try:
+        t = brentq(det, t0, t1, xtol=TIME_TOL, rtol=4 * np.finfo(float).eps)
+    except (ArithmeticError, ValueError):
+        return None
+    q = position(mech, t, q0, scale)
+    if q is None:
+        return None
+    return Singular("change point", float(t), q, null_motion(_jacobian(mech, t, q)[1]))
+
+
+def determinants(mech, t: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """det Cq at each row (a square Cq: no redundant equations)."""
+    return np.linalg.det(equations(mech, State(t, q)).jacobian)
+
+
+def singular_points(mech, t: np.ndarray, q: np.ndarray, solved: int,
+                    scale: float) -> list[Singular]:
+    """The change points between the solved rows (det Cq changes sign) and, when the run
+    stops before its end (``solved`` < len(t)), the dead point it stops at; in time order.
+    A stop that is no fold is left out (the run's own message says why it stops)."""
+    found = []
+    nq = mech.nq
+    if mech.n_equations == nq and solved > 1:
+        d = determinants(mech, t[:solved], q[:solved])
+        for k in np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]:
+            point = sign_change(mech, float(t[k]), float(t[k + 1]), q[k], scale)
+            if point is not None:
+                found.append(point)
+    if 0 < solved < len(t):
+        point = fold(mech, float(t[solved - 1]), q[solved - 1], scale)
+        if point is not None and t[solved - 1] - 1e-9 <= point.t <= t[solved] + 1e-9:
+            found.append(point)
+    return sorted(found, key=lambda p: p.t)
