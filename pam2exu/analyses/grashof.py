@@ -93,10 +93,10 @@ def crank_range(crank: float, rod: float, offset: float) -> list[tuple[float, fl
     """The crank angles θ from the guide's direction with |r sin θ − e| ≤ L: the crank pin
     within L of the slider pin's path (e its offset)."""
     lo, hi = (offset - rod) / crank, (offset + rod) / crank
-    if lo <= -1 and hi >= 1:
-        return [(-np.pi, np.pi)]
-    # sin θ ∈ [lo, hi] is cos(θ − π/2) ∈ [lo, hi]
-    return [(a + np.pi / 2, b + np.pi / 2) for a, b in cosine_range(lo, hi)]
+    turns = cosine_range(lo, hi)             # sin θ ∈ [lo, hi] is cos(θ − π/2) ∈ [lo, hi]
+    if turns == [(-np.pi, np.pi)]:
+        return turns
+    return [(a + np.pi / 2, b + np.pi / 2) for a, b in turns]
 
 
 def slider_range(crank: float, rod: float, offset: float) -> list[tuple[float, float]]:
