@@ -293,8 +293,10 @@ def describe_loop(mech, cycle, q0, order, dyad: Dyad | None) -> Loop:
         first = 3 if solids[1] in in_dyad and solids[3] not in in_dyad else 1
         last = 4 - first
         loop.input = mech.solids[solids[first]].name
+        roles = dict(zip(("frame", "input", "coupler", "output"),
+                         (names[0], names[first], names[2], names[last])))
         loop.grashof = grashof.four_bar_class(lengths[0], lengths[first], lengths[2],
-                                              lengths[last])
+                                              lengths[last], roles)
         loop.input_range = grashof.degrees(grashof.four_bar_input_range(
             lengths[0], lengths[first], lengths[2], lengths[last]))
     elif (len(edges) == 4 and len(slides) == 1 and slides[0] in (0, 3)

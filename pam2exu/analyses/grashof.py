@@ -32,10 +32,11 @@ class Grashof:
                 "condition": self.condition}
 
 
-def four_bar_class(frame: float, input_: float, coupler: float, output: float) -> Grashof:
+def four_bar_class(frame: float, input_: float, coupler: float, output: float,
+                   names: dict[str, str] | None = None) -> Grashof:
     """Grashof's law s + l ≤ p + q, and which link is the shortest: the frame (double-crank),
     a link next to it (crank-rocker), the coupler (double-rocker); = (change-point); >
-    (non-grashof, a triple rocker)."""
+    (non-grashof, a triple rocker). ``names``: the solids of the roles, for the words."""
     lengths = {"frame": frame, "input": input_, "coupler": coupler, "output": output}
     ordered = sorted(lengths.values())
     s, l = ordered[0], ordered[-1]
@@ -47,8 +48,9 @@ def four_bar_class(frame: float, input_: float, coupler: float, output: float) -
         return Grashof("non-grashof", left, right, condition + f" > p + q = {right:.6g}")
     shortest = min(lengths, key=lengths.get)
     kind = {"frame": "double-crank", "coupler": "double-rocker"}.get(shortest, "crank-rocker")
+    who = f" '{names[shortest]}'" if names else ""
     return Grashof(kind, left, right, condition + f" < p + q = {right:.6g} "
-                   f"(the shortest link: the {shortest})")
+                   f"(the shortest link: the {shortest}{who})")
 
 
 def slider_crank_class(crank: float, rod: float, offset: float) -> Grashof:
