@@ -217,8 +217,24 @@ def placement(mech, q0: np.ndarray, basis) -> tuple[dict[int, int], dict[int, Dy
                 dyads[k] = dyad
                 order[dyad.coupler] = order[dyad.output] = turn
                 grown = True
-        if not grown:
+        if not grown and not _free_input(mech, basis, dyads, order, turn):
             return order, dyads
+
+
+def _free_input(mech, basis, dyads, order, turn: int) -> bool:
+    """Where no actuator places the next solid (a degree of freedom left free), take as
+    the input of the first loop without a dyad its first solid not placed that is pinned
+    to a placed one; False when there is none."""
+    for k, cycle in enumerate(basis):
+        if k in dyads:
+            continue
+        for e, _ in cycle:
+            ends = (e.element.ref1.solid, e.element.ref2.solid)
+            placed = [s in order for s in ends]
+            if e.element.pins and sum(placed) == 1:
+                order[ends[placed.index(False)]] = turn
+                return True
+    return False
 
 
 def _dyad(mech, cycle, order) -> Dyad | None:
@@ -392,7 +408,8 @@ def classify(model, backend: str | None = None, t_end: float | None = None,
         solved = 1
         note = (f"{guess.dof} degree(s) of freedom not driven (solid(s) "
                 f"{', '.join(guess.free_solids)}): the position at t = 0 is the assembly "
-                "nearest the guess, and no run is followed")
+                "nearest the guess, no run is followed, and a loop's input is its first "
+                "free solid next to the frame")
     else:
         q, found = positions(job, guess.redundant > 0, partial=True)
         solved = found.solved
@@ -421,7 +438,8 @@ def classify(model, backend: str | None = None, t_end: float | None = None,
     for lp in found_loops:
         if lp.dyad is not None:
             lp.transmission = transmission_extremes(mech, lp.dyad, rows_t, rows_q)
-    if 0 < solved < len(t) and not any(p.kind == "dead point" for p in points):
+    if guess.dof == 0 and 0 < solved < len(t) and not any(p.kind == "dead point"
+                                                          for p in points):
         note = (f"the run stops after t = {t[solved - 1]:g} s "
                 f"(no dead point found there: run it to see why)")
     return Atlas(mech.model.name, str(mech.model.source), gruebler, without.dof,

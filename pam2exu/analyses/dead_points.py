@@ -9,8 +9,10 @@ Two kinds, told apart by the path of positions through them:
   C(q, t) = 0, Cq(q, t) v = 0, v₀ · v = 1, for (q, t, v): regular at a simple fold, so t is
   found to round-off;
 - a *change point* (the path goes on through it, the sign of det Cq changes, e.g. a
-  change-point four-bar with its links in line): the root of det Cq(q(t), t) along the
-  path, by Brent's method, each q(t) by Newton from the step before.
+  change-point four-bar with its links in line): where the branches cross, [Cq C_t] loses
+  rank too; located by Gauss–Newton on C = 0, Cqᵀ w = 0, C_tᵀ w = 0, w₀ · w = 1 for
+  (q, t, w), to round-off; failing that, the root of det Cq(q(t), t) along the path by
+  Brent's method (the positions there are ill-conditioned: about √ε in time).
 """
 from __future__ import annotations
 
@@ -87,6 +89,46 @@ def fold(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | None:
     return None
 
 
+def branch_point(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | None:
+    """The change point near (t0, q0): Gauss–Newton on C = 0, Cqᵀ w = 0, C_tᵀ w = 0,
+    w₀ · w = 1 (w₀ the combination of equations Cq nearly loses at q0: where the branches
+    cross, [Cq C_t] loses rank), consistent there and regular at a simple crossing; None
+    when it does not converge. Derivatives by central differences, as ``fold``."""
+    nq, m = mech.nq, mech.n_equations
+    w0 = np.linalg.svd(_jacobian(mech, t0, q0)[1])[0][:, -1]
+    x = np.concatenate([q0, [t0], w0])
+    h = STEP * scale
+    for _ in range(ITERATIONS):
+        q, t, w = x[:nq], x[nq], x[nq + 1:]
+        ts = np.concatenate([[t], np.full(2 * nq, t), [t + h, t - h]])
+        qs = np.repeat(q[None], 2 * nq + 3, axis=0)
+        qs[1:nq + 1] += h * np.eye(nq)
+        qs[nq + 1:2 * nq + 1] -= h * np.eye(nq)
+        eq = equations(mech, State(ts, qs))
+        C, J, Ct = eq.residual[0], eq.jacobian[0], eq.c_t[0]
+        Jw = np.einsum("nmq,m->nq", eq.jacobian, w)           # Cqᵀ w at each state
+        Ctw = eq.c_t @ w
+        F = np.concatenate([C, J.T @ w, [Ct @ w, w0 @ w - 1.0]])
+        A = np.zeros((m + nq + 2, nq + 1 + m))
+        A[:m, :nq], A[:m, nq] = J, Ct
+        A[m:m + nq, :nq] = ((Jw[1:nq + 1] - Jw[nq + 1:2 * nq + 1]) / (2 * h)).T
+        A[m:m + nq, nq] = (Jw[-2] - Jw[-1]) / (2 * h)
+        A[m:m + nq, nq + 1:] = J.T
+        A[m + nq, :nq] = (Ctw[1:nq + 1] - Ctw[nq + 1:2 * nq + 1]) / (2 * h)
+        A[m + nq, nq] = (Ctw[-2] - Ctw[-1]) / (2 * h)
+        A[m + nq, nq + 1:] = Ct
+        A[-1, nq + 1:] = w0
+        step = np.linalg.lstsq(A, -F, rcond=None)[0]
+        x = x + step
+        if not np.all(np.isfinite(x)):
+            return None
+        if abs(step[nq]) < TIME_TOL and np.max(np.abs(step[:nq])) < 1e-12 * scale:
+            q = x[:nq]
+            return Singular("change point", float(x[nq]), q,
+                            null_motion(_jacobian(mech, float(x[nq]), q)[1]))
+    return None
+
+
 def position(mech, t: float, q: np.ndarray, scale: float) -> np.ndarray | None:
     """q with C(q, t) = 0 by Newton from q (least squares with redundant equations); None
     when it does not converge."""
@@ -133,7 +175,9 @@ def singular_points(mech, t: np.ndarray, q: np.ndarray, solved: int,
     if mech.n_equations == nq and solved > 1:
         d = determinants(mech, t[:solved], q[:solved])
         for k in np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]:
-            point = sign_change(mech, float(t[k]), float(t[k + 1]), q[k], scale)
+            point = branch_point(mech, float(t[k]), q[k], scale)
+            if point is None or not t[k] <= point.t <= t[k + 1]:
+                point = sign_change(mech, float(t[k]), float(t[k + 1]), q[k], scale)
             if point is not None:
                 found.append(point)
     if 0 < solved < len(t):
