@@ -121,7 +121,8 @@ class Atlas:
                 "transmission_angle": lp.transmission})
         return {
             "model": self.model, "file": self.source,
-            "dof": {"gruebler": self.gruebler, "mobility": self.mobility,
+            "dof": self.mobility,
+            "mobility": {"gruebler": self.gruebler, "rank": self.mobility,
                     "actuated": self.actuated, "free": self.free,
                     "redundant": self.redundant,
                     "redundant_elements": self.redundant_elements, "meaning": self.meaning},

@@ -35,9 +35,9 @@ def _range(values, unit: str) -> str:
 
 def lines(found: dict) -> list[str]:
     """The atlas (``Atlas.as_dict``) in words, one line each."""
-    dof = found["dof"]
+    dof = found["mobility"]
     out = [f"model '{found['model']}' ({found['file']})",
-           f"mobility: Grübler–Kutzbach {dof['gruebler']}, rank {dof['mobility']} "
+           f"mobility: Grübler–Kutzbach {dof['gruebler']}, rank {dof['rank']} "
            f"({dof['meaning']}); actuated {dof['actuated']}, left free {dof['free']}"]
     for k, lp in enumerate(found["loops"], start=1):
         chain = " ".join(f"{s} –{j}–" for s, j in zip(lp["solids"], lp["joints"]))

@@ -194,11 +194,12 @@ def test_dead_point_of_a_slider_driven_slider_crank():
     assert loop.input_range[-1][1] == pytest.approx(np.sqrt((L + r) ** 2 - e * e), abs=1e-12)
 
 
-def six_bar(steps=40):
+def six_bar(steps=40, c2=0.35):
     """A Watt II six-bar: the four-bar O2-A-B-O4, and on the rocker's point C a second dyad
-    C-D-O6. Returns the model and the hand-computed transmission angles at the grid."""
+    C-D-O6 (link 0.4, output c2). Returns the model, the hand-computed poses and the acute
+    angle of two vectors."""
     a, b, c, o4, o6 = 0.1, 0.35, 0.3, np.array([0.4, 0.0]), np.array([0.9, 0.0])
-    c_local, b2, c2 = np.array([0.15, 0.1]), 0.4, 0.35
+    c_local, b2 = np.array([0.15, 0.1]), 0.4
     omega, t_end = 2 * np.pi, 1.0
 
     def pose(theta):
@@ -217,7 +218,7 @@ def six_bar(steps=40):
     text += solid("coupler", *A, angle(B - A), {"A": (0, 0), "B": (b, 0)})
     text += solid("rocker", *o4, psi, {"O": (0, 0), "B": (c, 0), "C": tuple(c_local)})
     text += solid("link", *C, angle(D - C), {"C": (0, 0), "D": (b2, 0)})
-    text += solid("output", *o6, angle(D - o6), {"O": (0, 0), "D": (c2, 0)})
+    text += solid("output", *o6, angle(D - o6), {"O": (0, 0), "D": (float(c2), 0)})
     for name, p, q in (("O2", "ground.O2", "crank.O"), ("A", "crank.A", "coupler.A"),
                        ("B", "coupler.B", "rocker.B"), ("O4", "ground.O4", "rocker.O"),
                        ("C", "rocker.C", "link.C"), ("D", "link.D", "output.D"),
@@ -261,6 +262,7 @@ def test_command_prints_the_atlas_and_its_json(examples, capsys):
     assert main(["classify", str(examples / "four_bar.toml"), "--json"]) == 0
     found = json.loads(capsys.readouterr().out)
     assert {"dof", "loops", "assembly_modes", "dead_points"} <= set(found)
+    assert found["dof"] == 1 and found["mobility"]["gruebler"] == 1
     (loop,) = found["loops"]
     assert {"solids", "joints", "kind", "grashof", "transmission_angle"} <= set(loop)
     assert loop["grashof"]["class"] == "crank-rocker"
@@ -307,3 +309,20 @@ def test_a_model_error_names_the_file_and_the_element(examples, tmp_path, capsys
     assert main(["classify", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "bad.toml" in err and "'A'" in err and "coupler.Q" in err
+
+
+def test_dead_point_of_a_six_bars_second_loop():
+    # a shorter output: C leaves the reach of the second dyad, |C − O6| = 0.4 + c2
+    c2 = 0.265
+    model, pose, _ = six_bar(c2=c2)
+    atlas = classify(model)
+    (point,) = atlas.dead_points
+    assert point["kind"] == "dead point" and point["loop"] == 2 and point["joint"] == "D"
+    from scipy.optimize import brentq
+    def gap(t):                        # C only (D does not exist past the dead point)
+        with np.errstate(invalid="ignore"):
+            return np.linalg.norm(pose(0.3 + 2 * np.pi * t)[3] - [0.9, 0.0]) - 0.4 - c2
+    t = prepare(model, analysis="kinematic").times
+    k = int(np.argmax([gap(x) > 0 for x in t]))
+    assert point["t"] == pytest.approx(brentq(gap, t[k - 1], t[k], xtol=1e-15), abs=1e-9)
+    assert atlas.loops[1].transmission["min"] == pytest.approx(0.0, abs=1e-5)
