@@ -29,8 +29,8 @@ def _range(values, unit: str) -> str:
         return "none: the loop cannot close"
     if unit == "deg" and len(values) == 1 and values[0][1] - values[0][0] >= 360 - 1e-9:
         return "a full turn"
-    return " or ".join(f"{lo:.4g} … {hi:.4g} {'°' if unit == 'deg' else unit}"
-                       for lo, hi in values)
+    mark = "°" if unit == "deg" else f" {unit}"
+    return " or ".join(f"{lo:.4g}{mark} … {hi:.4g}{mark}" for lo, hi in values)
 
 
 def lines(found: dict) -> list[str]:
