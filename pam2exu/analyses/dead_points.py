@@ -181,7 +181,28 @@ def singular_points(mech, t: np.ndarray, q: np.ndarray, solved: int,
             if point is not None:
                 found.append(point)
     if 0 < solved < len(t):
-        point = fold(mech, float(t[solved - 1]), q[solved - 1], scale)
-        if point is not None and t[solved - 1] - 1e-9 <= point.t <= t[solved] + 1e-9:
+        point = stop(mech, float(t[solved - 1]), float(t[solved]), q[solved - 1], scale)
+        if point is not None:
             found.append(point)
     return sorted(found, key=lambda p: p.t)
+
+
+#: bisections of the last step in ``stop``
+BISECTIONS = 20
+
+
+def stop(mech, t0: float, t1: float, q0: np.ndarray, scale: float) -> Singular | None:
+    """The dead point between t0 (solved: q0) and t1 (not solved): ``fold`` from the last
+    position solved, which moves closer by bisection (Newton from the one before) until the
+    fold converges within [t0, t1]; None when it never does (the stop is no fold)."""
+    for _ in range(BISECTIONS):
+        point = fold(mech, t0, q0, scale)
+        if point is not None and t0 - 1e-9 <= point.t <= t1 + 1e-9:
+            return point
+        middle = 0.5 * (t0 + t1)
+        q = position(mech, middle, q0, scale)
+        if q is not None:
+            t0, q0 = middle, q
+        else:
+            t1 = middle
+    return None

@@ -326,3 +326,14 @@ def test_dead_point_of_a_six_bars_second_loop():
     k = int(np.argmax([gap(x) > 0 for x in t]))
     assert point["t"] == pytest.approx(brentq(gap, t[k - 1], t[k], xtol=1e-15), abs=1e-9)
     assert atlas.loops[1].transmission["min"] == pytest.approx(0.0, abs=1e-5)
+
+
+def test_a_dead_point_far_past_the_last_solved_step_is_still_found():
+    # 2 steps: the run stops at t = 0.25 s, 0.22 s before the dead point; Newton on the
+    # extended system from there does not converge, from a bisected step it does
+    d, a, b, c = 0.4, 0.1, 0.35, 0.3
+    atlas = classify(four_bar(d, a, b, c, rocker_driven=True, psi0=2.0, speed=1.0,
+                              t_end=1.0, steps=2))
+    psi = np.arccos(((b - a) ** 2 - d * d - c * c) / (2 * d * c))
+    (point,) = atlas.dead_points
+    assert point["t"] == pytest.approx(psi - 2.0, abs=1e-9) and atlas.note == ""
