@@ -194,14 +194,13 @@ def _direction(q, line) -> np.ndarray:
 
 def placement(mech, q0: np.ndarray, basis) -> tuple[dict[int, int], dict[int, Dyad]]:
     """(the order each solid is placed in, the dyad that closes each loop of ``basis``):
-    the held solids first (0), then by turns each solid that the elements to placed solids
-    fix (``loops.rigid``) and each loop left with two solids to place, joined by a pin."""
+    the held solids first (0), then one by one each solid that the elements to placed
+    solids fix (``loops.rigid``) and each loop left with two solids to place, joined by a
+    pin (its coupler, then its output)."""
     jac = equations(mech, State([0.0], q0[None])).jacobian[0]
     order = {s: 0 for s in mech.held}
     dyads: dict[int, Dyad] = {}
-    turn = 0
     while True:
-        turn += 1
         grown = False
         for s in range(len(mech.solids)):
             if s in order:
@@ -209,20 +208,21 @@ def placement(mech, q0: np.ndarray, basis) -> tuple[dict[int, int], dict[int, Dy
             near = [el for el in mech.constraints
                     if s in el.solids and set(el.solids) - {s} <= set(order)]
             if near and loops.rigid(mech, jac, near, {s}):
-                order[s], grown = turn, True
+                order[s], grown = len(order), True
         for k, cycle in enumerate(basis):
             if k in dyads:
                 continue
             dyad = _dyad(mech, cycle, order)
             if dyad is not None:
                 dyads[k] = dyad
-                order[dyad.coupler] = order[dyad.output] = turn
+                order[dyad.coupler] = len(order)
+                order[dyad.output] = len(order)
                 grown = True
-        if not grown and not _free_input(mech, basis, dyads, order, turn):
+        if not grown and not _free_input(basis, dyads, order):
             return order, dyads
 
 
-def _free_input(mech, basis, dyads, order, turn: int) -> bool:
+def _free_input(basis, dyads, order) -> bool:
     """Where no actuator places the next solid (a degree of freedom left free), take as
     the input of the first loop without a dyad its first solid not placed that is pinned
     to a placed one; False when there is none."""
@@ -233,7 +233,7 @@ def _free_input(mech, basis, dyads, order, turn: int) -> bool:
             ends = (e.element.ref1.solid, e.element.ref2.solid)
             placed = [s in order for s in ends]
             if e.element.pins and sum(placed) == 1:
-                order[ends[placed.index(False)]] = turn
+                order[ends[placed.index(False)]] = len(order)
                 return True
     return False
 

@@ -337,3 +337,51 @@ def test_a_dead_point_far_past_the_last_solved_step_is_still_found():
     psi = np.arccos(((b - a) ** 2 - d * d - c * c) / (2 * d * c))
     (point,) = atlas.dead_points
     assert point["t"] == pytest.approx(psi - 2.0, abs=1e-9) and atlas.note == ""
+
+
+def test_a_floating_loop_is_measured_from_its_solid_placed_first():
+    """Watt I: the second loop coupler-E-link-G-out-F-rocker touches no frame."""
+    a, b, c, o4 = 0.1, 0.35, 0.3, np.array([0.4, 0.0])
+
+    def rot(f):
+        return np.array([[np.cos(f), -np.sin(f)], [np.sin(f), np.cos(f)]])
+
+    def pose(theta):
+        A = a * np.array([np.cos(theta), np.sin(theta)])
+        B = meet(A, o4, b, c, 1.0)
+        E = A + rot(angle(B - A)) @ [0.2, 0.15]
+        F = o4 + rot(angle(B - o4)) @ [0.15, 0.1]
+        return A, B, E, F, meet(E, F, 0.3, 0.25, 1.0)
+
+    A, B, E, F, G = pose(0.3)
+    text = '[model]\nname = "watt-1"\n' + GROUND.format(
+        points="O2 = [0.0, 0.0], O4 = [0.4, 0.0]", lines="")
+    text += solid("crank", 0, 0, 0.3, {"O": (0, 0), "A": (a, 0)})
+    text += solid("coupler", *A, angle(B - A), {"A": (0, 0), "B": (b, 0), "E": (0.2, 0.15)})
+    text += solid("rocker", *o4, angle(B - o4), {"O": (0, 0), "B": (c, 0), "F": (0.15, 0.1)})
+    text += solid("link", *E, angle(G - E), {"E": (0, 0), "G": (0.3, 0)})
+    text += solid("out", *F, angle(G - F), {"F": (0, 0), "G": (0.25, 0)})
+    for name, p, q in (("O2", "ground.O2", "crank.O"), ("A", "crank.A", "coupler.A"),
+                       ("B", "coupler.B", "rocker.B"), ("O4", "ground.O4", "rocker.O"),
+                       ("E", "coupler.E", "link.E"), ("G", "link.G", "out.G"),
+                       ("F", "rocker.F", "out.F")):
+        text += element("revolute", name, p, q)
+    text += element("angular_actuator", "motor", "ground", "crank",
+                    f'law = "polynomial"\nC = [0.3, {2 * np.pi!r}, 0.0, 0.0]\n')
+    model = loads(text + analysis(1.0, 20))
+    atlas = classify(model)
+    loop = atlas.loops[1]
+    assert loop.solids == ["coupler", "link", "out", "rocker"] and loop.reference == "coupler"
+    assert loop.input == "rocker" and atlas.assembly_modes == 4
+    lengths = (np.hypot(0.2 - 0.35, 0.15), 0.3, 0.25, np.hypot(0.3 - 0.15, 0.1))
+    s, *pq, l = sorted(lengths)
+    assert s + l > sum(pq) and loop.grashof.kind == "non-grashof"
+    assert loop.grashof.left == pytest.approx(s + l, abs=1e-12)
+    t = prepare(model, analysis="kinematic").times
+    mu = []
+    for theta in 0.3 + 2 * np.pi * t:               # the coupler 'out' F → G, 'link' E → G
+        A, B, E, F, G = pose(theta)
+        u, w = G - F, G - E
+        mu.append(np.degrees(np.arctan2(abs(u[0] * w[1] - u[1] * w[0]), abs(u @ w))))
+    assert loop.transmission["min"] == pytest.approx(min(mu), abs=1e-7)
+    assert loop.transmission["max"] == pytest.approx(max(mu), abs=1e-7)
