@@ -165,7 +165,7 @@ def test_slider_crank_grashof_with_offset(offset):
 def test_dead_points_of_a_rocker_driven_crank_rocker():
     d, a, b, c = 0.4, 0.1, 0.35, 0.3
     atlas = classify(four_bar(d, a, b, c, rocker_driven=True, psi0=2.0, speed=1.0,
-                              t_end=1.0, steps=50))
+                              t_end=1.0, steps=10))
     # the crank and coupler in line: |O2 B| = b − a, B = O4 + c (cos ψ, sin ψ)
     psi = np.arccos(((b - a) ** 2 - d * d - c * c) / (2 * d * c))
     (point,) = atlas.dead_points
@@ -185,7 +185,7 @@ def test_dead_points_of_a_rocker_driven_crank_rocker():
 
 def test_dead_point_of_a_slider_driven_slider_crank():
     r, L, e = 0.1, 0.3, 0.05
-    atlas = classify(slider_crank(r, L, e, slider_x0=0.3, speed=0.2, t_end=1.0, steps=40))
+    atlas = classify(slider_crank(r, L, e, slider_x0=0.3, speed=0.2, t_end=1.0, steps=10))
     (point,) = atlas.dead_points
     assert point["kind"] == "dead point" and point["joint"] == "A"
     assert point["t"] == pytest.approx((np.sqrt((L + r) ** 2 - e * e) - 0.3) / 0.2, abs=1e-9)
@@ -194,7 +194,7 @@ def test_dead_point_of_a_slider_driven_slider_crank():
     assert loop.input_range[-1][1] == pytest.approx(np.sqrt((L + r) ** 2 - e * e), abs=1e-12)
 
 
-def six_bar(steps=40, c2=0.35):
+def six_bar(steps=20, c2=0.35):
     """A Watt II six-bar: the four-bar O2-A-B-O4, and on the rocker's point C a second dyad
     C-D-O6 (link 0.4, output c2). Returns the model, the hand-computed poses and the acute
     angle of two vectors."""
