@@ -85,7 +85,9 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     centrodes : str, optional
         A moving solid's name: its fixed centrode and its moving centrode over the model's
         kinematic run (the moving one where the solid is at t), its pole I and its
-        inflection circle at t (``graphical.centrodes``).
+        inflection circle at t (``graphical.centrodes``); the drawing widens to hold the
+        circle when its radius is at most ``FAR_CENTRE`` sizes, and the centrodes are cut
+        where they pass ``FAR_CENTRE`` sizes from the mechanism.
 
     Returns
     -------
@@ -169,11 +171,11 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         when += "; centres I" + (f" ({', '.join(n for n, _ in far)}: far off)" if far else "")
     if centrodes is not None:
         curves = graphical.centrodes(model, centrodes, t)
-        circle = curves.inflection_centre + curves.inflection_radius * np.array(
-            [[1.0, 1.0], [-1.0, -1.0]])
-        for pts in (curves.pole[None], circle):
-            if np.all(constructions.visible(pts, lo, hi, FAR_CENTRE, mech_size)):
-                extra.append(pts)
+        if np.all(constructions.visible(curves.pole[None], lo, hi, FAR_CENTRE, mech_size)):
+            extra.append(curves.pole[None])
+        if curves.inflection_radius <= FAR_CENTRE * mech_size:      # the whole circle
+            extra.append(curves.inflection_centre + curves.inflection_radius * np.array(
+                [[1.0, 1.0], [-1.0, -1.0]]))
         when += f"; centrodes of {centrodes}: fixed (full), moving (dashed), inflection circle"
     if polygon is not None:
         poly = graphical.polygon(model, t, polygon)
