@@ -186,8 +186,9 @@ def polygon(model, t: float, kind: str) -> Polygon:
 class Centre:
     """The instantaneous centre I_ij of bodies ``bodies`` = (i, j), numbered from 1 (the
     ground) and named ``names``: ``point`` [m], NaN where it is at infinity (the two translate
-    relative to each other), then ``direction`` (unit) points to it; ``homogeneous`` is
-    h_i − h_j (``points.velocity_field``)."""
+    relative to each other), then ``direction`` (unit) points to it; both NaN and None where
+    the two move together (``defined``); ``homogeneous`` is h_i − h_j
+    (``points.velocity_field``)."""
 
     bodies: tuple[int, int]
     names: tuple[str, str]
@@ -204,6 +205,12 @@ class Centre:
     @property
     def finite(self) -> bool:
         return bool(np.all(np.isfinite(self.point)))
+
+    @property
+    def defined(self) -> bool:
+        """False where the two bodies move together (the same ω and velocities): every point
+        of the plane is then a centre of theirs."""
+        return self.finite or self.direction is not None
 
 
 @dataclass(frozen=True)
@@ -238,7 +245,15 @@ class Centres:
 def kennedy_residual(a: Centre, b: Centre, c: Centre) -> float | None:
     """How far three centres are from one line [m]: the triangle's height over its longest
     side, or the distance of one finite centre from the line through the other along the
-    direction of the one at infinity; None with two at infinity."""
+    direction of the one at infinity; None with two at infinity. Where two of the bodies
+    move together (a centre not ``defined``), the other two centres are one point: their
+    distance (0 when both are at infinity)."""
+    undefined = [x for x in (a, b, c) if not x.defined]
+    if undefined:
+        others = [x for x in (a, b, c) if x.defined]
+        if len(others) == 2 and all(x.finite for x in others):
+            return float(np.hypot(*(others[0].point - others[1].point)))
+        return 0.0
     finite = [x for x in (a, b, c) if x.finite]
     if len(finite) == 3:
         return collinearity(a.point, b.point, c.point)

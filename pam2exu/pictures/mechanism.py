@@ -158,10 +158,13 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         ok = constructions.visible([c.point for c in finite], lo, hi, FAR_CENTRE, mech_size)
         shown_all = {c.label for c, k in zip(finite, ok) if k}
         extra += [c.point[None, :] for c in finite if c.label in shown_all]
-        off = [c.label for c in found_all.centres if c.label not in shown_all]
+        off = [c.label for c in found_all.centres if c.label not in shown_all and c.defined]
+        together = [c.label for c in found_all.centres if not c.defined]
         when += ("; centres I_ij of " + ", ".join(f"{k} {n}" for k, n in
                                                    enumerate(found_all.bodies, start=1))
-                 + (f" ({', '.join(off)}: far off)" if off else ""))
+                 + (f" ({', '.join(off)}: far off)" if off else "")
+                 + (f" ({', '.join(together)}: none, the two move together)" if together
+                    else ""))
     elif ic:
         _, _, found = centres(model, t)
         for name, p in found:
