@@ -162,7 +162,7 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         together = [c.label for c in found_all.centres if not c.defined]
         when += ("; centres I_ij of " + ", ".join(f"{k} {n}" for k, n in
                                                    enumerate(found_all.bodies, start=1))
-                 + (f" ({', '.join(off)}: far off)" if off else "")
+                 + (f" ({', '.join(off)}: far off or at infinity)" if off else "")
                  + (f" ({', '.join(together)}: none, the two move together)" if together
                     else ""))
     elif ic:
