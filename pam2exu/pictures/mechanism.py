@@ -67,7 +67,7 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     guess : bool
         Draw the initial guess: every solid at the x, y, fi given in the model, not
         assembled (no analysis runs, so a model that does not assemble can be seen);
-        not with a time, vectors or centres.
+        not with a time, vectors, centres, a polygon or centrodes.
     ic : bool or 'all'
         True: mark each moving solid's instantaneous centre of rotation at t (``I crank``;
         from a kinematic run, ``points.instantaneous_centre``); a solid that translates has
