@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .sheet import ELEMENT_FONT, GROUND, INK, VECTOR_COLORS, Z_GUIDE, Z_LOAD, Sheet, _unit
+from .sheet import ELEMENT_FONT, GROUND, INK, VECTOR_COLORS, Z_LOAD, Sheet, _unit
 from .vectors import round_length
 
 #: the scale bar is about this fraction of the polygon's size (a round value)
@@ -150,18 +150,11 @@ def draw_centres(pen, found, shown: set) -> None:
         s = (pts - pts[0]) @ d
         a, b = pts[0] + (s.min() - 0.06 * pen.size) * d, pts[0] + (s.max() + 0.06 * pen.size) * d
         with pen.owner("kennedy:" + "-".join(map(str, line.bodies))):
-            pen._line([a, b], color=GROUND, lw=0.8, linestyle=(0, (5, 3)), zorder=Z_GUIDE)
+            pen.construction([a, b], GROUND, linestyle=(0, (5, 3)), width=0.8)
     for c in found.centres:
-        if c.label not in shown:
-            continue
-        with pen.owner(f"centre:{c.label}"):
-            p, r = c.point, 0.9 * pen.r
-            pen._circle(p, r, facecolor="white", edgecolor=INK, lw=1.2, zorder=Z_LOAD)
-            pen._line([p - [1.6 * r, 0.0], p + [1.6 * r, 0.0], [np.nan, np.nan],
-                       p - [0.0, 1.6 * r], p + [0.0, 1.6 * r]], color=INK, lw=1.0,
-                      zorder=Z_LOAD)
-            pen.label(p, c.label, None, INK, reach=1.6 * r, fontsize=ELEMENT_FONT,
-                      fontstyle="italic")
+        if c.label in shown:
+            with pen.owner(f"centre:{c.label}"):
+                pen.mark(c.point, c.label, INK)
 
 
 def _broken(points, ok) -> np.ndarray:
@@ -177,20 +170,17 @@ def draw_centrodes(pen, found, lo, hi, far: float, color) -> None:
     pole I and the inflection circle (red, dotted) at t."""
     size = pen.size
     with pen.owner("centrode:fixed"):
-        pen._line(_broken(found.fixed, visible(found.fixed, lo, hi, far, size)),
-                  color=FIXED_CENTRODE, lw=1.4, zorder=Z_GUIDE)
+        pen.construction(_broken(found.fixed, visible(found.fixed, lo, hi, far, size)),
+                         FIXED_CENTRODE, width=1.4)
     with pen.owner("centrode:moving"):
-        pen._line(_broken(found.moving_at, visible(found.moving_at, lo, hi, far, size)),
-                  color=color, lw=1.4, linestyle="--", zorder=Z_GUIDE)
+        pen.construction(_broken(found.moving_at, visible(found.moving_at, lo, hi, far, size)),
+                         color, linestyle="--", width=1.4)
     with pen.owner("inflection"):
         a = np.linspace(0.0, 2.0 * np.pi, 181)
         circle = found.inflection_centre + found.inflection_radius * np.column_stack(
             [np.cos(a), np.sin(a)])
-        pen._line(circle, color=INFLECTION, lw=1.1, linestyle=":", zorder=Z_GUIDE)
+        pen.construction(circle, INFLECTION, linestyle=":", width=1.1)
         pen.label(found.inflection_centre + found.inflection_radius * np.array([0.0, -1.0]),
                   "inflection circle", None, INFLECTION, fontsize=ELEMENT_FONT - 1)
     with pen.owner(f"pole:{found.solid}"):
-        p, r = found.pole, 0.9 * pen.r
-        pen._circle(p, r, facecolor="white", edgecolor=INFLECTION, lw=1.4, zorder=Z_LOAD)
-        pen.label(p, f"I {found.solid}", None, INFLECTION, reach=r, fontsize=ELEMENT_FONT,
-                  fontstyle="italic")
+        pen.mark(found.pole, f"I {found.solid}", INFLECTION)
