@@ -13,6 +13,12 @@ them (docs/model-format.md, "Output variables"), so default tables do not change
 - ``<coupler>.transmission_angle`` [rad]: of a solid joined by two revolutes to a driven
   input and to a rocker or a slider (``couplers``, ``transmission_angle``).
 
+And for the graphical methods (``pictures/graphical.py``): the relative centre of two solids
+from their velocity fields (``velocity_field``, ``relative_centre``), how far three points
+are from a line (``collinearity``, ``off_line``: Kennedy's theorem), the inflection circle
+(``inflection_circle``) and global points in a solid's frame (``in_frame``: the moving
+centrode).
+
 The functions are pure and vectorised over time steps (arrays of shape (n,) or (n, 2)),
 so a drawing can call them on one configuration as well.
 """
@@ -142,6 +148,112 @@ def instantaneous_centre(r, v, dfi, length: float = 1.0) -> np.ndarray:
     out = np.full(r.shape, np.nan, dtype=number_type(r, v, dfi))
     out[defined] = r[defined] + perp(v[defined]) / dfi[defined, None]
     return out
+
+
+def velocity_field(r, v, dfi) -> np.ndarray:
+    """h = (Ω u, ω), u = v − ω Ω r: a solid's velocity field v(P) = u + ω Ω P, homogeneous.
+
+    The relative centre of two solids is h_i − h_j in homogeneous coordinates
+    (``relative_centre``), so h_ij + h_jk = h_ik: the three centres of any three solids are
+    collinear (Kennedy's theorem).
+
+    Parameters
+    ----------
+    r, v : array_like (2,)
+        Any point of the solid (its frame's origin) [m] and that point's velocity [m/s].
+    dfi : float
+        The solid's angular velocity [rad/s].
+
+    Examples
+    --------
+    >>> velocity_field([1.0, 0.0], [0.0, 2.0], 2.0) + 0.0  # turning about the origin
+    array([0., 0., 2.])
+    """
+    r, v = np.asarray(r, dtype=float), np.asarray(v, dtype=float)
+    u = v - dfi * perp(r)
+    return np.array([-u[1], u[0], dfi])
+
+
+def relative_centre(h_i, h_j, length: float = 1.0) -> np.ndarray:
+    """I_ij = Ω (u_i − u_j) / (ω_i − ω_j): the point where v_i(P) = v_j(P) (NaN at infinity).
+
+    h_i, h_j are ``velocity_field``s. Where ω_i = ω_j (the solids translate relative to
+    each other) or I_ij lies farther than ``FAR`` · ``length`` from the origin, the centre is
+    at infinity, in the direction ``h_i − h_j``'s first two components: NaN.
+
+    Examples
+    --------
+    >>> relative_centre([0.0, 0.0, 2.0], [0.0, 0.0, 0.0])
+    array([0., 0.])
+    """
+    h = np.asarray(h_i, dtype=float) - np.asarray(h_j, dtype=float)
+    if h[2] == 0.0 or np.hypot(h[0], h[1]) > FAR * length * abs(h[2]):
+        return np.full(2, np.nan)
+    return h[:2] / h[2]
+
+
+def collinearity(a, b, c) -> float:
+    """|(b − a) × (c − a)| / (longest side): the height of the triangle abc, 0 when collinear [m].
+
+    Examples
+    --------
+    >>> collinearity([0.0, 0.0], [2.0, 0.0], [1.0, 0.5])
+    0.5
+    """
+    a, b, c = (np.asarray(x, dtype=float) for x in (a, b, c))
+    u, w = b - a, c - a
+    side = max(np.hypot(*u), np.hypot(*w), np.hypot(*(c - b)))
+    return float(abs(u[0] * w[1] - u[1] * w[0]) / side) if side > 0 else 0.0
+
+
+def off_line(a, b, direction) -> float:
+    """|(b − a) × d| / |d|: how far b is from the line through a along d [m]."""
+    u, d = np.asarray(b, dtype=float) - np.asarray(a, dtype=float), np.asarray(direction,
+                                                                                 dtype=float)
+    return float(abs(u[0] * d[1] - u[1] * d[0]) / np.hypot(*d))
+
+
+def inflection_circle(pole, a_pole, dfi: float) -> tuple[np.ndarray, float]:
+    """Centre I + a_I / (2 ω²), radius |a_I| / (2 ω²): the points P of zero normal
+    acceleration, a_P · (P − I) = 0, with a_P = a_I + α Ω (P − I) − ω² (P − I).
+
+    Parameters
+    ----------
+    pole : array_like (2,)
+        The solid's instantaneous centre I [m].
+    a_pole : array_like (2,)
+        The acceleration of the solid's point at I [m/s²] (not the pole's own rate of
+        travel along the centrodes: a_I = ω Ω u for the pole velocity u).
+    dfi : float
+        The solid's angular velocity ω ≠ 0 [rad/s].
+
+    Returns
+    -------
+    (numpy.ndarray (2,), float)
+        The circle's centre [m] and radius [m]; the diameter through I is the pole normal
+        and |a_I| / ω² the inflection circle's diameter.
+
+    Examples
+    --------
+    >>> c, r = inflection_circle([0.0, 0.0], [0.0, 4.0], 2.0)   # a wheel of radius 1 rolling
+    >>> c.tolist(), r
+    ([0.0, 0.5], 0.5)
+    """
+    a = np.asarray(a_pole, dtype=float)
+    return np.asarray(pole, dtype=float) + a / (2.0 * dfi * dfi), float(np.hypot(*a)) / (
+        2.0 * dfi * dfi)
+
+
+def in_frame(r, fi, p) -> np.ndarray:
+    """R(fi)ᵀ (p − r): global points p (n, 2) in the frame of a solid at r (n, 2), fi (n,).
+
+    Examples
+    --------
+    >>> in_frame([[1.0, 0.0]], [np.pi / 2], [[1.0, 2.0]]).round(12) + 0.0
+    array([[2., 0.]])
+    """
+    d = np.asarray(p, dtype=float) - np.asarray(r, dtype=float)
+    return rotate(-np.asarray(fi, dtype=float), d.T)
 
 
 def transmission_angle(a, b, normal) -> np.ndarray:

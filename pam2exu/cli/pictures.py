@@ -41,8 +41,16 @@ def add_parsers(sub) -> None:
     draw.add_argument("--guess", action="store_true",
                       help="draw the initial guess (x, y, fi as given, not assembled), the "
                            "constraints it does not meet in red")
-    draw.add_argument("--ic", action="store_true",
-                      help="mark each moving solid's instantaneous centre of rotation at T")
+    draw.add_argument("--ic", nargs="?", const=True, default=False, choices=("all",),
+                      help="mark each moving solid's instantaneous centre of rotation at T; "
+                           "--ic all: every centre I_ij, relative ones included, with the "
+                           "Kennedy lines")
+    draw.add_argument("--polygon", choices=("v", "a"),
+                      help="the velocity (v) or acceleration (a) polygon at T beside the "
+                           "mechanism, to scale with a scale bar (kinematic run)")
+    draw.add_argument("--centrodes", metavar="SOLID",
+                      help="the fixed and moving centrodes of SOLID over the model's run and "
+                           "its inflection circle at T")
     anim = sub.add_parser(
         "animate", help="animate the model's kinematic or dynamic run (GIF; MP4 with ffmpeg)",
         description="An animation of the kinematic run (dynamic, for a model whose analysis "
@@ -98,7 +106,7 @@ def draw(args, warnings) -> int:
 
     def make():
         draw(args.model, t=args.t, path=out, vectors=args.vectors, guess=args.guess,
-             ic=args.ic)
+             ic=args.ic, polygon=args.polygon, centrodes=args.centrodes)
         return out
     return picture("draw", make, args.debug)
 

@@ -27,13 +27,16 @@ __all__ = ["draw", "animate", "configurations", "pose", "extent", "Scene", "DRAW
 #: figure size of a drawing [in]
 DRAW_SIZE = (8.0, 6.0)
 #: instantaneous centres farther than this many sizes out of the mechanism's box are not
-#: drawn (``draw(ic=True)``): the drawing would shrink to nothing
+#: drawn (``draw(ic=True)``, ``ic='all'``, ``centrodes=``): the drawing would shrink to nothing
 FAR_CENTRE = 1.5
+#: figure size of a drawing with its polygon beside it (``draw(polygon=…)``) [in]
+POLYGON_SIZE = (13.0, 6.0)
 
 
 def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI,
          size: tuple[float, float] = DRAW_SIZE, vectors: str | None = None,
-         guess: bool = False, ic: bool = False):
+         guess: bool = False, ic: bool | str = False, polygon: str | None = None,
+         centrodes: str | None = None):
     """Draw the mechanism at time t; returns the matplotlib Figure.
 
     Solids, joints, guides, springs, actuators, torsors and the global frame, on axes
@@ -64,12 +67,27 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     guess : bool
         Draw the initial guess: every solid at the x, y, fi given in the model, not
         assembled (no analysis runs, so a model that does not assemble can be seen);
-        not with a time, vectors or centres.
-    ic : bool
-        Mark each moving solid's instantaneous centre of rotation at t (``I crank``; from a
-        kinematic run, ``points.instantaneous_centre``); a solid that translates has none,
-        one farther than ``FAR_CENTRE`` sizes from the mechanism is left out and named in
-        the title.
+        not with a time, vectors, centres, a polygon or centrodes.
+    ic : bool or 'all'
+        True: mark each moving solid's instantaneous centre of rotation at t (``I crank``;
+        from a kinematic run, ``points.instantaneous_centre``); a solid that translates has
+        none, one farther than ``FAR_CENTRE`` sizes from the mechanism is left out and named
+        in the title. ``'all'``: every centre I_ij of two bodies, relative ones included
+        (body 1 the ground, then the moving solids; the title numbers them), and the
+        Kennedy line through the three centres of every three bodies
+        (``graphical.all_centres``); those far off or at infinity are named in the title.
+    polygon : {'v', 'a'}, optional
+        The velocity or acceleration polygon at t in a second panel, right of the
+        mechanism (``graphical.polygon``; the figure is ``POLYGON_SIZE`` unless ``size`` is
+        given): every point's absolute vector from the pole o, each link's relative vectors
+        (for accelerations with their normal and tangential components), names and values,
+        a scale bar.
+    centrodes : str, optional
+        A moving solid's name: its fixed centrode and its moving centrode over the model's
+        kinematic run (the moving one where the solid is at t), its pole I and its
+        inflection circle at t (``graphical.centrodes``); the drawing widens to hold the
+        circle when its radius is at most ``FAR_CENTRE`` sizes, and the centrodes are cut
+        where they pass ``FAR_CENTRE`` sizes from the mechanism.
 
     Returns
     -------
@@ -78,8 +96,10 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     Raises
     ------
     PictureError
-        ``t`` is negative or not a number, ``vectors`` is not v, a or F, ``guess`` is
-        given with a time or vectors, or the image format of ``path`` is not supported.
+        ``t`` is negative or not a number, ``vectors`` is not v, a or F, ``polygon`` not
+        v or a, ``ic`` not True, False or 'all', ``centrodes`` not a moving solid (or it
+        translates at t), ``guess`` is given with a time, vectors, centres, a polygon or
+        centrodes, or the image format of ``path`` is not supported.
     ModelError
         The model has problems (``MobilityError`` for t > 0 when a degree of freedom is not
         driven).
@@ -103,14 +123,18 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
     >>> draw("examples/four_bar.toml", t=0.25, path="four_bar.svg")   # doctest: +SKIP
     <Figure size 800x600 with 1 Axes>
     """
+    from . import constructions, graphical
     from .pen import VECTOR_COLORS
     from .vectors import KINDS, at_instant, centres
     model = _model(model)
     arrows = None
+    if ic not in (True, False, "all"):
+        raise PictureError(f"--ic alone marks each solid's centre, --ic all every centre; "
+                           f"not {ic!r}")
     if guess:
-        if t or vectors or ic:
+        if t or vectors or ic or polygon or centrodes:
             raise PictureError("the initial guess is the model's x, y, fi as given: draw it "
-                               "without a time or vectors")
+                               "without a time, vectors, centres, a polygon or centrodes")
         mech = model.mechanism()
         q = mech.initial_q()
         when = "initial guess (x, y, fi as given, not assembled)"
@@ -127,17 +151,54 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         arrows.scaled(mech_size)
         extra.append(arrows.tips)
     shown, far = [], []
-    if ic:
+    found_all = poly = curves = None
+    if ic == "all":
+        found_all = graphical.all_centres(model, t)
+        finite = [c for c in found_all.centres if c.finite]
+        ok = constructions.visible([c.point for c in finite], lo, hi, FAR_CENTRE, mech_size)
+        shown_all = {c.label for c, k in zip(finite, ok) if k}
+        extra += [c.point[None, :] for c in finite if c.label in shown_all]
+        off = [c.label for c in found_all.centres if c.label not in shown_all and c.defined]
+        together = [c.label for c in found_all.centres if not c.defined]
+        when += ("; centres I_ij of " + ", ".join(f"{k} {n}" for k, n in
+                                                   enumerate(found_all.bodies, start=1))
+                 + (f" ({', '.join(off)}: far off or at infinity)" if off else "")
+                 + (f" ({', '.join(together)}: none, the two move together)" if together
+                    else ""))
+    elif ic:
         _, _, found = centres(model, t)
         for name, p in found:
             off = np.maximum(np.maximum(lo - p, p - hi), 0.0)
             (shown if max(off) <= FAR_CENTRE * mech_size else far).append((name, p))
         extra += [p[None, :] for _, p in shown]
         when += "; centres I" + (f" ({', '.join(n for n, _ in far)}: far off)" if far else "")
+    if centrodes is not None:
+        curves = graphical.centrodes(model, centrodes, t)
+        if np.all(constructions.visible(curves.pole[None], lo, hi, FAR_CENTRE, mech_size)):
+            extra.append(curves.pole[None])
+        if curves.inflection_radius <= FAR_CENTRE * mech_size:      # the whole circle
+            extra.append(curves.inflection_centre + curves.inflection_radius * np.array(
+                [[1.0, 1.0], [-1.0, -1.0]]))
+        when += f"; centrodes of {centrodes}: fixed (full), moving (dashed), inflection circle"
+    if polygon is not None:
+        poly = graphical.polygon(model, t, polygon)
+        if size == DRAW_SIZE:
+            size = POLYGON_SIZE
     fig = figure(*size, dpi)
-    ax = fig.add_subplot()
-    scene = Scene(ax, mech, q[None, :], np.vstack(extra) if extra else ())
+    ax = fig.add_subplot(1, 2, 1) if poly is not None else fig.add_subplot()
+    room = None if poly is None else np.array([size[0] / 2, size[1]]) - LABEL_ROOM
+    scene = Scene(ax, mech, q[None, :], np.vstack(extra) if extra else (), room=room)
     scene.show(t, q)
+    if found_all is not None:
+        constructions.draw_centres(scene.pen, found_all, shown_all)
+    if curves is not None:
+        index = {s.name: i for i, s in enumerate(mech.solids)}
+        constructions.draw_centrodes(scene.pen, curves, lo, hi, FAR_CENTRE,
+                                     scene.pen.color(index[centrodes]))
+    pens = [scene.pen]
+    if poly is not None:
+        colors = {s.name: scene.pen.color(i) for i, s in enumerate(mech.solids)}
+        pens.append(constructions.draw_polygon(fig.add_subplot(1, 2, 2), poly, colors))
     index = {s.name: i for i, s in enumerate(mech.solids)}
     for name, p in shown:
         with scene.pen.owner(f"centre:{name}"):
@@ -150,7 +211,7 @@ def draw(model, t: float = 0.0, path: str | Path | None = None, dpi: float = DPI
         unmet = _mark_unmet(scene, q, mech_size)
         when += f"; {len(unmet)} constraint{'s' * (len(unmet) != 1)} not met" if unmet else ""
     fit_title(fig, ax, f"'{mech.name}' — {when}")
-    _settle(fig, scene)
+    _settle(fig, pens)
     if path is not None:
         save(fig, path)
     return fig
@@ -175,9 +236,10 @@ def _mark_unmet(scene, q, size: float) -> list[str]:
     return unmet
 
 
-def _settle(fig, scene) -> None:
-    """Lay the figure out once and keep that layout, then place the names for it (their
-    places depend on the axes' size in pixels)."""
+def _settle(fig, pens) -> None:
+    """Lay the figure out once and keep that layout, then place the names of every pen for
+    it (their places depend on the axes' size in pixels)."""
     fig.canvas.draw()
     fig.set_layout_engine("none")
-    scene.pen.place_labels()
+    for pen in pens:
+        pen.place_labels()

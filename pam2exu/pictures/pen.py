@@ -203,13 +203,23 @@ class Pen(Sheet):
     def centre(self, p, solid: int, name: str) -> None:
         """A solid's instantaneous centre of rotation: a ringed cross in its colour, named
         ``I <solid>``."""
-        p, r, color = np.asarray(p, dtype=float), 1.1 * self.r, self.color(solid)
+        self.mark(p, f"I {name}", self.color(solid))
+
+    def mark(self, p, text: str, color=INK) -> None:
+        """A point of a construction (an instantaneous centre, a pole): a ringed cross in
+        ``color``, named ``text`` in italics."""
+        p, r = np.asarray(p, dtype=float), 1.1 * self.r
         self._circle(p, r, facecolor="white", edgecolor=color, lw=1.4, zorder=Z_LOAD)
         self._line([p - [1.8 * r, 0.0], p + [1.8 * r, 0.0], [np.nan, np.nan],
                     p - [0.0, 1.8 * r], p + [0.0, 1.8 * r]], color=color, lw=1.2,
                    zorder=Z_LOAD)
-        self.label(p, f"I {name}", None, color, reach=1.8 * r, fontsize=ELEMENT_FONT,
+        self.label(p, text, None, color, reach=1.8 * r, fontsize=ELEMENT_FONT,
                    fontstyle="italic")
+
+    def construction(self, xy, color=GROUND, linestyle="-", width: float = 1.0) -> None:
+        """A line of a construction (a Kennedy line, a centrode, a circle): the polyline
+        ``xy`` (k, 2) [m], broken at rows of NaN, under the solids."""
+        self._line(xy, color=color, lw=width, linestyle=linestyle, zorder=Z_GUIDE)
 
     def unmet(self, points) -> None:
         """A constraint the drawing does not meet (an initial guess): a red dotted line

@@ -90,9 +90,12 @@ class Scene:
         holds all of them.
     extra : array_like
         More points to keep inside the box, shape (k, 2) [m].
+    room : (float, float), optional
+        Width and height [in] the axes may take (default: the figure less ``LABEL_ROOM``;
+        a figure of two panels gives each its part).
     """
 
-    def __init__(self, ax, mech, q_all: np.ndarray, extra=()):
+    def __init__(self, ax, mech, q_all: np.ndarray, extra=(), room=None):
         self.ax, self.mech = ax, mech
         self.locals = [np.array([[float(v) for v in p] for p in s.points.values()]
                                 if s.points else np.zeros((0, 2))) for s in mech.solids]
@@ -104,7 +107,8 @@ class Scene:
         # the box with a margin, widened to the shape of the axes (the figure less room
         # for the labels and the title), then equal scales by shrinking the axes a little
         lo, hi = lo - MARGIN * self.size, hi + MARGIN * self.size
-        width, height = ax.figure.get_size_inches() - LABEL_ROOM
+        width, height = (ax.figure.get_size_inches() - LABEL_ROOM if room is None
+                         else np.asarray(room, dtype=float))
         centre, half = (lo + hi) / 2, (hi - lo) / 2
         half = np.maximum(half, half[::-1] * np.array([width / height, height / width]))
         ax.set_xlim(centre[0] - half[0], centre[0] + half[0])
