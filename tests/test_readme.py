@@ -33,8 +33,8 @@ def test_readme_python_blocks_run(monkeypatch, tmp_path):
 
 @pytest.mark.parametrize("page", [p for p in PAGES if p.name != "README.md"
                                   and _blocks(p, "python")], ids=lambda p: p.name)
-def test_docs_python_blocks_run(monkeypatch, page):
-    monkeypatch.chdir(ROOT)
+def test_docs_python_blocks_run(monkeypatch, page, tmp_path):
+    monkeypatch.chdir(_workspace(tmp_path))       # what a block writes lands in tmp_path
     for k, block in enumerate(_blocks(page, "python")):
         exec(compile(block, f"{page.name} python block {k + 1}", "exec"), {})
 
