@@ -1,6 +1,6 @@
 """An exam as one PDF (matplotlib, no LaTeX): a page per variant (the drawing at the first
 time asked, the data, the questions), then a page of solutions per variant (every answer,
-and the drawing with the velocity of every point at the first time asked)."""
+and the drawing with its velocity polygon at the first time asked)."""
 from __future__ import annotations
 
 import textwrap
@@ -46,7 +46,7 @@ def _page(exam, variant, solution: bool):
     head = "Solutions, variant" if solution else "Variant"
     fig.text(0.08, 0.96, f"{head} {variant.number} of {len(exam.variants)} — "
                          f"{Path(exam.source).name}", fontsize=14, weight="bold")
-    picture = draw(variant.model, t=first, vectors="v" if solution else None)
+    picture = draw(variant.model, t=first, polygon="v" if solution else None)
     picture.canvas.draw()
     image = np.asarray(picture.canvas.buffer_rgba())
     ax = fig.add_axes((0.08, 0.47, 0.84, 0.47))
