@@ -386,3 +386,27 @@ def test_natural_jacobian_against_the_closed_form(results):
     vB = ref["c"] * ref["dphi4"][0] * turn(np.array([np.cos(phi4), np.sin(phi4)]))
     zd = np.array([*ref["vA"][0], *vB, ref["dtheta"][0]])[perm]
     assert rel_err(out["zd"], zd) < RTOL
+
+
+def _make_teaching():
+    """docs/make_teaching.py, loaded by its path (docs/ is not a package)."""
+    spec = importlib.util.spec_from_file_location("make_teaching",
+                                                  ROOT / "docs" / "make_teaching.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_lessons_figures_are_the_commands_the_page_shows(tmp_path):
+    """Every figure of the four-bar lesson is drawn by docs/make_teaching.py with the
+    command the page shows beside it; the page names each, and draw one again here."""
+    make = _make_teaching()
+    page = (ROOT / "docs" / "teaching.md").read_text(encoding="utf-8")
+    for name, command, _ in make.FIGURES:
+        assert command in page and f"img/{name}" in page, name
+        assert (ROOT / "docs" / "img" / name).is_file(), \
+            f"missing docs/img/{name}: run python docs/make_teaching.py"
+    assert make.EXAM_COMMAND in page and f"img/{make.EXAM_FIGURE}" in page
+    assert (ROOT / "docs" / "img" / make.EXAM_FIGURE).is_file()
+    path = make.draw_figure("lesson_centres.png", tmp_path)
+    assert path.read_bytes().startswith(b"\x89PNG")

@@ -23,21 +23,18 @@ def write(exam, path: Path) -> Path:
     try:
         with PdfPages(temporary) as pdf:
             for variant in exam.variants:
-                pdf.savefig(_page(exam, variant, solution=False))
+                pdf.savefig(page(exam, variant, solution=False))
             for variant in exam.variants:
-                pdf.savefig(_page(exam, variant, solution=True))
+                pdf.savefig(page(exam, variant, solution=True))
         temporary.replace(path)
     finally:
         temporary.unlink(missing_ok=True)
     return path
 
 
-def pages(exam) -> int:
-    """The pages ``write`` writes: one per variant and one of solutions per variant."""
-    return 2 * len(exam.variants)
-
-
-def _page(exam, variant, solution: bool):
+def page(exam, variant, solution: bool):
+    """One page of the exam (a matplotlib Figure, A4): the variant's questions, or with
+    ``solution`` its answers and velocity polygon."""
     from matplotlib.figure import Figure
     from ..pictures import draw
     from . import data_lines
