@@ -50,12 +50,18 @@ def rotate(fi, v):
 
 def _rotate(c, s, v):
     """A v with A = [[c, −s], [s, c]]: ``rotate`` with cos fi and sin fi given."""
-    return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1]], axis=-1)
+    x, y = c * v[0] - s * v[1], s * v[0] + c * v[1]
+    out = np.empty(x.shape + (2,), x.dtype)     # np.stack's values, without its checks
+    out[..., 0], out[..., 1] = x, y
+    return out
 
 
 def perp(w):
     """Ω w = (−wy, wx): w turned 90° counter-clockwise (dA/dfi · s = Ω A s)."""
-    return np.stack([-w[..., 1], w[..., 0]], axis=-1)
+    out = np.empty(w.shape[:-1] + (2,), w.dtype)
+    np.negative(w[..., 1], out=out[..., 0])
+    out[..., 1] = w[..., 0]
+    return out
 
 
 def dot(a, b):

@@ -88,13 +88,19 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
     breakpoints = _breakpoints(mech)
     verified: set[int] = set()
     resolves = spent = 0              # re-solves, and the position solves they took
+    # Cq at every step is kept from the rates' evaluation when the condition numbers are
+    # wanted at every step (a short run): evaluated once, not again for them
+    keep = len(t) <= condition_samples(mech)
     while True:
         job.stage = "computing velocities and following the branch"
         tk, qk = t[:solved], q[:solved]
-        qd, qdd, residual = rates(job, tk, qk, redundant, own)
+        qd, qdd, residual, *kept = rates(job, tk, qk, redundant, own, with_jacobian=keep)
+        jacobian = kept[0] if kept else None
         check_residual(mech, tk, qk, job, residual)
         singular = ~(np.isfinite(qd).all(axis=1) & np.isfinite(qdd).all(axis=1))
-        q = _unwrap(mech, tk, q, qd, solved)
+        unwrapped = _unwrap(mech, tk, q, qd, solved)
+        if unwrapped is not q:       # whole turns taken out: Cq at qk is not Cq at q
+            q, jacobian = unwrapped, None
         if singular[0] or (singular.any() and not singular_ok):
             raise singular_error(job, int(np.argmax(singular)))
         scale = _scales(mech, qd)
@@ -102,7 +108,8 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
         k = _first_jump(defect, singular, verified)
         while k is not None:         # numerically singular steps: their rates are round-off
             near = [i for i in (k - 1, k) if i > 0 and not singular[i]]
-            at = [i for i, c in zip(near, rank.condition_numbers(mech, tk[near], qk[near]))
+            at = [i for i, c in zip(near, rank.condition_numbers(
+                mech, tk[near], qk[near], None if jacobian is None else jacobian[near]))
                   if c > SINGULAR]
             if not at:
                 break
@@ -161,7 +168,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
                   "there are interpolated from the neighbouring steps (error of order "
                   "(ω dt)⁴).", ConditionWarning)
     near = np.nonzero(_spikes(defect) | _with_neighbours(singular))[0]
-    _warn_ill_conditioned(job, q, singular, near)
+    _warn_ill_conditioned(job, q, singular, near, jacobian)
     return q, qd, (qdd if accelerations else None)
 
 
@@ -289,19 +296,26 @@ def _interpolate_singular(t, qd, qdd, singular):
     return qd, qdd
 
 
-def _warn_ill_conditioned(job: Job, q, singular, near=()) -> None:
+def condition_samples(mech) -> int:
+    """Steps of a run whose condition numbers are computed (equally spaced; an SVD costs
+    ~nq³: fewer for large mechanisms)."""
+    return int(np.clip(2e7 / max(1, mech.nq) ** 3, 1, CONDITION_SAMPLES))
+
+
+def _warn_ill_conditioned(job: Job, q, singular, near=(), jacobian=None) -> None:
     """Warn when the constraint Jacobian is ill-conditioned somewhere: at sampled steps,
-    and at the steps ``near`` singular positions or velocity jumps."""
+    and at the steps ``near`` singular positions or velocity jumps. ``jacobian``: Cq at
+    every step of q when already evaluated (else evaluated at the steps sampled)."""
     mech, t = job.mech, job.times
     tolerance = job.solver.tolerance
     if mech.n_equations == 0:
         return
-    # an SVD costs ~nq³: fewer samples for large mechanisms
-    samples = int(np.clip(2e7 / mech.nq ** 3, 1, CONDITION_SAMPLES))
+    samples = condition_samples(mech)
     steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), samples)).astype(int),
                             np.asarray(near, dtype=int)[:samples]])
     steps = steps[~singular[steps]]
-    condition = rank.condition_numbers(mech, t[steps], q[steps])
+    condition = rank.condition_numbers(mech, t[steps], q[steps],
+                                       None if jacobian is None else jacobian[steps])
     i = int(np.argmax(condition))
     worst = float(condition[i])
     job.info["max_condition_number"] = worst

@@ -156,8 +156,10 @@ def check_mobility(job: Job, q0: np.ndarray, need_driven: bool | None = None) ->
     declares, ``AnalysisType.driven``) raises MobilityError for a DOF not driven."""
     if need_driven is None:
         need_driven = job.analysis_type.driven
-    rank.require_defined(job.mech, float(job.times[0]), q0)
-    mob = rank.mobility(job.mech, float(job.times[0]), q0)
+    t0 = float(job.times[0])
+    eq = rank.at_guess(job.mech, t0, q0)          # evaluated once for both
+    rank.require_defined(job.mech, t0, q0, eq)
+    mob = rank.mobility(job.mech, t0, q0, jacobian=eq.jacobian[0])
     job.info.update(dof=mob.dof, redundant_equations=mob.redundant,
                     condition_number=mob.condition)
     if need_driven:

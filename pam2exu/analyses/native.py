@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..complex_step import as_array
-from ..kinematics import PER_SOLID, State, column
+from ..kinematics import PER_SOLID, PointSet, State, column
 from ..laws import Law
 from ..progress import Progress
 
@@ -30,6 +30,10 @@ SPARSE_CHUNK = 200_000
 #: steps per chunk of the residuals and the continuity defect: their arrays then stay in
 #: the cache
 RESIDUAL_CHUNK = 8192
+#: the key under which a mechanism keeps the points and directions its constraints ask
+#: for (``kinematics.PointSet``, from its first evaluation): ``equations`` builds them at
+#: once afterwards (``State.prepare``)
+POINTS = "_constraint_points"
 
 
 @dataclass
@@ -61,17 +65,22 @@ def equations(mech, st: State, jacobian: bool = True) -> Equations:
     residual, c_t = np.zeros((n, m), dtype), np.zeros((n, m), dtype)
     jac = np.zeros((n, m, mech.nq), dtype) if jacobian else None
     gamma = np.zeros((n, m), dtype) if st.qd is not None else None
+    points = mech.__dict__.get(POINTS) if st.jacobians else None
+    if points is not None:
+        st.prepare(points)              # the elements' points at once, the same values
     parts = []
     for el, rows in zip(mech.constraints, mech.rows):
         v, target = el.constraint(st)
         parts.append(v)
         f, df, ddf = target_values(target, st.t, el.equations)
         residual[:, rows] = v.value - f
-        c_t[:, rows] = -np.broadcast_to(df, (n, el.equations))
+        c_t[:, rows] = np.negative(df)          # broadcast over the steps
         if jac is not None:
             v.rows(jac, rows.start)
         if gamma is not None:
             gamma[:, rows] = ddf - v.conv
+    if points is None and st.jacobians and st.qd is None:
+        mech.__dict__[POINTS] = PointSet.of(st.asked)
     return Equations(residual, jac, c_t, gamma, parts)
 
 
@@ -152,9 +161,11 @@ def _solve(J, b, redundant, rtol=1e-12):
     return x
 
 
-def rates(mech, t, q, accelerations: bool, redundant: bool):
+def rates(mech, t, q, accelerations: bool, redundant: bool, with_jacobian: bool = False):
     """(qd, qdd, C) at every step; qdd is None when not asked for; C = C(q, t) (n, m)
-    comes from the same evaluation of the equations, for the residual check."""
+    comes from the same evaluation of the equations, for the residual check.
+    ``with_jacobian``: (qd, qdd, C, Cq), Cq (n, m, nq) from that evaluation too when the
+    steps are solved dense in one chunk (else None: it is not kept)."""
     n = len(t)
     qd = np.zeros_like(q)
     qdd = np.zeros_like(q) if accelerations else None
@@ -162,16 +173,19 @@ def rates(mech, t, q, accelerations: bool, redundant: bool):
     rows, cols = moving(mech)
     sparse = not redundant and mech.n_equations >= SPARSE_FROM
     parts = list(chunks(mech, n, sparse=sparse))
+    jacobian = None
     # a bar on a terminal when the pass takes several chunks (one chunk: over in a blink)
     with Progress(len(parts), "velocities and accelerations") as bar:
         for done, s in enumerate(parts, start=1):
             if not (sparse and _sparse_rates(mech, t[s], q[s], qd[s],
                                              qdd[s] if accelerations else None,
                                              residual[s], rows, cols)):
-                _dense_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
-                             residual[s], rows, cols, redundant)
+                J = _dense_rates(mech, t[s], q[s], qd[s], qdd[s] if accelerations else None,
+                                 residual[s], rows, cols, redundant)
+                if len(parts) == 1:
+                    jacobian = J
             bar.update(done)
-    return qd, qdd, residual
+    return (qd, qdd, residual, jacobian) if with_jacobian else (qd, qdd, residual)
 
 
 def _sparse_rates(mech, t, q, qd, qdd, residual, rows, cols) -> bool:
@@ -190,8 +204,8 @@ def _sparse_rates(mech, t, q, qd, qdd, residual, rows, cols) -> bool:
     return True
 
 
-def _dense_rates(mech, t, q, qd, qdd, residual, rows, cols, redundant) -> None:
-    """Fill qd, qdd (views) of a chunk by batched dense solves."""
+def _dense_rates(mech, t, q, qd, qdd, residual, rows, cols, redundant) -> np.ndarray:
+    """Fill qd, qdd (views) of a chunk by batched dense solves; returns the chunk's Cq."""
     eq = equations(mech, State(t, q))
     residual[:] = eq.residual
     J = eq.jacobian[:, rows[:, None], cols]
@@ -199,6 +213,7 @@ def _dense_rates(mech, t, q, qd, qdd, residual, rows, cols, redundant) -> None:
     if qdd is not None:
         gamma = equations(mech, State(t, q, qd, jacobians=False), jacobian=False).gamma
         qdd[:, cols] = _solve(J, gamma[:, rows], redundant)
+    return eq.jacobian
 
 
 def moving(mech):

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..backend import Positions
 from ..elements import ACCELERATION, VELOCITY
-from ..kinematics import ANGLES
+from ..kinematics import ANGLES, State
 from ..progress import Progress
 from . import continuity, native, rank
 from .checks import check_residual
@@ -111,17 +111,23 @@ def assemble(job: Job, redundant: bool, anchor_stiffness: float = 0.0) -> np.nda
 
 
 def rates(job: Job, t, q, redundant: bool, found: Positions | None = None,
-          accelerations: bool = True):
+          accelerations: bool = True, with_jacobian: bool = False):
     """(qd, qdd, C(q, t)) at the steps t: the backend's own (``found.qd``, ``qdd``) when it
     gave them for these rows, else the native pass's (``native.rates``); rows at a singular
-    position are NaN either way."""
+    position are NaN either way. ``with_jacobian``: (qd, qdd, C, Cq), Cq (n, m, nq) from the
+    same evaluation of the equations (None where the native pass does not keep it)."""
     if found is not None and found.qd is not None:
         n = len(t)
         with np.errstate(all="ignore"):
-            residual = native.residuals(job.mech, t, q)
-        return found.qd[:n], (found.qdd[:n] if accelerations else None), residual
+            if with_jacobian:            # C and Cq from one evaluation (the same C)
+                eq = native.equations(job.mech, State(t, q))
+                residual, jacobian = eq.residual, eq.jacobian
+            else:
+                residual, jacobian = native.residuals(job.mech, t, q), None
+        out = found.qd[:n], (found.qdd[:n] if accelerations else None), residual
+        return (*out, jacobian) if with_jacobian else out
     with np.errstate(all="ignore"):
-        return native.rates(job.mech, t, q, accelerations, redundant)
+        return native.rates(job.mech, t, q, accelerations, redundant, with_jacobian)
 
 
 def velocities(job: Job, q: np.ndarray, redundant: bool):

@@ -12,16 +12,17 @@ from ..kinematics import State
 from .native import chunks, equations, residuals
 
 
-def condition_numbers(mech, t, q) -> np.ndarray:
+def condition_numbers(mech, t, q, jacobian: np.ndarray | None = None) -> np.ndarray:
     """κ(Cq) at each step: largest over smallest singular value of the constraint Jacobian,
     its rows and columns equilibrated first (each scaled to unit length, three passes), so
     that units and the choice of length scale drop out; ∞ at a singular position.
 
     The one condition number of pam2exu (``pam2exu check``, ``Results.info``, the
     ConditionWarning). The shipped examples: 1.5 to 8.6 over their motion; a four-bar
-    0.2° from a change point: about 190.
+    0.2° from a change point: about 190. ``jacobian``: Cq (n, m, nq) at these steps when
+    already evaluated (``native.equations``).
     """
-    J = equations(mech, State(t, q)).jacobian
+    J = equations(mech, State(t, q)).jacobian if jacobian is None else jacobian
     if J.shape[1] == 0:
         return np.full(len(J), np.inf)
     for _ in range(3):
@@ -49,11 +50,12 @@ class Mobility:
         return text
 
 
-def _rank(mech, t: float, q: np.ndarray, rtol: float, rows=None):
+def _rank(mech, t: float, q: np.ndarray, rtol: float, rows=None, jacobian=None):
     """(U, s, Vt, rank) of the SVD of Cq at (q, t), with the angle columns scaled by the
     length scale so that all columns have units of length (only the equations ``rows``,
-    when given); None without equations."""
-    J = equations(mech, State([t], q[None, :])).jacobian[0]
+    when given); None without equations. ``jacobian``: Cq (m, nq) at (q, t) when already
+    evaluated."""
+    J = equations(mech, State([t], q[None, :])).jacobian[0] if jacobian is None else jacobian
     if rows is not None:
         J = J[rows]
     J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
@@ -63,11 +65,20 @@ def _rank(mech, t: float, q: np.ndarray, rtol: float, rows=None):
     return U, s, Vt, int(np.sum(s > rtol * max(1.0, s[0] if s.size else 1.0)))
 
 
-def require_defined(mech, t: float, q: np.ndarray) -> None:
-    """ModelError when some constraint equation is not defined at the initial guess q
-    (a linear actuator whose two points coincide there has no direction)."""
+def at_guess(mech, t: float, q: np.ndarray):
+    """The constraint equations (``native.Equations``) at one configuration q (the initial
+    guess), evaluated once for ``require_defined`` and ``mobility`` (NaN where undefined,
+    without numpy's warnings)."""
     with np.errstate(all="ignore"):
-        eq = equations(mech, State([t], q[None, :]))
+        return equations(mech, State([t], q[None, :]))
+
+
+def require_defined(mech, t: float, q: np.ndarray, eq=None) -> None:
+    """ModelError when some constraint equation is not defined at the initial guess q
+    (a linear actuator whose two points coincide there has no direction); ``eq``: the
+    equations there when already evaluated (``at_guess``)."""
+    if eq is None:
+        eq = at_guess(mech, t, q)
     bad = [el for el, rows in zip(mech.constraints, mech.rows)
            if not (np.isfinite(eq.residual[0, rows]).all()
                    and np.isfinite(eq.jacobian[0, rows]).all())]
@@ -79,12 +90,16 @@ def require_defined(mech, t: float, q: np.ndarray) -> None:
             mech.model.source)
 
 
-def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None) -> Mobility:
+def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None,
+             jacobian: np.ndarray | None = None) -> Mobility:
     """Rank test of Cq at (q, t): free degrees of freedom and redundant equations (of the
     equations ``rows`` only, a mask of C's rows, when given: ``classify`` leaves out the
-    actuators')."""
+    actuators'); ``jacobian``: Cq (m, nq) there when already evaluated (one evaluation for
+    the rank and the condition number)."""
+    if jacobian is None:
+        jacobian = equations(mech, State([t], q[None, :])).jacobian[0]
     keep = np.ones(mech.n_equations, dtype=bool) if rows is None else np.asarray(rows)
-    svd = _rank(mech, t, q, rtol, None if rows is None else keep)
+    svd = _rank(mech, t, q, rtol, None if rows is None else keep, jacobian=jacobian)
     if svd is None:
         return Mobility(mech.nq, 0, [s.name for s in mech.solids], [], np.inf)
     U, s, Vt, rank = svd
@@ -101,7 +116,7 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None) -> Mo
         for el, own in zip(mech.constraints, mech.rows):
             if np.max(weight[own]) > 1e-6:
                 dependent.append(el.name)
-    condition = float(condition_numbers(mech, [t], q[None, :])[0])
+    condition = float(condition_numbers(mech, [t], q[None, :], jacobian[None])[0])
     return Mobility(dof, redundant, free, dependent, condition)
 
 
