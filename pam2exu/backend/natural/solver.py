@@ -60,6 +60,8 @@ BLOCK = 8192
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
 COARSE_GAP = 64
+#: the machine epsilon (the size of round-off relative to a value)
+EPS = float(np.finfo(float).eps)
 
 
 @dataclass
@@ -105,7 +107,7 @@ class Solver(LinearSolves):
         z = np.array(z, dtype=float)
         ok = np.zeros(len(t), dtype=bool)
         active = np.arange(len(t))
-        eps = np.finfo(float).eps
+        eps = EPS
         last = np.full(len(t), np.inf)        # the previous step's size
         g = terms.targets(t, 0)               # the laws' values, the same every iteration
         for _ in range(self.settings.max_iterations):
@@ -146,41 +148,45 @@ class Solver(LinearSolves):
     def _newton_one(self, t: np.ndarray, z: np.ndarray):
         """``newton`` at one step (t (1,), z (1, nz)): the same arithmetic, without the
         bookkeeping of the steps still active (the sequential passes call it step by step)."""
+        with np.errstate(all="ignore"):          # entered once, not per iteration
+            x, ok = self._iterate_one(t, z)
+        return x[None], np.array([ok])
+
+    def _iterate_one(self, t: np.ndarray, z: np.ndarray):
+        """(z (nz,), converged): ``_newton_one``'s iteration."""
         terms, tol, w = self.terms, self.settings.tolerance, self.w
         x = np.array(z[0], dtype=float)
-        eps = np.finfo(float).eps
-        done_below = max(64 * eps, 100 * tol)
+        done_below = max(64 * EPS, 100 * tol)
         last = np.inf
         g = terms.targets(t, 0)
         for _ in range(self.settings.max_iterations):
             zc = x[:, None]
-            with np.errstate(all="ignore"):
-                phi, data = terms.residual_jacobian_cols(t, zc, g)
-                phi = phi[:, 0]
-                dz = self.solve(data.T, -phi[None])[0]
-                step = float(np.max(np.abs(dz) * w, initial=0.0))
-                small = step <= tol
-                # Φ within round-off of its terms: it decides only a step that did not
-                # shrink (``stalled``) or a least-squares one
-                floor = True
-                if self.least_squares or (not small and step > 0.7 * last):
-                    magnitude = np.maximum(terms.magnitude_cols(t, zc, g)[:, 0], self.floor[:, 0])
-                    size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
-                                     where=magnitude > 0)
-                    size[phi == 0] = 0.0
-                    floor = bool(np.all(size <= 64 * eps))
-                    if self.least_squares:
-                        small = small and bool(np.all(size <= done_below))
+            phi, data = terms.residual_jacobian_cols(t, zc, g)
+            phi = phi[:, 0]
+            dz = self.solve(data.T, -phi[None])[0]
+            step = float(np.max(np.abs(dz) * w, initial=0.0))
+            small = step <= tol
+            # Φ within round-off of its terms: it decides only a step that did not
+            # shrink (``stalled``) or a least-squares one
+            floor = True
+            if self.least_squares or (not small and step > 0.7 * last):
+                magnitude = np.maximum(terms.magnitude_cols(t, zc, g)[:, 0], self.floor[:, 0])
+                size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
+                                 where=magnitude > 0)
+                size[phi == 0] = 0.0
+                floor = bool(np.all(size <= 64 * EPS))
+                if self.least_squares:
+                    small = small and bool(np.all(size <= done_below))
             self.iterations += 1
             if not math.isfinite(step):
-                return x[None], np.zeros(1, dtype=bool)
+                return x, False
             stalled = floor and step > 0.7 * last
             if not stalled:
                 x = x + dz
             last = step
             if small or stalled:
-                return x[None], np.ones(1, dtype=bool)
-        return x[None], np.zeros(1, dtype=bool)
+                return x, True
+        return x, False
 
     def damped(self, t: float, z: np.ndarray, iterations: int = 200):
         """(z, ok): Newton's iteration at one time from a poor guess, each step shortened

@@ -94,6 +94,12 @@ class Terms:
         self._jc_alpha = self._alpha[kc]
         self._keeps = (kb, ka, ks, kc)
         self._jp_keep = np.r_[kb, ka]
+        # ``residual_jacobian_cols``: the coordinates of every term in one gather, and the
+        # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
+        # adds the same terms in the same order as two calls)
+        self._gather = np.r_[self.pa, self.pb, self.sb, self.sa]
+        self._split = np.cumsum([len(self.pa), len(self.pb), len(self.sb)])
+        self._both_index = np.r_[self.row_index, self.m + self.entry_index]
 
     # ---- evaluation: one column per step --------------------------------------------------
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
@@ -182,20 +188,29 @@ class Terms:
     def residual_jacobian_cols(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
                                ) -> tuple[np.ndarray, np.ndarray]:
         """(Φ (m, n), Φ_z data (nnz, n)) from one gather of the terms' coordinates: the same
-        values as ``residual_cols`` and ``jacobian_cols``."""
+        values as ``residual_cols`` and ``jacobian_cols`` (each product c z_a computed once,
+        for Φ and for ∂/∂z_b)."""
         x = self._ext(z)
-        xa, xb = x[self.pa], x[self.pb]
-        arg = x[self.sb] + self._alpha
-        sin, xs = np.sin(arg), x[self.sa]
-        out = self._sum(np.concatenate([self._pc * xa * xb, self._sc * xs * sin]), "row")
+        xa, xb, arg, xs = np.split(x[self._gather], self._split)
+        arg += self._alpha
+        sin = np.sin(arg)
+        ca, cs = self._pc * xa, self._sc * xs
+        kb, ka, ks, kc = self._keeps
+        entries = np.concatenate([np.concatenate([self._pc * xb, ca])[self._jp_keep],
+                                  self._js_c * sin[ks], cs[kc] * np.cos(arg[kc])])
+        rows = np.concatenate([ca * xb, cs * sin])
+        n = x.shape[1]
+        if n > BINCOUNT_STEPS:
+            out, data = self._sum(rows, "row"), self._sum(entries, "entry")
+        else:
+            index, size = self._both_index, self.m + len(self.rows)
+            flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
+            both = np.bincount(flat, weights=np.concatenate([rows, entries]).ravel(),
+                               minlength=size * n).reshape(size, n)
+            out, data = both[:self.m], both[self.m:]
         if self.laws:
             out[self.law_rows] -= self.targets(t, 0) if g is None else g
-        kb, ka, ks, kc = self._keeps
-        values = np.concatenate([
-            np.concatenate([self._pc * xb, self._pc * xa])[self._jp_keep],
-            self._js_c * sin[ks],
-            self._jc_c * xs[kc] * np.cos(arg[kc])])
-        return out, self._sum(values, "entry")
+        return out, data
 
     def dense_cols(self, data: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
         """Φ_z (m, nz, n) from its data (nnz, n); with ``order`` (m,), its rows in that
