@@ -98,7 +98,8 @@ class Terms:
         # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
         # adds the same terms in the same order as two calls)
         self._gather = np.r_[self.pa, self.pb, self.sb, self.sa]
-        self._split = np.cumsum([len(self.pa), len(self.pb), len(self.sb)])
+        edges = np.cumsum([0, len(self.pa), len(self.pb), len(self.sb), len(self.sa)])
+        self._parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
         self._both_index = np.r_[self.row_index, self.m + self.entry_index]
 
     # ---- evaluation: one column per step --------------------------------------------------
@@ -187,30 +188,46 @@ class Terms:
 
     def residual_jacobian_cols(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
                                ) -> tuple[np.ndarray, np.ndarray]:
-        """(Φ (m, n), Φ_z data (nnz, n)) from one gather of the terms' coordinates: the same
-        values as ``residual_cols`` and ``jacobian_cols`` (each product c z_a computed once,
-        for Φ and for ∂/∂z_b)."""
+        """(Φ (m, n), Φ_z data (nnz, n)): the same values as ``residual_cols`` and
+        ``jacobian_cols``. For a few steps (Newton step by step), from one gather of the
+        terms' coordinates, each product c z_a computed once (for Φ and ∂/∂z_b) and one
+        bincount for both sums (disjoint bins: the same additions in the same order)."""
+        if z.shape[1] > BINCOUNT_STEPS:
+            return self._residual_jacobian_many(t, z, g)
         x = self._ext(z)
-        xa, xb, arg, xs = np.split(x[self._gather], self._split)
+        gathered = x[self._gather]
+        xa, xb, arg, xs = (gathered[part] for part in self._parts)
         arg += self._alpha
         sin = np.sin(arg)
         ca, cs = self._pc * xa, self._sc * xs
         kb, ka, ks, kc = self._keeps
         entries = np.concatenate([np.concatenate([self._pc * xb, ca])[self._jp_keep],
                                   self._js_c * sin[ks], cs[kc] * np.cos(arg[kc])])
-        rows = np.concatenate([ca * xb, cs * sin])
-        n = x.shape[1]
-        if n > BINCOUNT_STEPS:
-            out, data = self._sum(rows, "row"), self._sum(entries, "entry")
-        else:
-            index, size = self._both_index, self.m + len(self.rows)
-            flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
-            both = np.bincount(flat, weights=np.concatenate([rows, entries]).ravel(),
-                               minlength=size * n).reshape(size, n)
-            out, data = both[:self.m], both[self.m:]
+        n, size = x.shape[1], self.m + len(self.rows)
+        index = self._both_index
+        flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
+        both = np.bincount(flat, weights=np.concatenate([ca * xb, cs * sin, entries]).ravel(),
+                           minlength=size * n).reshape(size, n)
+        out, data = both[:self.m], both[self.m:]
         if self.laws:
             out[self.law_rows] -= self.targets(t, 0) if g is None else g
         return out, data
+
+    def _residual_jacobian_many(self, t, z, g=None):
+        """``residual_jacobian_cols`` for many steps (each sum by its sparse summing matrix)."""
+        x = self._ext(z)
+        xa, xb = x[self.pa], x[self.pb]
+        arg = x[self.sb] + self._alpha
+        sin, xs = np.sin(arg), x[self.sa]
+        out = self._sum(np.concatenate([self._pc * xa * xb, self._sc * xs * sin]), "row")
+        if self.laws:
+            out[self.law_rows] -= self.targets(t, 0) if g is None else g
+        kb, ka, ks, kc = self._keeps
+        values = np.concatenate([
+            np.concatenate([self._pc * xb, self._pc * xa])[self._jp_keep],
+            self._js_c * sin[ks],
+            self._jc_c * xs[kc] * np.cos(arg[kc])])
+        return out, self._sum(values, "entry")
 
     def dense_cols(self, data: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
         """Φ_z (m, nz, n) from its data (nnz, n); with ``order`` (m,), its rows in that
