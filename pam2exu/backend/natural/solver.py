@@ -164,7 +164,7 @@ class Solver(LinearSolves):
             phi, data = terms.residual_jacobian_cols(t, zc, g)
             phi = phi[:, 0]
             dz = self.solve(data.T, -phi[None])[0]
-            step = float(np.max(np.abs(dz) * w, initial=0.0))
+            step = float((np.abs(dz) * w).max(initial=0.0))   # exact: the same max
             small = step <= tol
             # Φ within round-off of its terms: it decides only a step that did not
             # shrink (``stalled``) or a least-squares one
@@ -282,7 +282,7 @@ class Solver(LinearSolves):
             h = t[j] - t[k]
             guess = z[k] + h * self.zd[k] + 0.5 * h * h * self.zdd[k]
             zj, ok = self.newton(t[j:j + 1], guess[None])
-            miss = float(np.max(np.abs(zj[0] - guess) * self.w)) if ok[0] else np.inf
+            miss = float((np.abs(zj[0] - guess) * self.w).max()) if ok[0] else np.inf
             if miss > COARSE_MISS:             # a shorter interval
                 stride = max(1, stride // 4)
                 continue
