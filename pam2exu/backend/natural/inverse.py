@@ -1,0 +1,129 @@
+"""Inverse dynamics in natural coordinates: the constraint forces that make a given motion.
+
+Each solid's base point p and base vector v (``Frame``) are linear in z: ζ_b = (p, v) =
+A_b z + c_b (``Formulation.affine``). Its kinetic energy is a constant quadratic form in ζ̇_b,
+
+    T_b = ½ ζ̇_bᵀ M_b ζ̇_b,   M_b = [[m I, m G], [m Gᵀ, J_p / |d|² I]],   G = a_G I + b_G Ω,
+
+(``Formulation.mass_matrix`` is Σ A_bᵀ M_b A_b), so the solid's equilibrium, the forces
+its joints apply to it on (p, v), is
+
+    W_b = M_b ζ̈_b − Q_b                      (inertia minus applied: no velocity term)
+
+with Q_b the loads of gravity, the torsors and the spring-dampers (``loads.Loads``). On
+x, y, fi (``Loads.on_pose``) W is Q_inertia − Q_applied of the reference-point pass. Summed
+on z, the constraints' forces are the natural multipliers':
+
+    M z̈ + Φ_zᵀ μ = Q   ⇔   Φ_zᵀ μ = −Σ A_bᵀ W_b     (least norm where Φ_z is rank deficient)
+
+Every quantity is an array over the steps; the solids' constants (masses, a_G, b_G, J_p,
+|d|²) are arrays over the solids (``Bodies``), so that they can gain an axis over variants.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .loads import Loads
+
+#: rank tolerance of the least-norm multipliers, relative to the largest singular value
+RCOND = 1e-10
+
+
+@dataclass
+class Bodies:
+    """The solids of a formulation as arrays: ζ = A z + c and the constant mass matrices.
+
+    A : (ns, 4, nz)   c : (ns, 4)   mass : (ns, 4, 4)   (ground solids: A = 0, mass = 0)
+    """
+
+    A: np.ndarray
+    c: np.ndarray
+    mass: np.ndarray
+
+
+def body_mass_matrices(m, jp, a, b, d2) -> np.ndarray:
+    """M_b (…, 4, 4) = [[m I, m G], [m Gᵀ, J_p / |d|² I]], G = a I + b Ω (arrays over solids)."""
+    m, jp, a, b, d2 = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (m, jp, a, b, d2)))
+    eye, omega = np.eye(2), np.array([[0.0, -1.0], [1.0, 0.0]])
+    G = (m * a)[..., None, None] * eye + (m * b)[..., None, None] * omega
+    out = np.zeros(m.shape + (4, 4))
+    out[..., :2, :2] = m[..., None, None] * eye
+    out[..., :2, 2:] = G
+    out[..., 2:, :2] = np.swapaxes(G, -1, -2)
+    out[..., 2:, 2:] = (jp / d2)[..., None, None] * eye
+    return out
+
+
+def bodies(form) -> Bodies:
+    """The formulation's solids as arrays (made once per formulation)."""
+    kept = form.__dict__.setdefault("_kept", {})
+    if "bodies" not in kept:
+        ns, mech = len(form.frames), form.mech
+        A, c = np.zeros((ns, 4, form.nz)), np.zeros((ns, 4))
+        m, jp, a, b, d2 = (np.zeros(ns) for _ in range(5))
+        d2[:] = 1.0
+        for i, f in enumerate(form.frames):
+            for k, kind in enumerate(("p", "v")):
+                A[i, 2 * k:2 * k + 2], c[i, 2 * k:2 * k + 2] = form.affine(i, None, kind)
+            if i in form.grounds:
+                continue
+            s = mech.solids[i]
+            g = (float(s.cog[0]) - f.sp[0], float(s.cog[1]) - f.sp[1])
+            m[i] = float(s.mass)
+            a[i], b[i] = f._ab(g)
+            jp[i] = float(s.inertia) + m[i] * (g[0] ** 2 + g[1] ** 2)
+            d2[i] = f.d[0] ** 2 + f.d[1] ** 2
+        kept["bodies"] = Bodies(A, c, body_mass_matrices(m, jp, a, b, d2))
+    return kept["bodies"]
+
+
+def body_coordinates(bd: Bodies, z: np.ndarray, constant: bool = True) -> np.ndarray:
+    """ζ (n, ns, 4) = A z + c per solid (``constant`` False: A ż, the rates)."""
+    out = np.einsum("bkz,nz->nbk", bd.A, z)
+    return out + bd.c if constant else out
+
+
+def applied(form, t, z, q, zd) -> np.ndarray:
+    """Q_b (n, ns, 4) on (p, v): gravity, the torsors and the spring-dampers (rates ż)."""
+    loads = Loads(form, z, q, zd, t=t)
+    loads.gravity(form.mech.gravity)
+    for el in form.mech.elements:
+        el.natural_loads(loads)
+    return np.concatenate([loads.Qp, loads.Qv], axis=2)
+
+
+def constraint_forces(form, t, z, zd, zdd, q) -> np.ndarray:
+    """W (n, ns, 4) = M_b ζ̈_b − Q_b: what the joints apply to each solid's (p, v)."""
+    bd = bodies(form)
+    inertia = np.einsum("bkl,nbl->nbk", bd.mass, body_coordinates(bd, zdd, constant=False))
+    return inertia - applied(form, t, z, q, zd)
+
+
+def kinetic_energy(form, zd) -> np.ndarray:
+    """T (n,) = Σ_b ½ ζ̇_bᵀ M_b ζ̇_b."""
+    bd = bodies(form)
+    rate = body_coordinates(bd, zd, constant=False)
+    return 0.5 * np.einsum("nbk,bkl,nbl->n", rate, bd.mass, rate)
+
+
+def on_pose(form, z, q, W) -> np.ndarray:
+    """W on x, y, fi (n, nq): Q_xy = W_p, Q_fi = W_p·Ω(p − R) + W_v·Ω v (``Loads.on_pose``)."""
+    loads = Loads(form, z, q)
+    loads.Qp[:], loads.Qv[:] = W[:, :, :2], W[:, :, 2:]
+    return loads.on_pose()
+
+
+def multipliers(form, z, W, redundant: bool) -> np.ndarray:
+    """μ (n, m) with Φ_zᵀ μ = −Σ A_bᵀ W_b (= Q − M z̈), least norm where ``redundant``."""
+    rhs = -np.einsum("bkz,nbk->nz", bodies(form).A, W)
+    J = form.terms.dense(form.terms.jacobian(z))                    # (n, m, nz)
+    Jt = np.swapaxes(J, 1, 2)
+    if not redundant and J.shape[1] == J.shape[2]:
+        return np.linalg.solve(Jt, rhs[..., None])[..., 0]
+    return np.einsum("nmz,nz->nm", np.linalg.pinv(Jt, rcond=RCOND), rhs)
+
+
+__all__ = ["Bodies", "applied", "bodies", "body_coordinates", "body_mass_matrices",
+           "constraint_forces", "kinetic_energy", "multipliers", "on_pose"]

@@ -1,0 +1,127 @@
+"""Inverse dynamics in natural coordinates (backend/natural/inverse.py): each solid's
+constraint forces W_b = M_b ζ̈_b − Q_b with its constant mass matrix, and the multipliers of
+M z̈ + Φ_zᵀ μ = Q.
+
+References, independent of inverse.py: the reference-point force pass's Q_inertia −
+Q_applied and kinetic energy (analyses/force_pass.py: m a_G at G and J_G α, the elements'
+own loads) on the same motion turned into x, y, fi (``Natural.to_rates``);
+``Formulation.mass_matrix``; and, for an angular actuator, whose equation is fi2 − fi1 =
+f(t) in both formulations, the reference-point multiplier of its row (μ = −λ: the two
+passes put the constraint forces on opposite sides).
+"""
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pam2exu
+from pam2exu.analyses import force_pass
+from pam2exu.backend.natural import Natural, inverse
+from pam2exu.elements.actuators import AngularActuator
+from pam2exu.kinematics import State
+
+ROOT = Path(__file__).resolve().parents[2]
+STEPS = 24
+
+
+def _redundant():
+    """The parallelogram with a fifth bar (one redundant constraint), with masses and
+    gravity."""
+    model = pam2exu.load(ROOT / "tests/data/parallelogram5.toml")
+    model.gravity = 9.81
+    for k, name in enumerate(("crank1", "crank2", "crank3", "coupler")):
+        model[name].mass, model[name].inertia = 0.5 + k, 0.01 * (k + 1)
+    return model, True
+
+
+MODELS = {
+    "four_bar": lambda: (pam2exu.load(ROOT / "examples/four_bar.toml"), False),
+    "slider_crank": lambda: (pam2exu.load(ROOT / "examples/slider_crank.toml"), False),
+    "all_elements": lambda: (pam2exu.load(ROOT / "examples/all_elements.toml"), False),
+    "parallelogram5": _redundant,
+}
+
+
+@pytest.fixture(scope="module", params=list(MODELS))
+def motion(request):
+    """The natural kinematic run's z, ż, z̈ (ż, z̈ from the formulation's own velocity and
+    acceleration equations, least norm) and the same motion in x, y, fi."""
+    model, redundant = MODELS[request.param]()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = pam2exu.run(model, analysis="kinematic", steps=STEPS, backend="natural")
+    mech = model.mechanism()
+    backend = Natural()
+    form = backend.formulation(mech)
+    t, q = np.asarray(res.t), mech.coordinates(res)
+    z = form.from_q(q)
+    pinv = np.linalg.pinv(form.terms.dense(form.terms.jacobian(z)), rcond=1e-12)
+    zd = np.einsum("nzm,nm->nz", pinv, form.terms.velocity_rhs(t))
+    zdd = np.einsum("nzm,nm->nz", pinv, form.terms.gamma(t, z, zd))
+    qd, qdd = backend.to_rates(form, mech, z, zd, zdd)
+    return dict(name=request.param, mech=mech, form=form, redundant=redundant, t=t, q=q,
+                qd=qd, qdd=qdd, z=z, zd=zd, zdd=zdd)
+
+
+def test_the_solids_mass_matrices_sum_to_the_formulation_s(motion):
+    """Σ A_bᵀ M_b A_b = Formulation.mass_matrix() (measured: ≤ 1.1e-16)."""
+    form = motion["form"]
+    bd = inverse.bodies(form)
+    M = np.einsum("bkz,bkl,blw->zw", bd.A, bd.mass, bd.A)
+    np.testing.assert_allclose(M, form.mass_matrix(), rtol=0, atol=1e-15)
+
+
+def test_the_constraint_forces_are_the_reference_point_pass_s(motion):
+    """W on x, y, fi = Q_inertia − Q_applied of the native pass (dampers included), and
+    Σ ½ ζ̇ᵀ M_b ζ̇ its kinetic energy, to 1e-12 of their largest (measured: ≤ 1.0e-14
+    and 5.9e-15)."""
+    m = motion
+    st = State(m["t"], m["q"], m["qd"])
+    inertia, kinetic = force_pass.inertia_forces(m["mech"], st, m["qdd"])
+    native = inertia - force_pass.applied_forces(m["mech"], st, damping=True).force
+    W = inverse.constraint_forces(m["form"], m["t"], m["z"], m["zd"], m["zdd"], m["q"])
+    found = inverse.on_pose(m["form"], m["z"], m["q"], W)
+    assert np.abs(native).max() > 0
+    np.testing.assert_allclose(found, native, rtol=0, atol=1e-12 * np.abs(native).max())
+    np.testing.assert_allclose(inverse.kinetic_energy(m["form"], m["zd"]), kinetic,
+                               rtol=0, atol=1e-12 * np.abs(kinetic).max())
+
+
+def test_the_multipliers_balance_the_equations_of_motion(motion):
+    """M z̈ + Φ_zᵀ μ = Q (Q from the loads alone), to 1e-12 of |Q| + |M z̈| (measured:
+    ≤ 1.1e-14, the redundant parallelogram's least-norm μ)."""
+    m, form = motion, motion["form"]
+    W = inverse.constraint_forces(form, m["t"], m["z"], m["zd"], m["zdd"], m["q"])
+    mu = inverse.multipliers(form, m["z"], W, m["redundant"])
+    bd = inverse.bodies(form)
+    Q = np.einsum("bkz,nbk->nz", bd.A, inverse.applied(form, m["t"], m["z"], m["q"], m["zd"]))
+    J = form.terms.dense(form.terms.jacobian(m["z"]))
+    inertia = m["zdd"] @ form.mass_matrix().T
+    left = inertia + np.einsum("nmz,nm->nz", J, mu)
+    scale = np.abs(Q).max() + np.abs(inertia).max()
+    np.testing.assert_allclose(left, Q, rtol=0, atol=1e-12 * scale)
+
+
+def test_an_angular_actuator_s_multiplier_is_its_reference_point_one(motion):
+    """fi2 − fi1 = f(t) is the same equation in both formulations, so its natural multiplier
+    is minus the reference-point pass's λ of its row (measured: ≤ 9.2e-15 of the largest)."""
+    m, form, mech = motion, motion["form"], motion["mech"]
+    if m["redundant"]:
+        pytest.skip("least norm differs between the formulations (other unknowns)")
+    st = State(m["t"], m["q"], m["qd"])
+    inertia, _ = force_pass.inertia_forces(mech, st, m["qdd"])
+    rhs = inertia - force_pass.applied_forces(mech, st, damping=True).force
+    lam = force_pass.multipliers(mech, st, rhs, False)
+    W = inverse.constraint_forces(form, m["t"], m["z"], m["zd"], m["zdd"], m["q"])
+    mu = inverse.multipliers(form, m["z"], W, False)
+    checked = 0
+    for el, rows in zip(mech.constraints, mech.rows):
+        if not isinstance(el, AngularActuator):
+            continue
+        row = form.labels.index(f"'{el.name}' ({el.type})")
+        scale = np.abs(lam[:, rows.start]).max()
+        np.testing.assert_allclose(mu[:, row], -lam[:, rows.start], rtol=0,
+                                   atol=1e-10 * scale)
+        checked += 1
+    assert checked
