@@ -124,9 +124,14 @@ def element_wrench(el, st: State, lam: np.ndarray, jacobian=None) -> np.ndarray:
     block = jacobian.get(s)
     if block is None:
         return np.zeros((st.n, 3))
-    wrench = np.einsum("nkj,nk->nj", block, lam)
+    return reported_wrench(el, st, np.einsum("nkj,nk->nj", block, lam))
+
+
+def reported_wrench(el, st: State, wrench: np.ndarray) -> np.ndarray:
+    """A wrench (n, 3) on the element's receiving solid, about the solid's origin, moved to
+    the element's reporting point and turned into its reporting basis."""
     point, direction = el.report_frame(st)
-    return to_basis(move_wrench(wrench, st.q[:, pose(s)][:, :2], point), direction)
+    return to_basis(move_wrench(wrench, st.q[:, pose(el.receiver)][:, :2], point), direction)
 
 
 def reported(el) -> list[int]:
@@ -141,11 +146,18 @@ def reactions(mech, st: State, lam: np.ndarray, parts=None) -> dict[str, np.ndar
     or pin_slot, the moment at a revolute…) are checked to be zero. ``parts``: the
     elements' constraint quantities when already built (``native.Equations.parts``).
     """
-    out = {}
     if parts is None:
         parts = [el.constraint(st)[0] for el in mech.constraints]
-    for el, rows, v in zip(mech.constraints, mech.rows, parts):
-        wrench = element_wrench(el, st, lam[:, rows], v.jac)
+    return checked_reactions(mech, (element_wrench(el, st, lam[:, rows], v.jac)
+                                    for el, rows, v in zip(mech.constraints, mech.rows, parts)))
+
+
+def checked_reactions(mech, wrenches) -> dict[str, np.ndarray]:
+    """The reported components of every constraint element's wrench (n, 3) in its reporting
+    frame (``wrenches`` in ``mech.constraints`` order), by column name; the components that
+    are zero by construction are checked to be zero."""
+    out = {}
+    for el, wrench in zip(mech.constraints, wrenches):
         scale = (np.max(np.abs(wrench[:, :2]), initial=0.0)
                  + np.max(np.abs(wrench[:, 2]), initial=0.0) / mech.scale())
         for k, name in enumerate(el.wrench):
@@ -276,6 +288,45 @@ def over_time(mech, t, q, redundant: bool, qd=None, qdd=None):
     return out, energies
 
 
+def over_time_given(mech, t, q, qd, given):
+    """``over_time`` of a kinetostatic run whose constraint wrenches a backend gave
+    (``Backend.reactions``: each element's wrench on its receiver about the receiver's
+    origin, and the kinetic energy): the reactions reported and checked, the force
+    elements' outputs and the energies of the power balance from the applied forces."""
+    n = len(t)
+    out: dict[str, np.ndarray] = {}
+    energies = Energies(*(np.zeros(n) for _ in range(3)))
+    for s in native.chunks(mech, n, most=CHUNK_STEPS):
+        st = State(t[s], q[s], qd[s])
+        applied = applied_forces(mech, st, damping=True)
+        energies.energy[s] = given.kinetic[s] + applied.potential
+        energies.dissipation[s] = applied.dissipation
+        energies.external[s] = np.sum(applied.external * qd[s], axis=1)
+        wrenches = [reported_wrench(el, st, given.wrenches[s, k])
+                    for k, el in enumerate(mech.constraints)]
+        if given.modes is not None:
+            wrenches = _least_reported(mech, st, wrenches, given.modes[s])
+        found = checked_reactions(mech, wrenches)
+        for name, v in {**found, **applied.outputs}.items():
+            out.setdefault(name, np.empty(n))[s] = v
+    return out, energies
+
+
+def _least_reported(mech, st: State, wrenches: list, modes: np.ndarray) -> list:
+    """The reported wrenches plus the self-stresses' combination (``modes`` (n, r,
+    constraints, 3), about the receivers' origins) that makes the reported components
+    least in sum of squares: the native pass's least norm (``multipliers``)."""
+    shown = [reported(el) for el in mech.constraints]
+    moved = [[reported_wrench(el, st, modes[:, j, k]) for k, el in enumerate(mech.constraints)]
+             for j in range(modes.shape[1])]
+    R0 = np.concatenate([w[:, keep] for w, keep in zip(wrenches, shown)], axis=1)
+    S = np.stack([np.concatenate([w[:, keep] for w, keep in zip(mode, shown)], axis=1)
+                  for mode in moved], axis=1)                              # (n, r, K)
+    c = -np.einsum("njk,nk->nj", least_norm_inverse(np.swapaxes(S, 1, 2), 1e-10), R0)
+    return [w + np.einsum("nj,njd->nd", c, np.stack([mode[k] for mode in moved], axis=1))
+            for k, w in enumerate(wrenches)]
+
+
 def _sparse_multipliers(mech, st: State, rhs: np.ndarray):
     """λ with Cqᵀ λ = rhs for all states by one sparse LU (large mechanisms); None if singular."""
     from scipy.sparse.linalg import splu
@@ -357,5 +408,6 @@ def actuator_power(mech, st: State, outputs: dict[str, np.ndarray]) -> np.ndarra
 
 
 __all__ = ["Applied", "PowerBalance", "applied_forces", "actuator_power",
-           "element_wrench", "equilibrium_residual", "gravity", "inertia_forces",
-           "multipliers", "power_balance", "reactions"]
+           "checked_reactions", "element_wrench", "equilibrium_residual", "gravity",
+           "inertia_forces", "multipliers", "over_time_given", "power_balance", "reactions",
+           "reported_wrench"]

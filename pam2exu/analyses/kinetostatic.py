@@ -17,7 +17,9 @@ def kinetostatic(job: Job):
     Contract: positions from the backend's solver, qd and qdd natively (as kinematic);
     then at every step Cqᵀ λ = Q_inertia − Q_applied is solved natively (inertia from the
     mass at G and the inertia about G; gravity, torsors, springs and dampers applied), and
-    the reactions are read from λ (``force_pass.reactions``). The power balance is checked.
+    the reactions are read from λ (``force_pass.reactions``); a backend that
+    ``gives_reactions`` gives the elements' wrenches itself from its own inverse dynamics
+    (``Backend.reactions``), reported the same way. The power balance is checked.
     """
     mob = check_mobility(job, job.mech.initial_q())
     redundant = mob.redundant > 0
@@ -29,7 +31,13 @@ def kinetostatic(job: Job):
 def inverse_dynamics(job: Job, q, qd, qdd, redundant: bool) -> dict[str, np.ndarray]:
     """Reactions, spring and actuator forces at every step, then the power balance check."""
     job.stage = "computing the reactions and actuator forces (inverse dynamics)"
-    out, e = force_pass.over_time(job.mech, job.times, q, redundant, qd, qdd)
+    given = (job.backend.reactions(job.mech, job.times, q, qd, qdd, redundant)
+             if job.backend.gives_reactions else None)
+    if given is None:
+        out, e = force_pass.over_time(job.mech, job.times, q, redundant, qd, qdd)
+    else:
+        out, e = force_pass.over_time_given(job.mech, job.times, q, qd, given)
+        job.info["reactions_from"] = f"{job.backend.label}'s inverse dynamics"
     power = force_pass.actuator_power(job.mech, State(job.times, q), out)
     check_power_balance(job, power, e.energy, e.dissipation, e.external)
     return out

@@ -76,6 +76,30 @@ class Trajectory:
     error: str | None = None
 
 
+@dataclass
+class Reactions:
+    """A backend's answer to ``Backend.reactions``.
+
+    Attributes
+    ----------
+    wrenches : numpy.ndarray
+        (n, constraints, 3): each constraint element's wrench on its receiving solid
+        (``Element.receiver``), force x, y [N] and moment [N·m] about the solid's origin,
+        in ``Mechanism.constraints`` order (as the native pass's Cqᵀ λ on that solid).
+    kinetic : numpy.ndarray
+        (n,) the kinetic energy [J] (the power balance).
+    modes : numpy.ndarray or None
+        With redundant constraints, (n, r, constraints, 3): the wrenches of r independent
+        self-stresses (constraint forces in equilibrium without any load); the analysis
+        adds the combination that makes the reported components least in norm, as its
+        native pass does. None without redundant constraints.
+    """
+
+    wrenches: np.ndarray
+    kinetic: np.ndarray
+    modes: np.ndarray | None = None
+
+
 class Integrator(Enum):
     """How a backend integrates the equations of motion (``Backend.integrator``)."""
 
@@ -131,6 +155,11 @@ class Backend(ABC):
            ``solves_variants = True``     a study solves a chunk's variants together by
                                           ``solved_variants`` and runs each variant's
                                           analysis on the backend it returns for it
+           ``gives_reactions = True``     the kinetostatic analysis asks ``reactions``
+                                          for every constraint element's wrench from the
+                                          backend's own inverse dynamics, instead of
+                                          solving Cqᵀ λ = Q_inertia − Q_applied natively
+                                          (a None answer: it does)
            =============================  =================================================
 
         5. Keep the console quiet unless ``settings.verbose`` (or ``verbose``) is > 0.
@@ -163,6 +192,8 @@ class Backend(ABC):
         stops improving here").
     solves_variants : bool
         It implements ``solved_variants`` (many variants in one pass). Default False.
+    gives_reactions : bool
+        It implements ``reactions`` (inverse dynamics in its own coordinates). Default False.
     """
 
     name: ClassVar[str]
@@ -174,6 +205,7 @@ class Backend(ABC):
     integrator: ClassVar[Integrator] = Integrator.NONE
     integrator_name: ClassVar[str] = ""
     solves_variants: ClassVar[bool] = False
+    gives_reactions: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs):
         """A subclass declares its identity, and a method for each capability it declares."""
@@ -185,7 +217,8 @@ class Backend(ABC):
         needs = {"static_equilibrium": cls.moves_free_solids,
                  "integrate": cls.integrator is Integrator.FIXED_STEP,
                  "motion": cls.integrator is Integrator.ADAPTIVE,
-                 "solved_variants": cls.solves_variants}
+                 "solved_variants": cls.solves_variants,
+                 "reactions": cls.gives_reactions}
         for method, declared in needs.items():
             if declared and vars(Backend)[method] is _own(cls, method):
                 raise TypeError(f"backend class {cls.__name__} declares what "
@@ -377,6 +410,38 @@ class Backend(ABC):
         """
         raise NotImplementedError(f"the {self.name} backend does not solve variants "
                                   "together (solves_variants is False)")
+
+    def reactions(self, mech, times: np.ndarray, q: np.ndarray, qd: np.ndarray,
+                  qdd: np.ndarray, redundant: bool = False) -> Reactions | None:
+        """Every constraint element's wrench on its receiving solid at every step, from the
+        backend's own inverse dynamics of the motion (with ``gives_reactions``): what the
+        ``kinetostatic`` analysis calls instead of its native pass.
+
+        The wrenches are the constraint forces that make the motion: with the masses,
+        gravity, the torsors, the springs and the dampers, the same as the native pass's
+        Cqᵀ λ = Q_inertia − Q_applied on each receiving solid (to round-off); where
+        constraints are redundant, one solution and the self-stresses (``Reactions.modes``),
+        of which the analysis takes the least norm over the reported components.
+
+        Parameters
+        ----------
+        mech : Mechanism
+        times : numpy.ndarray
+            (n,) the times [s].
+        q, qd, qdd : numpy.ndarray
+            (n, nq) x, y, fi of every solid and their rates, consistent with the
+            constraints (the kinematic analysis's).
+        redundant : bool
+            The constraint Jacobian is rank deficient (consistent redundant constraints).
+
+        Returns
+        -------
+        Reactions or None
+            None where the backend does not handle the model: the analysis's native pass
+            then computes the reactions.
+        """
+        raise NotImplementedError(f"the {self.name} backend has no inverse dynamics of its "
+                                  "own (gives_reactions is False)")
 
 
 def _own(cls: type, method: str):

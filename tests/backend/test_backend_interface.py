@@ -27,10 +27,10 @@ FOUR_BAR = ROOT / "examples" / "four_bar.toml"
 def test_the_registered_backends_declare_their_capabilities():
     declared = {name: b.create() for name, b in registry.BACKENDS.items()}
     assert all(isinstance(b, Backend) for b in declared.values())
-    assert {n: (declared[n].gives_rates, declared[n].moves_free_solids, declared[n].integrator)
-            for n in ("exudyn", "natural")} \
-        == {"exudyn": (False, True, Integrator.FIXED_STEP),
-            "natural": (True, True, Integrator.ADAPTIVE)}
+    assert {n: (declared[n].gives_rates, declared[n].moves_free_solids, declared[n].integrator,
+                declared[n].gives_reactions) for n in ("exudyn", "natural")} \
+        == {"exudyn": (False, True, Integrator.FIXED_STEP, False),
+            "natural": (True, True, Integrator.ADAPTIVE, True)}
     assert declared["exudyn"].integrator_name == "Exudyn's generalized-α"
 
 
@@ -44,6 +44,7 @@ def _identity(name):
     ({"integrator": Integrator.ADAPTIVE}, "motion"),
     ({"integrator": Integrator.FIXED_STEP, "integrator_name": "its rule"}, "integrate"),
     ({"integrator": Integrator.FIXED_STEP, "integrate": lambda *a, **k: None}, "integrator_name"),
+    ({"gives_reactions": True}, "reactions"),
 ])
 def test_a_capability_declared_without_its_method_is_refused(declaration, missing):
     body = {**_identity("half"), "solve_positions": Natural.solve_positions, **declaration}
@@ -58,8 +59,8 @@ def test_a_backend_without_its_identity_is_refused():
     # with everything declared, only solve_positions is needed: the defaults declare nothing
     plain = type("Plain", (Backend,), {**_identity("plain"),
                                        "solve_positions": Natural.solve_positions})()
-    assert (plain.gives_rates, plain.moves_free_solids, plain.integrator) \
-        == (False, False, Integrator.NONE)
+    assert (plain.gives_rates, plain.moves_free_solids, plain.integrator,
+            plain.gives_reactions) == (False, False, Integrator.NONE, False)
     with pytest.raises(NotImplementedError, match="plain backend has no adaptive"):
         plain.motion(None, np.zeros(2), None, None, 1e-6)
 

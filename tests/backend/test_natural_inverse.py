@@ -125,3 +125,38 @@ def test_an_angular_actuator_s_multiplier_is_its_reference_point_one(motion):
                                    atol=1e-10 * scale)
         checked += 1
     assert checked
+
+
+# ---- the kinetostatic analysis through them (backend/natural/reactions.py) -----------------
+
+def _kinetostatic(model, gives_reactions, monkeypatch):
+    with monkeypatch.context() as patch:
+        patch.setattr(Natural, "gives_reactions", gives_reactions)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return pam2exu.run(model, analysis="kinetostatic", steps=STEPS, backend="natural")
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_kinetostatic_reactions_equal_the_reference_point_pass(name, monkeypatch):
+    """The natural backend's kinetostatic run takes its reactions from natural-coordinate
+    inverse dynamics (``reactions_from``); every force column equals the reference-point
+    pass's on the same motion (that backend declaring no reactions of its own) to 1e-9 of
+    the column's largest value, or of its element's other columns where it is zero (the
+    slider-crank's guide.Mz: 8.9e-16 N·m against 0) (measured: ≤ 1.9e-13, the redundant
+    parallelogram's least norm; ≤ 6e-14 without redundancy), and the power balance is
+    checked on both."""
+    model, _ = MODELS[name]()
+    natural = _kinetostatic(model, True, monkeypatch)
+    native = _kinetostatic(model, False, monkeypatch)
+    assert natural.info["reactions_from"] == "the natural-coordinate backend's inverse dynamics"
+    assert "reactions_from" not in native.info
+    assert list(natural.columns) == list(native.columns)
+    for column in native.columns:            # a column that is zero: its element's scale
+        element = column.split(".")[0]
+        scale = max(np.abs(native[c]).max() for c in native.columns
+                    if c == column or (c.startswith(element + ".") and not native[column].any()))
+        np.testing.assert_allclose(natural[column], native[column], rtol=0,
+                                   atol=1e-9 * scale + 1e-300, err_msg=column)
+    assert natural.info["power_balance_steps"] == native.info["power_balance_steps"] > 0
+    assert natural.info["power_balance_error"] <= natural.info["power_balance_tolerance"]

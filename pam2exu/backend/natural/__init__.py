@@ -21,6 +21,7 @@ from .formulation import Coordinate, Formulation, Frame
 from .dynamics import motion
 from .loads import multipliers
 from .anchored import anchored
+from .reactions import constraint_wrenches
 from .solver import MAX_SUBSTEPS, NaturalSettings, Solver
 from .variants import Answered, Stack, solve, stackable, structure
 from .statics import Statics, pose_distance
@@ -43,6 +44,8 @@ class Natural(Backend):
     integrator = Integrator.ADAPTIVE
     #: a chunk of variants in one pass: ``solved_variants`` (``variants``)
     solves_variants = True
+    #: the kinetostatic reactions from natural-coordinate inverse dynamics: ``reactions``
+    gives_reactions = True
 
     def __init__(self, answered: "Answered | None" = None):
         self._forms: dict = {}
@@ -202,6 +205,13 @@ class Natural(Backend):
         """See ``Backend.motion``: M z̈ + Φ_zᵀ μ = Q, Φ = 0 at index 1, integrated by
         DOP853 (Radau if stiff) with projections, to the tolerance (``dynamics.motion``)."""
         return motion(self, self.formulation(mech), mech, times, q0, qd0, tolerance, verbose)
+
+    def reactions(self, mech, times, q, qd, qdd, redundant=False):
+        """See ``Backend.reactions``: M z̈ + Φ_zᵀ μ = Q with the constant mass matrix, the
+        reactions from μ and each solid's equilibrium at the shared basic points
+        (``reactions``); None in the cases that module names."""
+        return constraint_wrenches(self.formulation(mech), np.asarray(times, dtype=float), q, qd,
+                                   qdd, redundant)
 
     # ---- back to x, y, fi ---------------------------------------------------------------------
     def to_q(self, form: Formulation, mech, z: np.ndarray, start: np.ndarray) -> np.ndarray:

@@ -42,6 +42,14 @@ class Bodies:
     c: np.ndarray
     mass: np.ndarray
 
+    @property
+    def block(self) -> np.ndarray:
+        """The mass matrices as one block-diagonal (4 ns, 4 ns) (one product for all solids)."""
+        ns = len(self.mass)
+        out = np.zeros((ns, 4, ns, 4))
+        out[np.arange(ns), :, np.arange(ns), :] = self.mass
+        return out.reshape(4 * ns, 4 * ns)
+
 
 def body_mass_matrices(m, jp, a, b, d2) -> np.ndarray:
     """M_b (…, 4, 4) = [[m I, m G], [m Gᵀ, J_p / |d|² I]], G = a I + b Ω (arrays over solids)."""
@@ -81,8 +89,15 @@ def bodies(form) -> Bodies:
 
 def body_coordinates(bd: Bodies, z: np.ndarray, constant: bool = True) -> np.ndarray:
     """ζ (n, ns, 4) = A z + c per solid (``constant`` False: A ż, the rates)."""
-    out = np.einsum("bkz,nz->nbk", bd.A, z)
+    ns, _, nz = bd.A.shape
+    out = (z @ bd.A.reshape(4 * ns, nz).T).reshape(len(z), ns, 4)
     return out + bd.c if constant else out
+
+
+def on_coordinates(bd: Bodies, W: np.ndarray) -> np.ndarray:
+    """Σ_b A_bᵀ W_b (n, nz): forces on the solids' (p, v) as forces on z."""
+    ns, _, nz = bd.A.shape
+    return W.reshape(len(W), 4 * ns) @ bd.A.reshape(4 * ns, nz)
 
 
 def applied(form, t, z, q, zd) -> np.ndarray:
@@ -97,15 +112,17 @@ def applied(form, t, z, q, zd) -> np.ndarray:
 def constraint_forces(form, t, z, zd, zdd, q) -> np.ndarray:
     """W (n, ns, 4) = M_b ζ̈_b − Q_b: what the joints apply to each solid's (p, v)."""
     bd = bodies(form)
-    inertia = np.einsum("bkl,nbl->nbk", bd.mass, body_coordinates(bd, zdd, constant=False))
-    return inertia - applied(form, t, z, q, zd)
+    block = form.__dict__["_kept"].setdefault("mass_block", bd.block)
+    inertia = (body_coordinates(bd, zdd, constant=False).reshape(len(z), -1) @ block.T)
+    return inertia.reshape(len(z), -1, 4) - applied(form, t, z, q, zd)
 
 
 def kinetic_energy(form, zd) -> np.ndarray:
-    """T (n,) = Σ_b ½ ζ̇_bᵀ M_b ζ̇_b."""
+    """T (n,) = Σ_b ½ ζ̇_bᵀ M_b ζ̇_b = ½ żᵀ M ż, M = Σ A_bᵀ M_b A_b."""
     bd = bodies(form)
-    rate = body_coordinates(bd, zd, constant=False)
-    return 0.5 * np.einsum("nbk,bkl,nbl->n", rate, bd.mass, rate)
+    M = form.__dict__["_kept"].setdefault(
+        "mass_z", np.einsum("bkz,bkl,blw->zw", bd.A, bd.mass, bd.A))
+    return 0.5 * np.sum(zd * (zd @ M), axis=1)
 
 
 def on_pose(form, z, q, W) -> np.ndarray:
@@ -115,10 +132,11 @@ def on_pose(form, z, q, W) -> np.ndarray:
     return loads.on_pose()
 
 
-def multipliers(form, z, W, redundant: bool) -> np.ndarray:
-    """μ (n, m) with Φ_zᵀ μ = −Σ A_bᵀ W_b (= Q − M z̈), least norm where ``redundant``."""
-    rhs = -np.einsum("bkz,nbk->nz", bodies(form).A, W)
-    J = form.terms.dense(form.terms.jacobian(z))                    # (n, m, nz)
+def multipliers(form, z, W, redundant: bool, jacobian: np.ndarray | None = None) -> np.ndarray:
+    """μ (n, m) with Φ_zᵀ μ = −Σ A_bᵀ W_b (= Q − M z̈), least norm where ``redundant``
+    (``jacobian``: Φ_z (n, m, nz) when already evaluated)."""
+    rhs = -on_coordinates(bodies(form), W)
+    J = form.terms.dense(form.terms.jacobian(z)) if jacobian is None else jacobian
     Jt = np.swapaxes(J, 1, 2)
     if not redundant and J.shape[1] == J.shape[2]:
         return np.linalg.solve(Jt, rhs[..., None])[..., 0]
@@ -126,4 +144,4 @@ def multipliers(form, z, W, redundant: bool) -> np.ndarray:
 
 
 __all__ = ["Bodies", "applied", "bodies", "body_coordinates", "body_mass_matrices",
-           "constraint_forces", "kinetic_energy", "multipliers", "on_pose"]
+           "constraint_forces", "kinetic_energy", "multipliers", "on_coordinates", "on_pose"]
