@@ -468,8 +468,8 @@ Multibody Systems*, 1994) and solves them with pam2exu's own Newton method. This
 explains that formulation on one worked example, the four-bar of
 [`examples/four_bar.toml`](../examples/four_bar.toml): its coordinates, its equations, their
 Jacobian, the exact acceleration terms and the constant mass matrix; then how every element
-type is converted, how x, y, fi come back, the forward dynamics and the static equilibrium
-it solves (every analysis runs on this backend), and how to read `pam2exu verify`.
+type is converted, how x, y, fi come back, the forward dynamics, the static equilibrium
+and the inverse dynamics it solves (every analysis runs on this backend), and how to read `pam2exu verify`.
 
 Every table, equation and number below is generated from the code
 (`pam2exu/backend/natural/`, `Element.natural` of each element type) by
@@ -894,6 +894,46 @@ is the exact gradient of −V everywhere in z. The analysis then checks stabilit
 reduced tangent stiffness in x, y, fi, as for Exudyn, so `pam2exu verify MODEL` on an
 equilibrium model compares two independent equilibria (rule in [verify.md](verify.md))."""
 
+INVERSE = """\
+## Inverse dynamics in natural coordinates
+
+The `kinetostatic` analysis on this backend takes its reactions and actuator forces from
+the natural coordinates (`pam2exu/backend/natural/inverse.py` and `reactions.py`, what
+`Natural.reactions` answers when the analysis asks: `Backend.gives_reactions`), not from the
+reference-point pass the Exudyn backend's runs use. Each solid's base point and base vector
+are ζ_b = (p, v) = A_b z + c_b, and its kinetic energy a constant quadratic form in ζ̇_b, so
+what its joints apply to it has no velocity term:
+
+```text
+W_b = M_b ζ̈_b − Q_b,   M_b = [[m I, m G], [m Gᵀ, J_p / |d|² I]],   G = a_G I + b_G Ω
+Σ A_bᵀ M_b A_b = M                                         (the constant mass matrix above)
+M z̈ + Φ_zᵀ μ = Q   ⇔   Φ_zᵀ μ = −Σ A_bᵀ W_b                (μ of least norm if redundant)
+```
+
+(Q_b: gravity, the torsors, the spring-dampers, as in the forward dynamics.) The reactions
+follow from μ and each solid's equilibrium:
+
+- an element with equations (prismatic, pin_slot, transmission, the actuators) applies
+  −(∂Φ_el/∂ζ̂_s)ᵀ μ_el to solid s, its rows written in each solid's own frame variables
+  ζ̂_s = (p_s, v_s, fi_s): a force on p, a moment from v and fi;
+- a revolute whose two points share a basic point P has no equation: the force it applies
+  to solid s is what is left at s's own copy of P's coordinates, A_sᵀ W_s plus the forces of
+  s's rigid-body rows and of the element rows through s's frame (per-body equilibrium at
+  the shared basic point); at a ground point, which has no coordinate, it is what s's wrench
+  balance leaves; several solids at one point share it by the point's incidence;
+- a fixed link gives what its held solid's balance leaves.
+
+Where constraints are redundant, the self-stresses (μ in the null space of Φ_zᵀ, without
+load) are added in the combination that makes the reported components least in norm: the
+reference-point pass's choice, so both backends report the same reactions. Everything is an
+array over the steps, the solids' constants arrays over the solids. The forces equal the
+reference-point pass's to round-off (`tests/backend/test_natural_inverse.py`: the four-bar,
+the slider-crank, `examples/all_elements.toml` and a redundant parallelogram, every force
+column within 1e-9, measured 2e-13), so `pam2exu verify MODEL -a kinetostatic` now compares
+forces from two formulations as well. A revolute whose points could not share a basic point,
+a solid pinned to the ground at two points, or an element between ground solids alone is
+left to the reference-point pass (`res.info["reactions_from"]` says which computed them)."""
+
 VERIFY = """\
 ## Reading `pam2exu verify`
 
@@ -965,6 +1005,7 @@ def render(w: Worked | None = None) -> str:
     out += _mass_formula_section()
     out += [DYNAMICS, ""]
     out += [STATICS, ""]
+    out += [INVERSE, ""]
     out += [VERIFY, ""]
     out += [SIDE.format(m=w.mech.n_equations, nq=w.mech.nq, nz=w.form.nz), ""]
     text = "\n".join(out)
