@@ -128,11 +128,13 @@ class Plan:
         self.rows_of = {k: np.array(v) for k, v in self.rows_of.items()}
         self._pins(form, mech, index)
         self._fixed(form, mech)
-        K = form.pose_forms()[:, :form.nz]
+        K = form.pose_forms()
         angles = np.zeros((len(self.angle_cols), form.nz))
         for r, c in enumerate(self.angle_cols.values()):
             angles[r, c] = 1.0
-        self.rates = np.linalg.pinv(np.vstack([K, angles]))   # ż from the poses' rates
+        self.angle_solids = np.array(list(self.angle_cols), dtype=int)
+        self.offsets = np.r_[K[:, -1], np.zeros(len(self.angle_cols))]
+        self.rates = np.linalg.pinv(np.vstack([K[:, :-1], angles]))   # z from the poses
 
     def _pins(self, form, mech, index) -> None:
         groups: dict[int, list] = {}
@@ -180,22 +182,22 @@ def plan(form: Formulation) -> Plan:
 
 
 def natural_rates(pl: Plan, q, qd, qdd):
-    """(z, ż, z̈) of the motion q, q̇, q̈: z placed from the poses (``Formulation.from_q``),
-    its rates the least-squares solution of (x, y, cos fi, sin fi, angle coordinates)′ =
-    K ż (exact: the poses are linear in z)."""
+    """(z, ż, z̈) of the motion q, q̇, q̈: the least-squares solutions of K z = y − k,
+    K ż = ẏ, K z̈ = ÿ, y = (x, y, cos fi, sin fi) of every solid and the angle coordinates
+    (exact: they are linear in z, ``Formulation.pose_forms``)."""
     ns = len(pl.form.frames)
-    i = np.arange(ns)
+    i, angles = np.arange(ns), pl.angle_solids
     fi, w, a = q[:, ANGLES], qd[:, ANGLES], qdd[:, ANGLES]
     c, s = np.cos(fi), np.sin(fi)
-    d1, d2 = np.empty((len(q), 4 * ns)), np.empty((len(q), 4 * ns))
-    d1[:, 0::4], d1[:, 1::4] = qd[:, column(i, 0)], qd[:, column(i, 1)]
-    d1[:, 2::4], d1[:, 3::4] = -s * w, c * w
-    d2[:, 0::4], d2[:, 1::4] = qdd[:, column(i, 0)], qdd[:, column(i, 1)]
-    d2[:, 2::4], d2[:, 3::4] = -s * a - c * w * w, c * a - s * w * w
-    solids = list(pl.angle_cols)
-    d1 = np.hstack([d1, qd[:, column(np.array(solids, dtype=int), 2)]])
-    d2 = np.hstack([d2, qdd[:, column(np.array(solids, dtype=int), 2)]])
-    return pl.form.from_q(q), d1 @ pl.rates.T, d2 @ pl.rates.T
+    y = np.empty((3, len(q), 4 * ns + len(angles)))
+    for out, v in zip(y, (q, qd, qdd)):
+        out[:, 0:4 * ns:4], out[:, 1:4 * ns:4] = v[:, column(i, 0)], v[:, column(i, 1)]
+        out[:, 4 * ns:] = v[:, column(angles, 2)]
+    y[0, :, 2:4 * ns:4], y[0, :, 3:4 * ns:4] = c, s
+    y[1, :, 2:4 * ns:4], y[1, :, 3:4 * ns:4] = -s * w, c * w
+    y[2, :, 2:4 * ns:4], y[2, :, 3:4 * ns:4] = -s * a - c * w * w, c * a - s * w * w
+    y[0] -= pl.offsets
+    return tuple(inverse.times(v, pl.rates) for v in y)
 
 
 def _about_origin(p, v, force_p, force_v, moment=0.0):
@@ -265,12 +267,12 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
     on = {}                                                    # (element, solid) -> about O
     copies = np.zeros((n, ns, form.nz))                         # A_sᵀ W_s per solid
     for i in pl.moving:
-        copies[:, i] = W[:, i] @ bd.A[i]
+        copies[:, i] = np.einsum("nk,kz->nz", W[:, i], bd.A[i])
     for r, i in enumerate(pl.rigid):                           # s's rigid rows on its copy
         copies[:, i] += J[:, r] * mu[:, r, None]
     for k, rows in pl.rows_of.items():
         el = mech.constraints[k]
-        g = np.matmul(mu[:, None, pl.first + rows], Jh[:, rows])[:, 0]
+        g = np.einsum("nr,nrj->nj", mu[:, pl.first + rows], Jh[:, rows])
         total = np.zeros((n, 3))
         for i in el.solids:
             if i in form.grounds or (k, i) in on:
@@ -281,7 +283,7 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
             on[(k, i)] = w = _about_origin(zeta[:, i, :2], zeta[:, i, 2:], -g[:, j:j + 2],
                                            -g[:, j + 2:j + 4], moment)
             total += w
-            copies[:, i] += g[:, j:j + 4] @ bd.A[i]
+            copies[:, i] += np.einsum("nk,kz->nz", g[:, j:j + 4], bd.A[i])
             if f.angle is not None:
                 copies[:, i, pl.angle_cols[i]] += g[:, f.angle]
         wrench[:, k] = -total if el.receiver in form.grounds else on[(k, el.receiver)]
@@ -305,7 +307,7 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
         else:
             point = np.broadcast_to(pin.constant, (n, 2))
             force = np.stack([left[:, i, :2] for i in pin.solids], axis=1)
-        revolute = np.matmul(pin.inverse, force)                 # on each receiver
+        revolute = np.einsum("es,nsd->ned", pin.inverse, force)  # on each receiver
         for e, k in enumerate(pin.revolutes):
             el = mech.constraints[k]
             w = np.zeros((n, 3))
