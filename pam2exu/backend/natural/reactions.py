@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy import sparse
 
 from ...kinematics import ANGLES, column, cross, perp, pose
 from ..base import Reactions
@@ -38,8 +39,10 @@ from .forms import Expr, Vec
 from .formulation import Formulation
 from .terms import Terms
 
-#: steps per chunk (arrays that stay in the cache; the results do not depend on it)
+#: steps per chunk at most (arrays that stay in the cache; the results do not depend on it)
 CHUNK_STEPS = 4096
+#: bytes of one chunk's largest Jacobian at most (large mechanisms: fewer steps per chunk)
+CHUNK_BYTES = 1 << 24
 
 
 class _FrameEquations(Formulation):
@@ -134,7 +137,8 @@ class Plan:
             angles[r, c] = 1.0
         self.angle_solids = np.array(list(self.angle_cols), dtype=int)
         self.offsets = np.r_[K[:, -1], np.zeros(len(self.angle_cols))]
-        self.rates = np.linalg.pinv(np.vstack([K[:, :-1], angles]))   # z from the poses
+        Q, R = np.linalg.qr(np.vstack([K[:, :-1], angles]))       # full column rank
+        self.rates = sparse.csr_matrix(np.linalg.solve(R, Q.T))     # its left inverse
 
     def _pins(self, form, mech, index) -> None:
         groups: dict[int, list] = {}
@@ -223,8 +227,10 @@ def constraint_wrenches(form: Formulation, t, q, qd, qdd,
     n, nc = len(t), len(pl.mech.constraints)
     out = Reactions(np.empty((n, nc, 3)), np.empty(n),
                     np.empty((n, extra, nc, 3)) if redundant else None)
-    for a in range(0, n, CHUNK_STEPS):
-        s = slice(a, min(n, a + CHUNK_STEPS))
+    size = max(1, min(CHUNK_STEPS, CHUNK_BYTES // (8 * max(1, form.m * form.nz,
+                                                          pl.terms.m * pl.terms.nz))))
+    for a in range(0, n, size):
+        s = slice(a, min(n, a + size))
         out.wrenches[s], out.kinetic[s], modes = _chunk(pl, t[s], q[s], qd[s], qdd[s], extra)
         if redundant:
             out.modes[s] = modes
