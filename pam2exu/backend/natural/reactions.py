@@ -35,7 +35,7 @@ from scipy import sparse
 from ...kinematics import ANGLES, column, cross, perp, pose
 from ..base import Reactions
 from . import inverse
-from .forms import Expr, Vec
+from .forms import ONE, Expr, Vec
 from .formulation import Formulation
 from .terms import Terms
 
@@ -152,7 +152,7 @@ class Plan:
             solids = sorted({s for el in els for s in el.solids if s not in form.grounds})
             cols = None
             if not vec.x.is_constant:
-                cols = np.array([next(iter(e.linear().keys() - {-1})) for e in (vec.x, vec.y)])
+                cols = np.array([next(iter(e.linear().keys() - {ONE})) for e in (vec.x, vec.y)])
             D = np.zeros((len(solids), len(els)))      # the force on each solid, per revolute
             for k, el in enumerate(els):
                 for r, s in enumerate(solids):
@@ -160,7 +160,7 @@ class Plan:
                         D[r, k] = 1.0 if s == el.receiver else -1.0
             constant = None
             if cols is None:
-                constant = np.array([vec.x.linear().get(-1, 0.0), vec.y.linear().get(-1, 0.0)])
+                constant = np.array([vec.x.linear().get(ONE, 0.0), vec.y.linear().get(ONE, 0.0)])
                 for s in solids:
                     grounded[s] = grounded.get(s, 0) + 1
             self.pins.append(_Pin(cols, constant, solids, [index[el] for el in els],
