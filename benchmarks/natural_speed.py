@@ -157,7 +157,7 @@ WHAT_CHANGED = [
     "reference-point Jacobian is built and no 9 × 9 system solved per step; the constant "
     "products are sparse (single-threaded: a threaded BLAS product of this size is a "
     "hundred times slower on a loaded machine). The force columns are the reference-point "
-    "pass's to 2e-13.",
+    "pass's to 1e-13.",
     "",
     "What is left: beside the backend, every run also pays the analyses' own checks (the "
     "mobility's rank, the condition numbers' SVDs, the residual check), the same on both "

@@ -928,8 +928,8 @@ load) are added in the combination that makes the reported components least in n
 reference-point pass's choice, so both backends report the same reactions. Everything is an
 array over the steps, the solids' constants arrays over the solids. The forces equal the
 reference-point pass's to round-off (`tests/backend/test_natural_inverse.py`: the four-bar,
-the slider-crank, `examples/all_elements.toml` and a redundant parallelogram, every force
-column within 1e-9, measured 2e-13), so `pam2exu verify MODEL -a kinetostatic` now compares
+the slider-crank, `examples/all_elements.toml`, a redundant parallelogram and a six-bar,
+every force column within 1e-9, measured 7e-14), so `pam2exu verify MODEL -a kinetostatic` now compares
 forces from two formulations as well. A revolute whose points could not share a basic point,
 a solid pinned to the ground at two points, or an element between ground solids alone is
 left to the reference-point pass (`res.info["reactions_from"]` says which computed them)."""

@@ -19,11 +19,14 @@ constraint element's wrench on its receiving solid:
 - a fixed link: the held solid's balance, W of its loads minus every element's wrench on it
   (an element's wrench on a ground solid is minus the sum on its moving solids).
 
-Not handled (``None``: the analysis's reference-point pass runs): redundant constraints
-(the reference-point pass's least norm is over the reported components), a revolute whose
-points could not share a basic point (two equations on basic points, not on frames), a
-solid pinned to the ground at two points, an element between ground solids only, two
-fixed links on one solid.
+Redundant constraints: μ of least norm, and the wrenches of the self-stresses (μ in the
+null space of Φ_zᵀ without load), of which the analysis adds the combination that makes
+the reported components least in norm, as its reference-point pass does.
+
+Not handled (``None``: the analysis's reference-point pass runs): every solid held (no
+coordinate), a revolute whose points could not share a basic point (two equations on basic
+points, not on frames), a solid pinned to the ground at two points, an element between
+ground solids only, two fixed links on one solid.
 """
 from __future__ import annotations
 
@@ -118,7 +121,8 @@ class Plan:
         self.frame_eq = eq = _FrameEquations(form)
         self.terms = Terms(eq.nz, [r[1:] for r in eq._rows])
         self.first = form.m - len(eq._rows)            # the element rows' first row
-        self.ok = not eq.unshared and form.labels[self.first:] == [r[0] for r in eq._rows]
+        self.ok = (form.nz > 0 and not eq.unshared       # nz = 0: every solid held
+                   and form.labels[self.first:] == [r[0] for r in eq._rows])
         self.rigid = np.array(_rigid_owners(form), dtype=int)
         self.ok &= len(self.rigid) == self.first
         self.moving = [i for i in range(len(form.frames)) if i not in form.grounds]
