@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .complex_step import as_array
+from .complex_step import as_array, number_type
 
 
 # ---- the layout of q: (x, y, fi) of each solid in order -----------------------------------
@@ -226,10 +226,11 @@ class PointSet:
 
     @classmethod
     def of(cls, asked: list[tuple]) -> "PointSet":
+        locals_ = [as_array(a[1]) for a in asked]      # complex at p + ih (complex step)
         return cls(np.array([a[0] for a in asked], dtype=int),
-                   np.array([a[1] for a in asked], dtype=float).reshape(-1, 2),
+                   np.array(locals_, dtype=number_type(*locals_)).reshape(-1, 2),
                    np.array([a[2] for a in asked], dtype=bool),
-                   [(a[0], np.asarray(a[1], dtype=float).tobytes(), a[2]) for a in asked])
+                   [(a[0], local.tobytes(), a[2]) for a, local in zip(asked, locals_)])
 
 
 class State:
