@@ -548,15 +548,20 @@ def plot_dynamic(path, measured):
     plt.close(fig)
 
 
-def replace_section(page: Path, lines: list[str], begin: str = BEGIN, end: str = END) -> None:
+def replace_section(page: Path, lines: list[str], begin: str = BEGIN, end: str = END,
+                    before: str | None = None) -> None:
     """Put ``lines`` (begin … end) in place of the page's section between those markers
-    (default section 8's), or at its end."""
+    (default section 8's); a page without it gets it before the line ``before`` if it has
+    that line, else at its end."""
     text = page.read_text(encoding="utf-8") if page.exists() else ""
     block = "\n".join(lines)
     if begin in text and end in text:
         head, rest = text.split(begin, 1)
         _, tail = rest.split(end, 1)
         text = head + block + tail
+    elif before is not None and f"\n{before}\n" in text:
+        head, tail = text.split(f"\n{before}\n", 1)
+        text = f"{head}\n{block}\n\n{before}\n{tail}"
     else:
         text = text.rstrip("\n") + ("\n\n" if text else "") + block + "\n"
     page.write_text(text, encoding="utf-8")
