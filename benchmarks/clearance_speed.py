@@ -42,15 +42,16 @@ CASES = (("locomotive clearance, 400 steps / its kinematic run",
           None, 3.0))
 
 
-def ratio(path: str, steps: int | None) -> tuple[float, float]:
-    """(best clearance [s], best kinematic [s]) of the model, in alternation."""
+def ratio(path: str, steps: int | None, repeats: int = REPEATS) -> tuple[float, float]:
+    """(best clearance [s], best kinematic [s]) of the model, in alternation, ``repeats``
+    runs of each."""
     model = pam2exu.load(ROOT / path)
     kw = {} if steps is None else {"steps": steps}
     best = {"clearance": float("inf"), "kinematic": float("inf")}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         pam2exu.run(model, analysis="clearance", **kw)            # imports, caches
-        for _ in range(REPEATS):
+        for _ in range(repeats):
             for analysis in best:
                 begin = time.perf_counter()
                 pam2exu.run(model, analysis=analysis, **kw)

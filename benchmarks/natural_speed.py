@@ -65,16 +65,23 @@ def timed(model, analysis, steps, backend) -> float:
         return time.perf_counter() - start
 
 
+def paired(model, analysis, steps, repeats) -> dict:
+    """{backend: best wall seconds} of the natural and Exudyn backends' runs, in alternation
+    with their order swapped every repeat, after a warm-up run of each."""
+    best = {"natural": float("inf"), "exudyn": float("inf")}
+    timed(model, analysis, steps, "natural")            # warm-up (imports, caches)
+    timed(model, analysis, steps, "exudyn")
+    for r in range(repeats):
+        for backend in (("natural", "exudyn") if r % 2 else ("exudyn", "natural")):
+            best[backend] = min(best[backend], timed(model, analysis, steps, backend))
+    return best
+
+
 def measure(quick: bool = False) -> dict:
     """Best wall times of every configuration, with the load averages around them."""
     out = {"load_before": os.getloadavg(), "ratios": [], "per_step": []}
     for label, make, analysis, steps, repeats, few, target in RATIOS:
-        model, best = make(), {"natural": float("inf"), "exudyn": float("inf")}
-        timed(model, analysis, steps, "natural")            # warm-up (imports, caches)
-        timed(model, analysis, steps, "exudyn")
-        for r in range(few if quick else repeats):
-            for backend in (("natural", "exudyn") if r % 2 else ("exudyn", "natural")):
-                best[backend] = min(best[backend], timed(model, analysis, steps, backend))
+        best = paired(make(), analysis, steps, few if quick else repeats)
         out["ratios"].append((label, best["natural"], best["exudyn"], target))
         log(f"  {label}: natural {best['natural'] * 1e3:.1f} ms, "
             f"Exudyn {best['exudyn'] * 1e3:.1f} ms")

@@ -99,12 +99,18 @@ def predictor_call_seconds(model, calls=20_000, repeats=5):
     return best
 
 
+def slow_four_bar(slow_steps):
+    """(the four-bar turning at 10 rad/s, t_end): 0.0031 rad per step over ``slow_steps``
+    steps (110,000 steps over 34.6 s)."""
+    slow = pam2exu.load(ROOT / "examples" / "four_bar.toml")
+    slow["motor"].C = [0.0, 10.0, 0.0, 0.0]
+    return slow, 34.6 * slow_steps / 110_000
+
+
 def measure(rounds, steps, slow_steps):
     """{config: [(seconds, parts predicted, parts, iterations per step), one per round]}."""
     model = pam2exu.load(ROOT / "examples" / "four_bar.toml")
-    slow = pam2exu.load(ROOT / "examples" / "four_bar.toml")
-    slow["motor"].C = [0.0, 10.0, 0.0, 0.0]
-    slow_t_end = 34.6 * slow_steps / 110_000       # 10 rad/s: 0.0031 rad per step
+    slow, slow_t_end = slow_four_bar(slow_steps)
     jobs = {"plain": lambda: plain_exudyn_four_bar(steps, 1e-13, "symbolic")[1]}
     cpu = {key: [] for key in ("plain", *(f"{c} {k}" for c in ("fast", "slow")
                                            for k in SETTINGS))}

@@ -50,7 +50,9 @@ cases.py (the mechanisms and their references), plain_exudyn.py (the hand-writte
 four-bar), measure.py (grids, timing, errors of one configuration), sections.py (the
 sections 1–5 above), backends.py (section 6), clearance.py (section 7), dynamics.py
 (section 8), studies.py (section 9). Reporting: report.py (docs/performance.md),
-report_backends.py (its section 6), plot.py (docs/img/work_precision.png). The file puts the repository root on ``sys.path`` so that
+report_backends.py (its section 6), plot.py (docs/img/work_precision.png); the sections
+other scripts write alone (targets.py, clearance_speed.py, natural_speed.py, predictor.py)
+stay on the page as they were (page.py). The file puts the repository root on ``sys.path`` so that
 ``benchmarks`` and ``references`` import from a clone (``python -m benchmarks.speed_vs_error``
 from the root does the same).
 """
