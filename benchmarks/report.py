@@ -92,8 +92,9 @@ def write_report(out_dir, info, plan, quick, grid, hard, chain_rows, plain_rows,
           "(the machine, the targets below, sections 1 to 9) comes from that run, except in "
           "a section that says it was rewritten alone by a script of its own (each such "
           "section gives the date, commit and load averages of its own run; a full "
-          "regeneration keeps them as they are). Timings are the best of {plan.repeats} repeats ({plan.big_repeats} for "
-          f"runs of 100,000 steps; section 2: {plan.compare_repeats}; chain: "
+          "regeneration keeps them as they are). "
+          f"Timings are the best of {plan.repeats} repeats ({plan.big_repeats} for runs of "
+          f"100,000 steps; section 2: {plan.compare_repeats}; chain: "
           f"{plan.repeats} up to N = 8, 2 for N = 16, 1 above), errors the largest relative "
           "error against closed-form or hand-written Newton–Euler references (never against "
           "pam2exu itself).")

@@ -59,6 +59,7 @@ from the root does the same).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 import time
@@ -145,6 +146,8 @@ def main(argv=None):
     dynamics = section("8. dynamic: work against precision", measure_dynamics, plan)
     studies = section("9. studies: variants per second", measure_studies, plan)
     elapsed = time.perf_counter() - start
+    info["load averages at the end (1, 5, 15 min)"] = ", ".join(f"{x:.2f}"
+                                                               for x in os.getloadavg())
     out_dir.mkdir(parents=True, exist_ok=True)
     plot(out_dir / "img" / "work_precision.png", grid, chain_rows, side)
     plot_dynamic(out_dir / "img" / "dynamic_work_precision.png", dynamics)

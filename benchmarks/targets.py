@@ -76,6 +76,10 @@ class Sizes:
 
 
 FULL = Sizes()
+SIZE_LABELS = {"long_steps": "the four-bar's long runs, steps", "slow_steps": "steps at 0.003 "
+               "rad per step", "variants": "the study's variants", "study_steps": "each "
+               "variant's steps", "passes": "passes", "long_repeats": "rounds of the long runs",
+               "clearance_repeats": "repeats of each clearance run"}
 QUICK = Sizes(passes=1, clearance_repeats=1, short_quick=True, long_steps=5000,
               long_repeats=1, slow_steps=5500, variants=6, study_steps=10, quick=True)
 
@@ -297,9 +301,8 @@ def section(m: Measured) -> list[str]:
             "; ".join(f"pass {i + 1}: {f.ratio:.2f}× = {f.detail}"
                       for i, f in enumerate(figures)) or "–",
             " / ".join(dict.fromkeys(f.beside for f in figures)) or "–"]) + " |")
-    reduced = [f"{name} {getattr(s, name):,} (the issue: {getattr(FULL, name):,})"
-               for name in ("long_steps", "slow_steps", "variants", "study_steps", "passes")
-               if getattr(s, name) != getattr(FULL, name)]
+    reduced = [f"{label} {getattr(s, name):,} (full size: {getattr(FULL, name):,})"
+               for name, label in SIZE_LABELS.items() if getattr(s, name) != getattr(FULL, name)]
     lines = [BEGIN, "## Targets of issue 25", ""]
     if s.quick:
         lines += ["**`--quick` smoke run: tiny sizes, numbers not representative.**", ""]
