@@ -15,11 +15,13 @@ One row per row of the issue's table, each ratio's two sides timed in this run, 
 - the natural backend's kinetostatic four-bar per step / the plain Exudyn script's positions
   per step (``plain_exudyn.plain_exudyn_four_bar``, symbolic driver), 100,000 steps, with the
   Exudyn backend's kinetostatic run beside, the three in rotation;
-- the four-bar study (``studies.STUDY``: 2,000 variants × 100 steps, kinetostatic) through the
-  studies API (``studies.run_on``: ``pam2exu.studies``' ``study`` on the executor the command
-  line would open, in-process and 2 worker processes), its time per variant-step / the plain
-  script's positions per step (timed just before and after it), and 1 worker / 2 workers;
-  pylinkage's ``analyze_tolerance`` beside it where pylinkage imports (``studies.pylinkage_rows``);
+- the issue's study as shipped (``STUDY_FILE``: the four-bar's kinetostatic tolerance study,
+  2,000 variants × 100 steps, natural backend, variants in one pass) through the studies API
+  (``studies.run_on``: ``pam2exu.studies``' ``study`` on the executor the command line would
+  open, in-process and 2 worker processes), its time per variant-step / the plain script's
+  positions per step (timed just before and after it), and 1 worker / 2 workers; beside it the
+  same study on the Exudyn backend (in-process) and pylinkage's ``analyze_tolerance`` where
+  pylinkage imports (``studies.pylinkage_rows``);
 - the Exudyn backend's positions (``predictor.pam_seconds``, the predictor as the run decides)
   / the plain script, and the four-bar at 0.003 rad per step (``predictor.slow_four_bar``),
   default / predictor never: in rounds, each side once per round in alternation.
@@ -50,12 +52,16 @@ from benchmarks import clearance_speed, natural_speed, predictor, studies  # noq
 from benchmarks.dynamics import replace_section  # noqa: E402
 from benchmarks.measure import ROOT, log, machine  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
+from pam2exu.studies import load_study  # noqa: E402
 
 BEGIN = ("<!-- targets of issue 25: written by benchmarks/targets.py (python "
          "benchmarks/targets.py rewrites it alone) -->")
 END = "<!-- end of targets of issue 25 -->"
 #: a page without the section gets it before this line
 BEFORE = "## 1. Work against precision: four-bar and slider-crank"
+#: the issue's study, as shipped: the four-bar's kinetostatic tolerance study, 2,000 variants
+#: × 100 steps, on the natural backend (variants in one pass)
+STUDY_FILE = ROOT / "examples" / "studies" / "four_bar_tolerance.toml"
 TOLERANCE = 1e-13                       # the plain script's Newton tolerance (pam2exu's default)
 VERDICTS = ("met", "not met", "met in", "not measured")
 
@@ -186,9 +192,14 @@ def natural_per_step_rows(s: Sizes, _m: Measured):
                  f"{us['exudyn'] / us['plain']:.2f}× the plain script")
 
 
+def the_study(s: Sizes):
+    """The issue's study as shipped (``STUDY_FILE``), at this run's size."""
+    return replace(load_study(STUDY_FILE), samples=s.variants, steps=s.study_steps)
+
+
 def study_rows(s: Sizes, m: Measured):
     studies.workers_see_this_clone()
-    study = studies.the_study(s.variants, s.study_steps)
+    study = the_study(s)
     plain = plain_seconds(s.long_steps)
     second = len(m.loads) % 2 == 1              # every other pass: 2 workers first
     runs = [("in-process", 1), ("2 worker processes", 2)]
@@ -196,20 +207,26 @@ def study_rows(s: Sizes, m: Measured):
     for label, workers in (reversed(runs) if second else runs):
         row, out = studies.run_on(label, workers, None, study, table)
         done[workers], table = row, table if table is not None else out
+    exudyn, _ = studies.run_on("in-process", 1, None, replace(study, backend="exudyn"))
     plain = min(plain, plain_seconds(s.long_steps))
     plain_us = 1e6 * plain / s.long_steps
     one, two = done[1], done[2]
     pylinkage, m.pylinkage_note = studies.pylinkage_rows(s.variants, [s.study_steps])
     p = pylinkage[0]
-    beside = (f"pylinkage {p.version} `analyze_tolerance`, {p.samples:,} samples × "
-              f"{p.steps} steps: {p.us_per_sample_step:.1f} µs per sample-step, "
-              f"{p.us_per_sample_step / plain_us:.2f}× the plain script" if p.version else
-              "pylinkage: not installed in this interpreter, not measured")
+    beside = (f"the same study on the Exudyn backend (each variant its own run), one worker: "
+              + (f"failed: {exudyn.failure}" if exudyn.failure else
+                 f"{exudyn.us_per_variant_step:.0f} µs per variant-step, "
+                 f"{exudyn.us_per_variant_step / plain_us:.2f}× the plain script") + "; "
+              + (f"pylinkage {p.version} `analyze_tolerance`, {p.samples:,} samples × "
+                 f"{p.steps} steps: {p.us_per_sample_step:.1f} µs per sample-step, "
+                 f"{p.us_per_sample_step / plain_us:.2f}× the plain script" if p.version else
+                 "pylinkage: not installed in this interpreter, not measured"))
     if one.failure:
         yield Figure("study", float("nan"), f"failed: {one.failure}", beside)
     else:
         yield Figure("study", one.us_per_variant_step / plain_us,
-                     f"{one.us_per_variant_step:.0f} µs per variant-step ({one.seconds:.1f} s "
+                     f"{study.backend} backend, batched = {str(study.batched).lower()}: "
+                     f"{one.us_per_variant_step:.1f} µs per variant-step ({one.seconds:.1f} s "
                      f"in all) / plain {plain_us:.1f} µs/step ({s.long_steps:,} steps)", beside)
     if one.failure or two.failure:
         yield Figure("workers", float("nan"), f"failed: {one.failure or two.failure}")
@@ -325,9 +342,9 @@ def section(m: Measured) -> list[str]:
               "|---|---|---|---|---|---|", *rows, "",
               "*From*: the figures of each pass (the Exudyn backend is pam2exu's default; "
               "*plain*: the plain, hand-written Exudyn script of section 2, symbolic driver, "
-              f"positions only). The study runs through the studies API at its defaults (the "
-              "engine a user's `pam2exu.study` runs), so its rows measure whatever engine "
-              f"that is at this commit. pylinkage: {m.pylinkage_note or 'not run'}.",
+              f"positions only). The study is `examples/studies/four_bar_tolerance.toml` run "
+              "through the studies API as a user's `pam2exu.study` runs it, so its rows "
+              f"measure the engine of this commit. pylinkage: {m.pylinkage_note or 'not run'}.",
               END]
     return lines
 
