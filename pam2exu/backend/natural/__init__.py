@@ -47,7 +47,7 @@ class Natural(Backend):
     #: the kinetostatic reactions from natural-coordinate inverse dynamics: ``reactions``
     gives_reactions = True
 
-    def __init__(self, answered: "Answered | None" = None):
+    def __init__(self, answered: Answered | None = None):
         self._forms: dict = {}
         #: a run solved beforehand with other variants (``variants.Answered``): the positions
         #: it asks for exactly are read from it, not solved again
