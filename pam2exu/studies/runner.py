@@ -75,8 +75,7 @@ def run_variant(payload: dict, values: np.ndarray, made=None, solved=None):
         warnings.simplefilter("always")
         try:
             if model is None:
-                model = varied(payload["model_text"], dict(zip(payload["names"], values)),
-                               payload["source"], as_made=payload.get("as_made", False))
+                model = variant_model(payload, values)
             subject, backend = solved if solved is not None else (model,
                                                                   payload.get("backend"))
             res = run(subject, payload["analysis"], t_end=payload["t_end"],
@@ -91,14 +90,19 @@ def run_variant(payload: dict, values: np.ndarray, made=None, solved=None):
             return None, error_text(exc), warned(early + caught), None
 
 
+def variant_model(payload: dict, values: np.ndarray):
+    """The variant's model: the payload's model text with its values (``varied``)."""
+    return varied(payload["model_text"], dict(zip(payload["names"], values)),
+                  payload["source"], as_made=payload.get("as_made", False))
+
+
 def made_variant(payload: dict, values: np.ndarray):
     """(the variant's model, the warnings making it gave), or (None, []) when it cannot be
     made (its ``run_variant`` then makes it again and reports why)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            return varied(payload["model_text"], dict(zip(payload["names"], values)),
-                          payload["source"], as_made=payload.get("as_made", False)), caught
+            return variant_model(payload, values), caught
         except Exception:                             # noqa: BLE001 (its run reports it)
             return None, []
 
