@@ -49,6 +49,23 @@ def _jacobian(mech, t: float, q: np.ndarray):
     return eq.residual[0], eq.jacobian[0], eq.c_t[0]
 
 
+def _stencil(mech, q: np.ndarray, t: float, h: float):
+    """The equations at (q, t), then at q ± h eᵢ for every coordinate i, then at t ± h: the
+    states ``_central`` differences."""
+    nq = len(q)
+    ts = np.concatenate([[t], np.full(2 * nq, t), [t + h, t - h]])
+    qs = np.repeat(q[None], 2 * nq + 3, axis=0)
+    qs[1:nq + 1] += h * np.eye(nq)
+    qs[nq + 1:2 * nq + 1] -= h * np.eye(nq)
+    return equations(mech, State(ts, qs))
+
+
+def _central(f: np.ndarray, nq: int, h: float):
+    """(∂f/∂q, ∂f/∂t) = ((f(q + h eᵢ) − f(q − h eᵢ)) / 2h, (f(t + h) − f(t − h)) / 2h) from f
+    at the states of ``_stencil`` (first axis); ∂f/∂q with q along its last axis."""
+    return ((f[1:nq + 1] - f[nq + 1:2 * nq + 1]) / (2 * h)).T, (f[-2] - f[-1]) / (2 * h)
+
+
 def null_motion(jac: np.ndarray) -> np.ndarray:
     """The unit right singular vector of Cq's smallest singular value: v with Cq v ≈ 0."""
     return np.linalg.svd(jac)[2][-1]
@@ -64,15 +81,9 @@ def fold(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | None:
     h = STEP * scale
     for _ in range(ITERATIONS):
         q, t, v = x[:nq], x[nq], x[nq + 1:]
-        ts = np.concatenate([[t], np.full(2 * nq, t), [t + h, t - h]])
-        qs = np.repeat(q[None], 2 * nq + 3, axis=0)
-        qs[1:nq + 1] += h * np.eye(nq)
-        qs[nq + 1:2 * nq + 1] -= h * np.eye(nq)
-        eq = equations(mech, State(ts, qs))
+        eq = _stencil(mech, q, t, h)
         C, J, Ct = eq.residual[0], eq.jacobian[0], eq.c_t[0]
-        Jv = eq.jacobian @ v                                   # (2 nq + 3, m)
-        d_q = ((Jv[1:nq + 1] - Jv[nq + 1:2 * nq + 1]) / (2 * h)).T
-        d_t = (Jv[-2] - Jv[-1]) / (2 * h)
+        d_q, d_t = _central(eq.jacobian @ v, nq, h)            # of Cq v
         m = len(C)
         F = np.concatenate([C, J @ v, [v0 @ v - 1.0]])
         A = np.zeros((2 * m + 1, 2 * nq + 1))
@@ -100,22 +111,16 @@ def branch_point(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | No
     h = STEP * scale
     for _ in range(ITERATIONS):
         q, t, w = x[:nq], x[nq], x[nq + 1:]
-        ts = np.concatenate([[t], np.full(2 * nq, t), [t + h, t - h]])
-        qs = np.repeat(q[None], 2 * nq + 3, axis=0)
-        qs[1:nq + 1] += h * np.eye(nq)
-        qs[nq + 1:2 * nq + 1] -= h * np.eye(nq)
-        eq = equations(mech, State(ts, qs))
+        eq = _stencil(mech, q, t, h)
         C, J, Ct = eq.residual[0], eq.jacobian[0], eq.c_t[0]
         Jw = np.einsum("nmq,m->nq", eq.jacobian, w)           # Cqᵀ w at each state
         Ctw = eq.c_t @ w
         F = np.concatenate([C, J.T @ w, [Ct @ w, w0 @ w - 1.0]])
         A = np.zeros((m + nq + 2, nq + 1 + m))
         A[:m, :nq], A[:m, nq] = J, Ct
-        A[m:m + nq, :nq] = ((Jw[1:nq + 1] - Jw[nq + 1:2 * nq + 1]) / (2 * h)).T
-        A[m:m + nq, nq] = (Jw[-2] - Jw[-1]) / (2 * h)
+        A[m:m + nq, :nq], A[m:m + nq, nq] = _central(Jw, nq, h)
         A[m:m + nq, nq + 1:] = J.T
-        A[m + nq, :nq] = (Ctw[1:nq + 1] - Ctw[nq + 1:2 * nq + 1]) / (2 * h)
-        A[m + nq, nq] = (Ctw[-2] - Ctw[-1]) / (2 * h)
+        A[m + nq, :nq], A[m + nq, nq] = _central(Ctw, nq, h)
         A[m + nq, nq + 1:] = Ct
         A[-1, nq + 1:] = w0
         step = np.linalg.lstsq(A, -F, rcond=None)[0]
