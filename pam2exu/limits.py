@@ -37,6 +37,8 @@ MEMORY = 4 * 2**30
 
 def is_number(v) -> bool:
     """A finite real number (not a bool), one a float can hold (not an integer of 400 digits)."""
+    if type(v) is float:                 # the usual case, without the ABC's check
+        return math.isfinite(v)
     if not isinstance(v, numbers.Real) or isinstance(v, bool):
         return False
     try:

@@ -10,6 +10,7 @@ columns or the solid or element before the dot. ``compare``, ``read_csv``, ``plo
 from __future__ import annotations
 
 import fnmatch
+import functools
 
 from ..errors import ModelError, Problem, closest
 from ..limits import one_form
@@ -143,6 +144,17 @@ def select_columns(columns: list[str], patterns) -> list[str]:
         return list(columns)
     if isinstance(patterns, str):
         patterns = [patterns]
+    chosen, problems = _chosen(tuple(columns), tuple(patterns))
+    if problems:
+        raise ModelError(list(problems))
+    return list(chosen)
+
+
+@functools.lru_cache(maxsize=256)
+def _chosen(columns: tuple[str, ...], patterns: tuple[str, ...]):
+    """(the columns chosen, in order; the problems of patterns that match none): what
+    ``select_columns`` decides, once per columns and patterns (a study's variants ask the
+    same question thousands of times)."""
     chosen, problems = set(), []
     for p in map(spelled, patterns):
         hits = [c for c in columns if selects(_pattern(p), c)]
@@ -150,6 +162,4 @@ def select_columns(columns: list[str], patterns) -> list[str]:
             problems.append(Problem("outputs", f"'{p}' matches no variable of this analysis"
                                                f"{closest(p, columns)}"))
         chosen.update(hits)
-    if problems:
-        raise ModelError(problems)
-    return [c for c in columns if c in chosen]
+    return tuple(c for c in columns if c in chosen), tuple(problems)
