@@ -192,6 +192,9 @@ class Scope:
         i, solid, item = self._split(text)
         if item is None:
             return i, solid, None, None
+        items = solid.points if kind == "point" else solid.lines
+        if isinstance(items, dict) and item in items:      # the usual case: found
+            return i, solid, item, items[item]
         tables = {"point": _table(solid.points), "line": _table(solid.lines)}
         other = "line" if kind == "point" else "point"
         if item not in tables[kind]:
