@@ -75,6 +75,79 @@ def test_predictor_brings_newton_to_one_iteration_per_step(four_bar):
     np.testing.assert_allclose(runs[True][0], runs[False][0], rtol=0, atol=1e-12)
 
 
+def test_a_run_takes_one_jacobian_per_step(four_bar):
+    """Exudyn's own counters: by default a run's steps are solved by modified Newton, one
+    Jacobian each (full Newton: one per iteration, 3 per step at 1,000 steps without the
+    predictor), at the same configurations to the tolerance (1e-13 × 0.4 m; 1e-12 checked)
+    and the crank at its law 2π t."""
+    runs = {}
+    for modified in (True, False):
+        ex = ExudynSystem(four_bar.mech)
+        q, solved = ex.solve_positions(four_bar.times, SolveSettings(
+            predictor=False, modified_newton=modified))
+        assert solved == len(four_bar.times)
+        runs[modified] = q, ex.mbs.sys["staticSolver"].it.newtonJacobiCount / solved
+    assert runs[True][1] <= 1.01 and runs[False][1] >= 2.9, runs
+    assert SolveSettings().modified_newton
+    np.testing.assert_allclose(runs[True][0], runs[False][0], rtol=0, atol=1e-12)
+    crank = [s.name for s in four_bar.mech.solids].index("crank")
+    np.testing.assert_allclose(runs[True][0][:, column(crank, 2)], 2 * np.pi * four_bar.times,
+                               rtol=0, atol=1e-13)
+
+
+def test_one_time_alone_and_redundant_constraints_keep_full_newton(four_bar):
+    """An assembly (one time, from a guess: full Newton's path decides the branch) and a
+    redundant mechanism (a singular Jacobian) are solved by full Newton; a run by modified
+    Newton unless asked otherwise, and the exported script writes the run's settings."""
+    key = "staticSolver.newton.useModifiedNewton"
+    mech, on, off = four_bar.mech, SolveSettings(), SolveSettings(modified_newton=False)
+    assert system.solver_options(mech, on, False)[key] is True
+    assert key not in system.solver_options(mech, on, False, run=False)
+    assert key not in system.solver_options(mech, on, True)
+    assert key not in system.solver_options(mech, off, False)
+    ex = ExudynSystem(mech)
+    ex.solve_positions(four_bar.times[:1])
+    assert not ex.mbs.sys["staticSolver"].newton.useModifiedNewton
+
+
+def parallelogram(th0):
+    """A parallelogram four-bar (cranks r = 0.3 m, coupler and ground L = 1 m), the crank
+    from θ0 at 6π rad/s: its links are collinear (a change point) at θ = π."""
+    r, L = 0.3, 1.0
+    m = pam2exu.Model("parallelogram", gravity=0.0)
+    m.add_solid("ground", points={"O1": [0.0, 0.0], "O2": [L, 0.0]})
+    m.add_solid("crank", fi=th0, points={"O": [0.0, 0.0], "A": [r, 0.0]})
+    m.add_solid("coupler", x=r * np.cos(th0), y=r * np.sin(th0),
+                points={"A": [0.0, 0.0], "B": [L, 0.0]})
+    m.add_solid("rocker", x=L, fi=th0, points={"O": [0.0, 0.0], "B": [r, 0.0]})
+    m.add("fixed", anc1="ground")
+    m.add("revolute", anc1="ground.O1", anc2="crank.O")
+    m.add("revolute", anc1="crank.A", anc2="coupler.A")
+    m.add("revolute", anc1="coupler.B", anc2="rocker.B")
+    m.add("revolute", anc1="ground.O2", anc2="rocker.O")
+    m.add("angular_actuator", anc1="ground", anc2="crank", C=[th0, 6 * np.pi])
+    return m
+
+
+def test_a_run_modified_newton_leaves_unsolved_is_solved_by_full_newton():
+    """Past the parallelogram's change point θ = π (from θ0 = 0.9π, 0.24 rad per step),
+    modified Newton's second iteration diverges and Exudyn stops early (step 28 of 80);
+    the run is then solved again by full Newton: every step, the same positions as full
+    Newton's bit for bit, and the crank at its law."""
+    job = prepare(parallelogram(0.9 * np.pi), analysis="kinematic", steps=20)
+    n = len(job.times)
+    modified = ExudynSystem(job.mech)
+    assert modified._solve_positions(job.times, SolveSettings(), False, False)[1] < n
+    ex = ExudynSystem(job.mech)
+    q, solved = ex.solve_positions(job.times)
+    full, _ = ExudynSystem(job.mech).solve_positions(job.times,
+                                                     SolveSettings(modified_newton=False))
+    assert solved == n and ex.error is None
+    np.testing.assert_array_equal(q, full)
+    np.testing.assert_allclose(q[:, column(1, 2)], 0.9 * np.pi + 6 * np.pi * job.times,
+                               rtol=0, atol=1e-12)
+
+
 def test_angular_actuator_law_is_compiled(four_bar):
     """The motor's law is an Exudyn symbolic function, not a Python pre-step function."""
     ex = ExudynSystem(four_bar.mech)

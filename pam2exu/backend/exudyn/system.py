@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -62,6 +62,14 @@ class SolveSettings:
         there one iteration from the prediction can stop on the tolerance with a position
         error of ~5e-12 rad after a change point (the redundant parallelogram), where two
         from the previous step reach round-off.
+    modified_newton : bool
+        True (the default): a run's steps are solved by Exudyn's modified Newton, the
+        Jacobian computed and factorised once per step and reused by that step's further
+        iterations (``modified_newton``; Exudyn goes back to full Newton within a step that
+        contracts poorly); the positions agree with full Newton's to the tolerance, for one
+        Jacobian per step instead of one per iteration (docs/performance.md). False: full
+        Newton, a Jacobian every iteration. One time alone (an assembly, from a guess) and
+        redundant constraints are always solved by full Newton.
     """
 
     tolerance: float = 1e-13
@@ -69,14 +77,20 @@ class SolveSettings:
     dense: bool | None = None
     verbose: int = 0
     predictor: bool | str = "auto"
+    modified_newton: bool = True
+
+
+def modified_newton(settings: SolveSettings, redundant: bool, run: bool) -> bool:
+    """modified = asked ∧ a run of steps (not one time alone) ∧ no redundant constraints."""
+    return bool(settings.modified_newton) and run and not redundant
 
 
 def solver_options(mech, settings: SolveSettings, redundant: bool,
-                   roundoff: float = 0.0) -> dict:
+                   roundoff: float = 0.0, run: bool = True) -> dict:
     """The SimulationSettings that differ from Exudyn's defaults, {dotted path: value}.
 
     roundoff: the residual floor of ``ExudynSystem.roundoff`` (a lower bound of the
-    absolute tolerance).
+    absolute tolerance); run: a run of steps (False: one time alone, e.g. an assembly).
     """
     dense = settings.dense if settings.dense is not None else mech.nq <= DENSE_UP_TO
     options = {
@@ -89,6 +103,9 @@ def solver_options(mech, settings: SolveSettings, redundant: bool,
         "staticSolver.newton.relativeTolerance": settings.tolerance,
         "staticSolver.newton.maxIterations": settings.max_iterations,
     }
+    if modified_newton(settings, redundant, run):
+        options["staticSolver.newton.useModifiedNewton"] = True
+        options["staticSolver.newton.modifiedNewtonJacUpdatePerStep"] = True
     if redundant:
         dense = True
         options["linearSolver.ignoreSingularJacobian"] = True
@@ -305,10 +322,11 @@ class ExudynSystem:
         return 16.0 * np.finfo(float).eps * size * gain
 
     def simulation_settings(self, settings: SolveSettings, redundant: bool,
-                            roundoff: float = 0.0):
+                            roundoff: float = 0.0, run: bool = True):
         """Exudyn's SimulationSettings with ``solver_options`` applied."""
         ss = exu.SimulationSettings()
-        for path, value in solver_options(self.mech, settings, redundant, roundoff).items():
+        for path, value in solver_options(self.mech, settings, redundant, roundoff,
+                                          run).items():
             *parents, leaf = path.split(".")
             target = ss
             for name in parents:
@@ -330,8 +348,23 @@ class ExudynSystem:
 
         Exudyn's load step k ≥ 1 is solved at time k·dt; the laws are evaluated one
         step earlier, so load step k gives time t_{k−1} (``loadStepStart`` cannot be < 0).
+
+        A run that modified Newton leaves unsolved is solved again by full Newton: Exudyn
+        does not restart a step whose second iteration diverges, as at a change point,
+        where full Newton's iteration still converges (linearly).
         """
         settings = settings or SolveSettings()
+        q, solved = self._solve_positions(times, settings, redundant, multipliers)
+        if solved < len(q) and modified_newton(settings, redundant, len(q) > 1):
+            spent = self.newton_iterations
+            q, solved = self._solve_positions(times, replace(settings, modified_newton=False),
+                                              redundant, multipliers)
+            self.newton_iterations += spent
+        return q, solved
+
+    def _solve_positions(self, times, settings: SolveSettings, redundant: bool,
+                         multipliers: bool) -> tuple[np.ndarray, int]:
+        """``solve_positions`` with the given settings."""
         times = np.asarray(times, dtype=float)
         n = len(times)
         self.error, self.multipliers, self.newton_iterations = None, None, 0
@@ -399,7 +432,7 @@ class ExudynSystem:
                 return True
 
             mbs.SetPostStepUserFunction(post_step)
-        ss = self.simulation_settings(settings, redundant, self.roundoff(times))
+        ss = self.simulation_settings(settings, redundant, self.roundoff(times), run=n > 1)
         # where Newton fails, Exudyn retries with smaller steps: at most MIN_STEP_FRACTION
         # of a step (its default, 1e-8 s, lets a long step be cut into ~1e15 pieces)
         ss.staticSolver.minimumStepSize = MIN_STEP_FRACTION * dt
