@@ -69,7 +69,9 @@ def run(model, analysis=None, **settings):
     solver : pam2exu.backend.SolveSettings, optional
         The backend's settings; for Exudyn, its static solver's: ``tolerance`` (Newton's
         absolute tolerance relative to the mechanism's length, default 1e-13),
-        ``max_iterations``, ``dense``, ``verbose``, ``predictor``.
+        ``max_iterations``, ``dense``, ``verbose``, ``predictor``, ``modified_newton``
+        (default True: a run's steps by Exudyn's modified Newton, one Jacobian per step;
+        docs/analyses.md).
     backend : str, optional
         What solves the positions (``pam2exu.registry.BACKENDS``): ``'exudyn'`` (the
         default); an unknown name is a ModelError listing the known ones.
