@@ -1,4 +1,5 @@
-"""The Exudyn backend's predictor, decided by measurement, against the plain Exudyn script.
+"""The Exudyn backend's position solve (modified Newton, the predictor decided by measurement)
+against the plain Exudyn script.
 
     python benchmarks/predictor.py            # rewrites its section of docs/performance.md
     python benchmarks/predictor.py --quick    # one round of 10,000 steps, printed only
@@ -6,9 +7,10 @@
 Times, in rounds, each configuration once per round in alternation (the order reversed every
 other round), in-process with the model loaded: the four-bar (examples/four_bar.toml,
 θ = 2π t, 1 s) positions only (``outputs=["x", "y", "fi"]``), 100,000 steps, with the
-predictor as decided by the run (the default, ``predictor="auto"``), always and never,
-beside the plain hand-written Exudyn script (``plain_exudyn_four_bar``, symbolic driver:
-building, solving and reading the sensors); and the four-bar turning 0.003 rad per step
+predictor as decided by the run (the default, ``predictor="auto"``), always and never, and
+the default by full Newton (``modified_newton=False``, a Jacobian every iteration), beside
+the plain hand-written Exudyn script (``plain_exudyn_four_bar``, symbolic driver: building,
+solving and reading the sensors; full Newton); and the four-bar turning 0.003 rad per step
 (θ = 10 t, 110,000 steps over 34.6 s) each way. Each configuration's best round, and the
 ratios of the best times; *per round*: the range of the ratios of the runs of one round
 (seconds apart). Newton iterations per step and the probe's decision are read from every
@@ -41,8 +43,11 @@ from benchmarks.report import table, verdict  # noqa: E402
 BEGIN = ("<!-- section predictor: written by benchmarks/predictor.py (python "
          "benchmarks/predictor.py rewrites it alone) -->")
 END = "<!-- end of section predictor -->"
-SETTINGS = {"auto": "auto", "on": True, "off": False}
-LABEL = {"auto": 'default (`"auto"`)', "on": "predictor always", "off": "predictor never"}
+#: configuration -> (predictor, modified_newton)
+SETTINGS = {"auto": ("auto", True), "on": (True, True), "off": (False, True),
+            "full": ("auto", False)}
+LABEL = {"auto": 'default (`"auto"`)', "on": "predictor always", "off": "predictor never",
+         "full": 'default (`"auto"`), full Newton'}
 
 
 class Recorder:
@@ -73,13 +78,14 @@ class Recorder:
         system.ExudynSystem.solve_positions = self.original
 
 
-def pam_seconds(model, steps, t_end, predictor):
+def pam_seconds(model, steps, t_end, predictor, modified_newton=True):
     """Wall seconds of one positions-only run."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         start = time.perf_counter()
         pam2exu.run(model, analysis="kinematic", steps=steps, t_end=t_end,
-                    outputs=["x", "y", "fi"], solver=SolveSettings(predictor=predictor))
+                    outputs=["x", "y", "fi"],
+                    solver=SolveSettings(predictor=predictor, modified_newton=modified_newton))
         return time.perf_counter() - start
 
 
@@ -115,8 +121,8 @@ def measure(rounds, steps, slow_steps):
     cpu = {key: [] for key in ("plain", *(f"{c} {k}" for c in ("fast", "slow")
                                            for k in SETTINGS))}
     for key, setting in SETTINGS.items():
-        jobs[f"fast {key}"] = (lambda s=setting: pam_seconds(model, steps, 1.0, s))
-        jobs[f"slow {key}"] = (lambda s=setting: pam_seconds(slow, slow_steps, slow_t_end, s))
+        jobs[f"fast {key}"] = (lambda s=setting: pam_seconds(model, steps, 1.0, *s))
+        jobs[f"slow {key}"] = (lambda s=setting: pam_seconds(slow, slow_steps, slow_t_end, *s))
     out = {key: [] for key in jobs}
     recorder = Recorder()
     try:
@@ -158,6 +164,7 @@ def section(out, steps, slow_steps, slow_t_end, info, load_before, load_after, m
     rows = []
     r_fast = ratio("fast auto", "plain")
     r_slow = ratio("slow auto", "slow off")
+    r_full = ratio("fast auto", "fast full")
     rows.append(["four-bar positions, 100,000 steps, default / the plain Exudyn script, same run"
                  if steps == 100_000 else f"four-bar positions, {steps:,} steps / plain script",
                  f"{r_fast[0]:.2f}× ({1e6 * best['fast auto']:.1f} / {1e6 * best['plain']:.1f} "
@@ -170,6 +177,11 @@ def section(out, steps, slow_steps, slow_t_end, info, load_before, load_after, m
                  f"{r_slow[2]:.2f}×; CPU time "
                  f"{cpu_best['slow auto'] / cpu_best['slow off']:.2f}×)",
                  "≤ 1.0×", verdict(r_slow[0], 1.0)])
+    rows.append([f"four-bar positions, {steps:,} steps: default (modified Newton) / full Newton",
+                 f"{r_full[0]:.2f}× ({1e6 * best['fast auto']:.1f} / "
+                 f"{1e6 * best['fast full']:.1f} µs/step; per round {r_full[1]:.2f}–"
+                 f"{r_full[2]:.2f}×; CPU time "
+                 f"{cpu_best['fast auto'] / cpu_best['fast full']:.2f}×)", "–", "–"])
     detail = []
     for case, label in (("fast", f"θ = 2π t, {steps:,} steps over 1 s"),
                         ("slow", f"θ = 10 t, {slow_steps:,} steps over {slow_t_end:.1f} s")):
@@ -187,7 +199,8 @@ def section(out, steps, slow_steps, slow_t_end, info, load_before, load_after, m
                    f"{plain_iterations:.2f}", "–"])
     return [
         BEGIN,
-        "## The Exudyn backend's predictor, decided by measurement",
+        "## The Exudyn backend's position solve: modified Newton, the predictor decided by "
+        "measurement",
         "",
         f"Generated by `benchmarks/predictor.py` on {info['date (UTC)']} UTC in one run of "
         f"{minutes:.1f} minutes, on this page's machine ({info['CPU']}, {info['cores']} "
@@ -196,6 +209,15 @@ def section(out, steps, slow_steps, slow_t_end, info, load_before, load_after, m
         "was shared, so read the ratios, each of two runs of the same round, not the times. "
         f"{len(next(iter(out.values())))} rounds, each configuration once per round in "
         "alternation; best round of each.",
+        "",
+        "Each step of a run is solved by Exudyn's modified Newton (`SolveSettings."
+        "modified_newton`, docs/analyses.md): the Jacobian is computed and factorised once "
+        "per step and reused by the step's further iterations, where full Newton (the plain "
+        "script's) computes and factorises it at every iteration: one Jacobian per step "
+        "instead of one per iteration, for an iteration more where the reused Jacobian "
+        "falls just short of the tolerance (the table's iterations per step), and the same "
+        "positions to the tolerance. A run it leaves unsolved (it can diverge next to a change point) is "
+        "solved again by full Newton.",
         "",
         "The predictor (`SolveSettings.predictor`, docs/analyses.md) sets Exudyn's "
         "coordinates before each load step to the parabola through the last three steps, "
