@@ -95,19 +95,25 @@ def test_a_run_takes_one_jacobian_per_step(four_bar):
                                rtol=0, atol=1e-13)
 
 
-def test_one_time_alone_and_redundant_constraints_keep_full_newton(four_bar):
-    """An assembly (one time, from a guess: full Newton's path decides the branch) and a
-    redundant mechanism (a singular Jacobian) are solved by full Newton; a run by modified
-    Newton unless asked otherwise, and the exported script writes the run's settings."""
+def test_one_time_alone_redundant_constraints_and_many_turns_keep_full_newton(four_bar):
+    """An assembly (one time, from a guess: full Newton's path decides the branch), a
+    redundant mechanism (a singular Jacobian) and a run whose round-off floor is above the
+    tolerance (100 turns: 16 ulps of 200π = 2.2e-12 > 1e-13 × 0.4 m; modified Newton would
+    stop at the floor) are solved by full Newton; a run by modified Newton unless asked
+    otherwise (the exported script writes the run's settings)."""
     key = "staticSolver.newton.useModifiedNewton"
     mech, on, off = four_bar.mech, SolveSettings(), SolveSettings(modified_newton=False)
     assert system.solver_options(mech, on, False)[key] is True
     assert key not in system.solver_options(mech, on, False, run=False)
     assert key not in system.solver_options(mech, on, True)
     assert key not in system.solver_options(mech, off, False)
-    ex = ExudynSystem(mech)
-    ex.solve_positions(four_bar.times[:1])
-    assert not ex.mbs.sys["staticSolver"].newton.useModifiedNewton
+    assert key not in system.solver_options(mech, on, False, roundoff=4.1e-14)
+    for times, modified in ((four_bar.times[:1], False), (four_bar.times, True),
+                            (np.linspace(0.0, 100.0, 2001), False)):
+        ex = ExudynSystem(mech)
+        q, solved = ex.solve_positions(times)
+        assert solved == len(times) and ex.modified is modified
+        assert ex.mbs.sys["staticSolver"].newton.useModifiedNewton is modified
 
 
 def parallelogram(th0):

@@ -63,13 +63,12 @@ class SolveSettings:
         error of ~5e-12 rad after a change point (the redundant parallelogram), where two
         from the previous step reach round-off.
     modified_newton : bool
-        True (the default): a run's steps are solved by Exudyn's modified Newton, the
-        Jacobian computed and factorised once per step and reused by that step's further
-        iterations (``modified_newton``; Exudyn goes back to full Newton within a step that
-        contracts poorly); the positions agree with full Newton's to the tolerance, for one
-        Jacobian per step instead of one per iteration (docs/performance.md). False: full
-        Newton, a Jacobian every iteration. One time alone (an assembly, from a guess) and
-        redundant constraints are always solved by full Newton.
+        True (the default): a run's steps by Exudyn's modified Newton (one Jacobian per
+        step, reused by its further iterations; the same positions to the tolerance); False:
+        full Newton (a Jacobian per iteration). One time alone (an assembly, from a guess),
+        redundant constraints and a run whose round-off floor is above the tolerance (angles
+        of many turns: modified Newton would stop at the floor, full Newton's last iteration
+        goes below it) always use full Newton (``modified_newton``).
     """
 
     tolerance: float = 1e-13
@@ -80,9 +79,11 @@ class SolveSettings:
     modified_newton: bool = True
 
 
-def modified_newton(settings: SolveSettings, redundant: bool, run: bool) -> bool:
-    """modified = asked ∧ a run of steps (not one time alone) ∧ no redundant constraints."""
-    return bool(settings.modified_newton) and run and not redundant
+def modified_newton(settings: SolveSettings, redundant: bool, run: bool, roundoff: float,
+                    scale: float) -> bool:
+    """asked ∧ a run (not one time) ∧ not redundant ∧ roundoff ≤ tolerance · scale."""
+    return (bool(settings.modified_newton) and run and not redundant
+            and roundoff <= settings.tolerance * scale)
 
 
 def solver_options(mech, settings: SolveSettings, redundant: bool,
@@ -103,7 +104,7 @@ def solver_options(mech, settings: SolveSettings, redundant: bool,
         "staticSolver.newton.relativeTolerance": settings.tolerance,
         "staticSolver.newton.maxIterations": settings.max_iterations,
     }
-    if modified_newton(settings, redundant, run):
+    if modified_newton(settings, redundant, run, roundoff, mech.scale()):
         options["staticSolver.newton.useModifiedNewton"] = True
         options["staticSolver.newton.modifiedNewtonJacUpdatePerStep"] = True
     if redundant:
@@ -350,12 +351,12 @@ class ExudynSystem:
         step earlier, so load step k gives time t_{k−1} (``loadStepStart`` cannot be < 0).
 
         A run that modified Newton leaves unsolved is solved again by full Newton: Exudyn
-        does not restart a step whose second iteration diverges, as at a change point,
-        where full Newton's iteration still converges (linearly).
+        does not restart a step whose second iteration diverges (at a change point, where
+        full Newton's still converges, linearly).
         """
         settings = settings or SolveSettings()
         q, solved = self._solve_positions(times, settings, redundant, multipliers)
-        if solved < len(q) and modified_newton(settings, redundant, len(q) > 1):
+        if solved < len(q) and self.modified:
             spent = self.newton_iterations
             q, solved = self._solve_positions(times, replace(settings, modified_newton=False),
                                               redundant, multipliers)
@@ -368,7 +369,7 @@ class ExudynSystem:
         times = np.asarray(times, dtype=float)
         n = len(times)
         self.error, self.multipliers, self.newton_iterations = None, None, 0
-        self.predicted = False
+        self.predicted = self.modified = False
         if not self.sensors:                     # every solid is fixed: nothing to solve
             return np.tile(self.mech.initial_q(), (n, 1)), n
         # one time alone (an assembly, a restart at the last step) is step k0 = 1 of a grid
@@ -433,6 +434,7 @@ class ExudynSystem:
 
             mbs.SetPostStepUserFunction(post_step)
         ss = self.simulation_settings(settings, redundant, self.roundoff(times), run=n > 1)
+        self.modified = ss.staticSolver.newton.useModifiedNewton
         # where Newton fails, Exudyn retries with smaller steps: at most MIN_STEP_FRACTION
         # of a step (its default, 1e-8 s, lets a long step be cut into ~1e15 pieces)
         ss.staticSolver.minimumStepSize = MIN_STEP_FRACTION * dt
