@@ -71,6 +71,18 @@ class LinearSolves:
                 return x
         return self._least_squares(data, b)
 
+    def solve_one(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """``solve`` at one step (data (nnz,), b (m,) -> x (nz,)): the same LAPACK solve of the
+        same matrix where ``solve`` takes numpy's dense one, with fewer calls around it."""
+        terms = self.terms
+        if not self.least_squares and terms.nz and (
+                terms.nz < SPARSE_FROM or terms.nz ** 2 <= DENSE_WORK):
+            try:
+                return np.linalg.solve(terms.dense_one(data), b)
+            except np.linalg.LinAlgError:
+                pass
+        return self.solve(data[None], b[None])[0]
+
     def _least_squares(self, data, b):
         """The minimum-norm least-squares x of Φ_z x = b per step (SVD); NaN where a square
         system is singular."""
@@ -136,6 +148,14 @@ class LinearSolves:
         """(ż, z̈) at the steps (z solved): Φ_z ż = g', Φ_z z̈ = γ; in chunks that bound
         the memory of the Jacobians."""
         terms = self.terms
+        if len(t) == 1 and terms.nz:              # one step (the coarse pass's)
+            data = terms.jacobian_one(z[0])
+            b = np.zeros(terms.m)
+            if terms.laws:
+                b[terms.law_rows] = terms.targets(t, 1)[:, 0]
+            zd = self.solve_one(data, b)
+            g2 = terms.targets(t, 2)[:, 0] if terms.laws else None
+            return zd[None], self.solve_one(data, terms.gamma_one(z[0], zd, g2))[None]
         zd, zdd = np.empty_like(z), np.empty_like(z)
         rows = self.rows_per_chunk()
         for a in range(0, len(t), rows):

@@ -159,18 +159,18 @@ class Solver(LinearSolves):
         done_below = max(64 * EPS, 100 * tol)
         last = np.inf
         g = terms.targets(t, 0)
+        g1 = g[:, 0]
         for _ in range(self.settings.max_iterations):
-            zc = x[:, None]
-            phi, data = terms.residual_jacobian_cols(t, zc, g)
-            phi = phi[:, 0]
-            dz = self.solve(data.T, -phi[None])[0]
+            phi, data = terms.residual_jacobian_one(x, g1)
+            dz = self.solve_one(data, -phi)
             step = float((np.abs(dz) * w).max(initial=0.0))   # exact: the same max
             small = step <= tol
             # Φ within round-off of its terms: it decides only a step that did not
             # shrink (``stalled``) or a least-squares one
             floor = True
             if self.least_squares or (not small and step > 0.7 * last):
-                magnitude = np.maximum(terms.magnitude_cols(t, zc, g)[:, 0], self.floor[:, 0])
+                magnitude = np.maximum(terms.magnitude_cols(t, x[:, None], g)[:, 0],
+                                       self.floor[:, 0])
                 size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
                                  where=magnitude > 0)
                 size[phi == 0] = 0.0

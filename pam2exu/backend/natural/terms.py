@@ -93,6 +93,10 @@ class Terms:
         self._jc_c, self._jc_a, self._jc_b = self._sc[kc], self.sa[kc], self.sb[kc]
         self._jc_alpha = self._alpha[kc]
         self._keeps = (kb, ka, ks, kc)
+        # the same constants 1-D, for the evaluations at one step (``*_one``)
+        self._jp_c1, self._js_c1, self._js_alpha1, self._jc_c1, self._jc_alpha1 = (
+            a[:, 0] for a in (self._jp_c, self._js_c, self._js_alpha, self._jc_c,
+                              self._jc_alpha))
         self._jp_keep = np.r_[kb, ka]
         # ``residual_jacobian_cols``: the coordinates of every term in one gather, and the
         # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
@@ -212,6 +216,66 @@ class Terms:
         if self.laws:
             out[self.law_rows] -= self.targets(t, 0) if g is None else g
         return out, data
+
+    # ---- evaluation at one step: 1-D arrays (Newton and the rates step by step) ---------------
+    # The same arithmetic as the ``*_cols`` methods' column of that step (the same products
+    # in the same order, the same bincount): the same bits, with fewer numpy calls.
+    def residual_jacobian_one(self, z: np.ndarray, g: np.ndarray | None = None
+                              ) -> tuple[np.ndarray, np.ndarray]:
+        """(Φ (m,), Φ_z data (nnz,)) at one configuration z (nz,): ``residual_jacobian_cols``'
+        column; g: ``targets(t, 0)[:, 0]`` of the step (its laws' rows)."""
+        pc, sc, alpha, (kb, ka, ks, kc) = self.pc, self.sc, self.salpha, self._keeps
+        x = np.empty(self.nz + 1)
+        x[:self.nz] = z
+        x[self.nz] = 1.0
+        gathered = x[self._gather]
+        xa, xb, arg, xs = (gathered[part] for part in self._parts)
+        arg += alpha
+        sin = np.sin(arg)
+        ca, cs = pc * xa, sc * xs
+        entries = np.concatenate([np.concatenate([pc * xb, ca])[self._jp_keep],
+                                  self._js_c1 * sin[ks], cs[kc] * np.cos(arg[kc])])
+        both = np.bincount(self._both_index, weights=np.concatenate([ca * xb, cs * sin, entries]),
+                           minlength=self.m + len(self.rows))
+        out = both[:self.m]
+        if self.laws:
+            out[self.law_rows] -= g
+        return out, both[self.m:]
+
+    def jacobian_one(self, z: np.ndarray) -> np.ndarray:
+        """Φ_z data (nnz,) at one configuration z (nz,): ``jacobian_cols``' column."""
+        x = np.empty(self.nz + 1)
+        x[:self.nz] = z
+        x[self.nz] = 1.0
+        values = np.concatenate([
+            self._jp_c1 * x[self._jp_i],
+            self._js_c1 * np.sin(x[self._js_b] + self._js_alpha1),
+            self._jc_c1 * x[self._jc_a] * np.cos(x[self._jc_b] + self._jc_alpha1)])
+        return np.bincount(self.entry_index, weights=values, minlength=len(self.rows))
+
+    def dense_one(self, data: np.ndarray) -> np.ndarray:
+        """Φ_z (m, nz) from its data (nnz,) at one step."""
+        J = np.zeros((self.m, self.nz))
+        J[self.rows, self.cols] = data
+        return J
+
+    def gamma_one(self, z: np.ndarray, zd: np.ndarray, g2: np.ndarray | None) -> np.ndarray:
+        """γ (m,) at one step: ``gamma_cols``' column; g2: ``targets(t, 2)[:, 0]``."""
+        pc, sc, alpha = self.pc, self.sc, self.salpha
+        x = np.empty(self.nz + 1)
+        x[:self.nz] = z
+        x[self.nz] = 1.0
+        v = np.zeros(self.nz + 1)
+        v[:self.nz] = zd
+        arg = x[self.sb] + alpha
+        wb = v[self.sb]
+        values = np.concatenate([
+            2.0 * pc * v[self.pa] * v[self.pb],
+            sc * wb * (2.0 * v[self.sa] * np.cos(arg) - x[self.sa] * wb * np.sin(arg))])
+        out = -np.bincount(self.row_index, weights=values, minlength=self.m)
+        if self.laws:
+            out[self.law_rows] += g2
+        return out
 
     def _residual_jacobian_many(self, t, z, g=None):
         """``residual_jacobian_cols`` for many steps (each sum by its sparse summing matrix)."""
