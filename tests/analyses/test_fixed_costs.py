@@ -129,3 +129,16 @@ def test_newton_and_rates_at_one_step_are_the_batch_bits(natural_solver):
     zd, zdd = solver.rates(t, one)
     zd2, zdd2 = solver.rates(np.r_[t, t], np.repeat(one, 2, axis=0))
     assert zd[0].tobytes() == zd2[0].tobytes() and zdd[0].tobytes() == zdd2[0].tobytes()
+
+
+def test_the_pivot_order_at_one_configuration_is_the_batched_one(natural_solver):
+    """The equations' pivot order at the run's start (one configuration, eliminated in 2-D)
+    is the batched elimination's (``batched.lu_factor``) for that configuration, exchanges
+    included."""
+    form, solver, z = natural_solver
+    rng = np.random.default_rng(3)
+    many = np.concatenate([z.T, z.T[:1] + rng.standard_normal((20, form.nz))])
+    batched = solver.pivot_orders(many)
+    assert any((o != np.arange(form.m)).any() for o in batched)
+    for k, zk in enumerate(many):
+        assert (solver.pivot_orders(zk[None])[0] == batched[k]).all()

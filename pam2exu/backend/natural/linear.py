@@ -123,6 +123,11 @@ class LinearSolves:
         if key == self._ordered[0]:              # the run's start, asked again
             return self._ordered[1]
         m, N = self.terms.m, len(z)
+        if N == 1:
+            order = _pivot_order(self.terms.dense_one(self.terms.jacobian_one(z[0])))
+            order = (self.order if order is None else order)[None]
+            self._ordered = (key, order)
+            return order
         A = self.terms.dense_cols(self.terms.jacobian_cols(z.T))
         swaps, regular = lu_factor(A)
         order = np.tile(np.arange(m)[:, None], (1, N))
@@ -225,3 +230,32 @@ class LinearSolves:
         if not (np.isfinite(zd).all() and np.isfinite(zdd).all()):
             return None
         return z, zd, zdd, step <= tol
+
+
+def _pivot_order(A: np.ndarray) -> np.ndarray | None:
+    """The rows' order (m,) that partial pivoting gives for one square A (m, m): the
+    arithmetic and choices of ``batched.lu_factor`` (threshold 1) on that one system, in
+    2-D; None where A is singular or not finite (``pivot_orders`` then keeps its order)."""
+    if not np.isfinite(A).all():
+        return None
+    A = A.copy()
+    m = len(A)
+    order = np.arange(m)
+    for k in range(m):
+        size = np.abs(A[k:, k]).tolist()
+        best, largest = 0, size[0]
+        for r in range(1, len(size)):          # the first largest, as lu_factor
+            if size[r] > largest:
+                best, largest = r, size[r]
+        if size[0] < largest:                  # exchange rows k and k + best
+            p = k + best
+            A[[k, p]] = A[[p, k]]
+            order[k], order[p] = order[p], order[k]
+        pivot = A[k, k]
+        if not np.isfinite(pivot) or pivot == 0.0:
+            return None
+        if k + 1 < m:
+            L = A[k + 1:, k] / pivot
+            A[k + 1:, k] = L
+            A[k + 1:, k + 1:] -= L[:, None] * A[k, k + 1:][None]
+    return order
