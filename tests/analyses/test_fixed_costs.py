@@ -67,7 +67,7 @@ def test_a_short_run_takes_its_condition_numbers_from_the_rates_jacobian(four_ba
     assert res.info["max_condition_number"] == float(np.max(apart))
 
 
-@pytest.mark.parametrize("steps", [1, 7, 32, 33, 40])
+@pytest.mark.parametrize("steps", [1, 7, 32, 33, 40, 257, 300])
 def test_phi_and_its_jacobian_in_one_pass_are_the_separate_bits(four_bar, steps):
     """``residual_jacobian_cols`` (one gather, one bincount for a few steps) gives Φ and
     Φ_z bit for bit as ``residual_cols`` and ``jacobian_cols``."""
