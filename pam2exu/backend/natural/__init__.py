@@ -218,7 +218,7 @@ class Natural(Backend):
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
         value in the whole turn nearest ``start`` (in chunks of steps: bounded memory; one
         row per quantity inside, the step axis last)."""
-        K = _kept(form, "pose_sum", lambda: _summing(form.pose_forms()))
+        K = _kept(form, "pose_sum", lambda: _summing(_pose_forms(form)))
         kind = self._angle_kinds(form)
         qT = np.empty((mech.nq, len(z)))             # one row per x, y, fi
         free, c = kind.free, kind.coordinate
@@ -263,8 +263,8 @@ class Natural(Backend):
     def to_rates(self, form: Formulation, mech, z, zd, zdd):
         """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
         (in chunks of steps: bounded memory; one row per quantity inside)."""
-        K = _kept(form, "pose_sum", lambda: _summing(form.pose_forms()))
-        Kz = _kept(form, "pose_rate_sum", lambda: _summing(form.pose_forms()[:, :form.nz]))
+        K = _kept(form, "pose_sum", lambda: _summing(_pose_forms(form)))
+        Kz = _kept(form, "pose_rate_sum", lambda: _summing(_pose_forms(form)[:, :form.nz]))
         kind = self._angle_kinds(form)
         qdT, qddT = np.empty((mech.nq, len(z))), np.empty((mech.nq, len(z)))
         f, c = kind.free, kind.coordinate
@@ -297,6 +297,11 @@ def _kept(form: Formulation, name: str, make):
     if name not in kept:
         kept[name] = make()
     return kept[name]
+
+
+def _pose_forms(form: Formulation) -> np.ndarray:
+    """``form.pose_forms()``, made once per formulation (to_q and to_rates both sum it)."""
+    return _kept(form, "pose_forms", form.pose_forms)
 
 
 def _ext(zT: np.ndarray) -> np.ndarray:
