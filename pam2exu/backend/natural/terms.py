@@ -100,6 +100,15 @@ class Terms:
             a[:, 0] for a in (self._jp_c, self._js_c, self._js_alpha, self._jc_c,
                               self._jc_alpha))
         self._jp_keep = np.r_[kb, ka]
+        # ``residual_jacobian_one``: its values are [c z_a z_b, c z_a sin, c z_a, c z_b,
+        # c sin, c z_a cos] (products over all terms); the sums' weights pick, in the order of
+        # ``residual_jacobian_cols``, Φ's terms, then Φ_z's: c z_b, c z_a (kept), c sin (ks),
+        # c z_a cos (kc)
+        P, S = len(self.pa), len(self.sa)
+        self._pc2 = np.r_[self.pc, self.pc]
+        self._one_pick = np.r_[np.arange(P + S),
+                               np.r_[P + S + P + np.arange(P), P + S + np.arange(P)][self._jp_keep],
+                               3 * P + S + np.nonzero(ks)[0], 3 * P + 2 * S + np.nonzero(kc)[0]]
         # ``residual_jacobian_cols``: the coordinates of every term in one gather, and the
         # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
         # adds the same terms in the same order as two calls)
@@ -225,19 +234,19 @@ class Terms:
     def residual_jacobian_one(self, z: np.ndarray, g: np.ndarray | None = None
                               ) -> tuple[np.ndarray, np.ndarray]:
         """(Φ (m,), Φ_z data (nnz,)) at one configuration z (nz,): ``residual_jacobian_cols``'
-        column; g: ``targets(t, 0)[:, 0]`` of the step (its laws' rows)."""
-        pc, sc, alpha, (kb, ka, ks, kc) = self.pc, self.sc, self.salpha, self._keeps
+        column; g: ``targets(t, 0)[:, 0]`` of the step (its laws' rows). Every product is
+        made once over all terms and the summed ones picked by one index (``_one_pick``)."""
+        P, S = len(self.pa), len(self.sa)
         x = np.empty(self.nz + 1)
         x[:self.nz] = z
         x[self.nz] = 1.0
-        gathered = x[self._gather]
-        xa, xb, arg, xs = (gathered[part] for part in self._parts)
-        arg += alpha
-        sin = np.sin(arg)
-        ca, cs = pc * xa, sc * xs
-        entries = np.concatenate([np.concatenate([pc * xb, ca])[self._jp_keep],
-                                  self._js_c1 * sin[ks], cs[kc] * np.cos(arg[kc])])
-        both = np.bincount(self._both_index, weights=np.concatenate([ca * xb, cs * sin, entries]),
+        gathered = x[self._gather]                   # z_a, z_b of the products; z_b, z_a of sines
+        ab = self._pc2 * gathered[:2 * P]            # c z_a, c z_b
+        arg = gathered[2 * P:2 * P + S] + self.salpha
+        sin, cs = np.sin(arg), self.sc * gathered[2 * P + S:]
+        values = np.concatenate([ab[:P] * gathered[P:2 * P], cs * sin, ab, self.sc * sin,
+                                 cs * np.cos(arg)])
+        both = np.bincount(self._both_index, weights=values[self._one_pick],
                            minlength=self.m + len(self.rows))
         out = both[:self.m]
         if self.laws:
