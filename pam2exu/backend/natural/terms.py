@@ -65,7 +65,7 @@ class Terms:
         self.pc = p[:, 3]
         self.sr, self.sa, self.sb = (s[:, k].astype(int) for k in range(3))
         self.salpha, self.sc = s[:, 3], s[:, 4]
-        self.row_index = np.r_[self.pr, self.sr]
+        self.row_index = np.concatenate([self.pr, self.sr])
         self.law_rows = np.array([r for r, _, _ in self.laws], dtype=int)
         self._last_times, self._last_laws = None, []
         # the terms' constants as columns, kept (evaluations broadcast them over the steps)
@@ -89,8 +89,8 @@ class Terms:
         # derivatives in one gather), then c sin(z_b + α) and c z_a cos(z_b + α)
         kb, ka = self.pa != nz, self.pb != nz
         ks, kc = self.sa != nz, self.sb != nz
-        self._jp_c = np.r_[self.pc[kb], self.pc[ka]][:, None]
-        self._jp_i = np.r_[self.pb[kb], self.pa[ka]]
+        self._jp_c = np.concatenate([self.pc[kb], self.pc[ka]])[:, None]
+        self._jp_i = np.concatenate([self.pb[kb], self.pa[ka]])
         self._js_c, self._js_b, self._js_alpha = self._sc[ks], self.sb[ks], self._alpha[ks]
         self._jc_c, self._jc_a, self._jc_b = self._sc[kc], self.sa[kc], self.sb[kc]
         self._jc_alpha = self._alpha[kc]
@@ -99,23 +99,23 @@ class Terms:
         self._jp_c1, self._js_c1, self._js_alpha1, self._jc_c1, self._jc_alpha1 = (
             a[:, 0] for a in (self._jp_c, self._js_c, self._js_alpha, self._jc_c,
                               self._jc_alpha))
-        self._jp_keep = np.r_[kb, ka]
+        self._jp_keep = np.concatenate([kb, ka])
         # ``residual_jacobian_one``: its values are [c z_a z_b, c z_a sin, c z_a, c z_b,
         # c sin, c z_a cos] (products over all terms); the sums' weights pick, in the order of
         # ``residual_jacobian_cols``, Φ's terms, then Φ_z's: c z_b, c z_a (kept), c sin (ks),
         # c z_a cos (kc)
         P, S = len(self.pa), len(self.sa)
-        self._pc2 = np.r_[self.pc, self.pc]
-        self._one_pick = np.r_[np.arange(P + S),
-                               np.r_[P + S + P + np.arange(P), P + S + np.arange(P)][self._jp_keep],
-                               3 * P + S + np.nonzero(ks)[0], 3 * P + 2 * S + np.nonzero(kc)[0]]
+        self._pc2 = np.concatenate([self.pc, self.pc])
+        jp = np.concatenate([P + S + P + np.arange(P), P + S + np.arange(P)])[self._jp_keep]
+        self._one_pick = np.concatenate([np.arange(P + S), jp, 3 * P + S + np.nonzero(ks)[0],
+                                         3 * P + 2 * S + np.nonzero(kc)[0]])
         # ``residual_jacobian_cols``: the coordinates of every term in one gather, and the
         # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
         # adds the same terms in the same order as two calls)
-        self._gather = np.r_[self.pa, self.pb, self.sb, self.sa]
+        self._gather = np.concatenate([self.pa, self.pb, self.sb, self.sa])
         edges = np.cumsum([0, len(self.pa), len(self.pb), len(self.sb), len(self.sa)])
         self._parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
-        self._both_index = np.r_[self.row_index, self.m + self.entry_index]
+        self._both_index = np.concatenate([self.row_index, self.m + self.entry_index])
 
     # ---- evaluation: one column per step --------------------------------------------------
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
