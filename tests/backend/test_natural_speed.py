@@ -133,3 +133,29 @@ def test_a_large_system_gets_its_rates_with_its_positions():
     zd, zdd = solver.rates(t, z)
     for mine, fresh in ((solver.zd, zd), (solver.zdd, zdd)):
         assert np.max(np.abs(mine - fresh)) <= 1e-10 * np.max(np.abs(fresh))
+
+
+def test_newton_stops_where_quadratic_convergence_says_the_next_step_is_below(
+        four_bar_mech, monkeypatch):
+    """Newton at one time stops after the step whose successor, step³ / last², would be 1000
+    times below the tolerance (the iteration that would only confirm it is not taken): a
+    coarse step of the four-bar takes 3 iterations instead of 4, and lands within round-off
+    of the 4-iteration answer."""
+    from pam2exu.backend.natural import solver as solver_module
+    form, solver = solver_of(four_bar_mech)
+    z0 = form.from_q(four_bar_mech.initial_q()[None])
+    t = np.array([0.0, 0.04])
+    start, _ = solver.newton(t[:1], z0)
+    zd, zdd = solver.rates(t[:1], start)
+    h = t[1] - t[0]
+    guess = start + h * zd + 0.5 * h * h * zdd            # the coarse pass's predictor
+    answers = {}
+    for converged in (solver_module.CONVERGED, 0.0):     # 0: every step must be below tol
+        monkeypatch.setattr(solver_module, "CONVERGED", converged)
+        solver.iterations = 0
+        z, ok = solver.newton(t[1:], guess)
+        assert ok[0]
+        answers[converged] = (z[0], solver.iterations)
+    (fast, n_fast), (slow, n_slow) = answers.values()
+    assert (n_fast, n_slow) == (3, 4)
+    assert np.max(np.abs(fast - slow) * solver.w) <= 1e-15

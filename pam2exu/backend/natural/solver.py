@@ -60,6 +60,9 @@ BLOCK = 8192
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
 COARSE_GAP = 64
+#: Newton stops where quadratic convergence puts its next step below CONVERGED × tolerance
+#: (``next_below``): the answer is then as accurate as a step below the tolerance makes it
+CONVERGED = 1e-3
 #: the machine epsilon (the size of round-off relative to a value)
 EPS = float(np.finfo(float).eps)
 
@@ -72,7 +75,8 @@ class NaturalSettings:
     ----------
     tolerance : float
         Newton stops when its step is below this, relative to the mechanism's length (angles
-        and unit vectors: the step itself), or when the residual is at round-off.
+        and unit vectors: the step itself), when quadratic convergence puts its next step
+        1000 times below it (``next_below``), or when the residual is at round-off.
     max_iterations : int
         Newton iterations per step before the step is cut into sub-steps.
     verbose : int
@@ -82,6 +86,14 @@ class NaturalSettings:
     tolerance: float = 1e-13
     max_iterations: int = 25
     verbose: int = 0
+
+
+def next_below(step, last, tol: float):
+    """Whether Newton's next step, quadratic convergence's step³ / last², is below tol / 1000
+    (with the step below last / 1000: the convergence is quadratic); then the iterate after
+    this step is the answer, and the iteration that would only confirm it is not taken."""
+    return (step < 1e-3 * last) & (last < math.inf) & \
+        (step * step * step <= CONVERGED * tol * last * last)
 
 
 class Solver(LinearSolves):
@@ -119,6 +131,8 @@ class Solver(LinearSolves):
                 dz = self.solve(terms.jacobian(za), -phi)
                 step = np.max(np.abs(dz) * self.w, axis=1, initial=0.0)
                 small = step <= tol
+                if not self.least_squares:
+                    small |= next_below(step, last[active], tol)
                 # |Φ| relative to its terms: wanted where the step alone does not decide
                 ask = ~small | self.least_squares
                 size = np.zeros_like(phi)
@@ -164,7 +178,7 @@ class Solver(LinearSolves):
             phi, data = terms.residual_jacobian_one(x, g1)
             dz = self.solve_one(data, -phi)
             step = float((np.abs(dz) * w).max(initial=0.0))   # exact: the same max
-            small = step <= tol
+            small = step <= tol or (not self.least_squares and next_below(step, last, tol))
             # Φ within round-off of its terms: it decides only a step that did not
             # shrink (``stalled``) or a least-squares one
             floor = True
