@@ -159,3 +159,20 @@ def test_newton_stops_where_quadratic_convergence_says_the_next_step_is_below(
     (fast, n_fast), (slow, n_slow) = answers.values()
     assert (n_fast, n_slow) == (3, 4)
     assert np.max(np.abs(fast - slow) * solver.w) <= 1e-15
+
+
+def test_the_run_starts_from_the_assembly_it_solved(monkeypatch):
+    """The run after the assembly starts from the assembly's natural coordinates (its angle
+    coordinates those of the start, whole turns added) instead of solving t0 again: Newton
+    at t0 once a run (before: twice)."""
+    at = []
+    iterate = Solver._iterate_one
+
+    def counted(self, t, z):
+        at.append(float(t[0]))
+        return iterate(self, t, z)
+
+    monkeypatch.setattr(Solver, "_iterate_one", counted)
+    model = pam2exu.load(ROOT / "examples" / "four_bar.toml")
+    res = pam2exu.run(model, analysis="kinematic", steps=100, backend="natural")
+    assert at.count(0.0) == 1 and len(res.t) == 101
