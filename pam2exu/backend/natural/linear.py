@@ -71,17 +71,17 @@ class LinearSolves:
                 return x
         return self._least_squares(data, b)
 
-    def solve_one(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """``solve`` at one step (data (nnz,), b (m,) -> x (nz,)): the same LAPACK solve of the
-        same matrix where ``solve`` takes numpy's dense one, with fewer calls around it."""
+    def solve_one(self, J: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """``solve`` at one step (J (m, nz) dense, b (m,) -> x (nz,)): the same LAPACK solve of
+        the same matrix where ``solve`` takes numpy's dense one, with fewer calls around it."""
         terms = self.terms
         if not self.least_squares and terms.nz and (
                 terms.nz < SPARSE_FROM or terms.nz ** 2 <= DENSE_WORK):
             try:
-                return np.linalg.solve(terms.dense_one(data), b)
+                return np.linalg.solve(J, b)
             except np.linalg.LinAlgError:
                 pass
-        return self.solve(data[None], b[None])[0]
+        return self.solve(J[terms.rows, terms.cols][None], b[None])[0]
 
     def _least_squares(self, data, b):
         """The minimum-norm least-squares x of Φ_z x = b per step (SVD); NaN where a square
@@ -124,7 +124,7 @@ class LinearSolves:
             return self._ordered[1]
         m, N = self.terms.m, len(z)
         if N == 1:
-            order = _pivot_order(self.terms.dense_one(self.terms.jacobian_one(z[0])))
+            order = _pivot_order(self.terms.jacobian_one(z[0]))
             order = (self.order if order is None else order)[None]
             self._ordered = (key, order)
             return order
@@ -154,13 +154,7 @@ class LinearSolves:
         the memory of the Jacobians."""
         terms = self.terms
         if len(t) == 1 and terms.nz:              # one step (the coarse pass's)
-            data = terms.jacobian_one(z[0])
-            b = np.zeros(terms.m)
-            if terms.laws:
-                b[terms.law_rows] = terms.targets(t, 1)[:, 0]
-            zd = self.solve_one(data, b)
-            g2 = terms.targets(t, 2)[:, 0] if terms.laws else None
-            return zd[None], self.solve_one(data, terms.gamma_one(z[0], zd, g2))[None]
+            return tuple(x[None] for x in self.rates_one(t, z[0]))
         zd, zdd = np.empty_like(z), np.empty_like(z)
         rows = self.rows_per_chunk()
         for a in range(0, len(t), rows):
@@ -169,6 +163,18 @@ class LinearSolves:
             zd[s] = self.solve(data, terms.velocity_rhs(t[s]))
             zdd[s] = self.solve(data, terms.gamma(t[s], z[s], zd[s]))
         return zd, zdd
+
+    def rates_one(self, t, z):
+        """(ż, z̈) (nz,) at one step (t (1,), z (nz,) solved, nz > 0): ``rates``' arithmetic
+        on 1-D arrays."""
+        terms = self.terms
+        J = terms.jacobian_one(z)
+        b = np.zeros(terms.m)
+        if terms.laws:
+            b[terms.law_rows] = terms.targets(t, 1)[:, 0]
+        zd = self.solve_one(J, b)
+        g2 = terms.targets(t, 2)[:, 0] if terms.laws else None
+        return zd, self.solve_one(J, terms.gamma_one(z, zd, g2))
 
     def _bulk(self, t, z, order, iterations: int = 4):
         """(z, ż, z̈, ok) for a block of steps of a small square system from good guesses

@@ -175,8 +175,8 @@ class Solver(LinearSolves):
         g = terms.targets(t, 0)
         g1 = g[:, 0]
         for _ in range(self.settings.max_iterations):
-            phi, data = terms.residual_jacobian_one(x, g1)
-            dz = self.solve_one(data, -phi)
+            phi, J = terms.residual_jacobian_one(x, g1)
+            dz = self.solve_one(J, -phi)
             step = float((np.abs(dz) * w).max(initial=0.0))   # exact: the same max
             small = step <= tol or (not self.least_squares and next_below(step, last, tol))
             # Φ within round-off of its terms: it decides only a step that did not
@@ -308,11 +308,10 @@ class Solver(LinearSolves):
             k = j
         return intervals, len(t)
 
-    def _keep_rates(self, t, z, *steps: int):
-        """Solve and keep the rates at these steps (solved)."""
-        at = list(steps)
-        self.zd[at], self.zdd[at] = self.rates(t[at], z[at])
-        self.own_rates[at] = True
+    def _keep_rates(self, t, z, j: int):
+        """Solve and keep the rates at the step j (solved)."""
+        self.zd[j], self.zdd[j] = self.rates_one(t[j:j + 1], z[j])
+        self.own_rates[j] = True
 
     def _fill(self, t, z, intervals) -> list[int]:
         """Solve the steps inside every interval at once from cubic Hermite guesses; the

@@ -116,6 +116,10 @@ class Terms:
         edges = np.cumsum([0, len(self.pa), len(self.pb), len(self.sb), len(self.sa)])
         self._parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
         self._both_index = np.concatenate([self.row_index, self.m + self.entry_index])
+        # the same sums straight into a dense Φ_z (m, nz), row by row (``*_one``): each
+        # position gets its entry's terms in the same order
+        self._dense_index = (self.rows * nz + self.cols)[self.entry_index]
+        self._both_dense = np.concatenate([self.row_index, self.m + self._dense_index])
 
     # ---- evaluation: one column per step --------------------------------------------------
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
@@ -187,10 +191,16 @@ class Terms:
         return out
 
     def magnitude_at(self, scales: np.ndarray) -> np.ndarray:
-        """Σ |terms| per row (m,) with every coordinate at its scale (nz,)."""
-        x = np.r_[scales, 1.0][:, None]
-        values = np.concatenate([self._apc * x[self.pa] * x[self.pb], self._asc * x[self.sa]])
-        return self._sum(values, "row")[:, 0]
+        """Σ |terms| per row (m,) with every coordinate at its scale (nz,); the last answer is
+        kept (a run's assembly and its steps ask with the same scales; not to be modified)."""
+        key = scales.tobytes()
+        kept = self.__dict__.get("_magnitude_at")
+        if kept is None or kept[0] != key:
+            x = np.r_[scales, 1.0][:, None]
+            values = np.concatenate([self._apc * x[self.pa] * x[self.pb],
+                                     self._asc * x[self.sa]])
+            kept = self._magnitude_at = (key, self._sum(values, "row")[:, 0])
+        return kept[1]
 
     def jacobian_cols(self, z: np.ndarray) -> np.ndarray:
         """Φ_z as data (nnz, n) on the pattern (``rows``, ``cols``)."""
@@ -233,9 +243,10 @@ class Terms:
     # in the same order, the same bincount): the same bits, with fewer numpy calls.
     def residual_jacobian_one(self, z: np.ndarray, g: np.ndarray | None = None
                               ) -> tuple[np.ndarray, np.ndarray]:
-        """(Φ (m,), Φ_z data (nnz,)) at one configuration z (nz,): ``residual_jacobian_cols``'
-        column; g: ``targets(t, 0)[:, 0]`` of the step (its laws' rows). Every product is
-        made once over all terms and the summed ones picked by one index (``_one_pick``)."""
+        """(Φ (m,), Φ_z (m, nz) dense) at one configuration z (nz,): ``residual_jacobian_cols``'
+        column, Φ_z's data on its pattern; g: ``targets(t, 0)[:, 0]`` of the step (its laws'
+        rows). Every product is made once over all terms and the summed ones picked by one
+        index (``_one_pick``)."""
         P, S = len(self.pa), len(self.sa)
         x = np.empty(self.nz + 1)
         x[:self.nz] = z
@@ -246,15 +257,16 @@ class Terms:
         sin, cs = np.sin(arg), self.sc * gathered[2 * P + S:]
         values = np.concatenate([ab[:P] * gathered[P:2 * P], cs * sin, ab, self.sc * sin,
                                  cs * np.cos(arg)])
-        both = np.bincount(self._both_index, weights=values[self._one_pick],
-                           minlength=self.m + len(self.rows))
+        both = np.bincount(self._both_dense, weights=values[self._one_pick],
+                           minlength=self.m * (1 + self.nz))
         out = both[:self.m]
         if self.laws:
             out[self.law_rows] -= g
-        return out, both[self.m:]
+        return out, both[self.m:].reshape(self.m, self.nz)
 
     def jacobian_one(self, z: np.ndarray) -> np.ndarray:
-        """Φ_z data (nnz,) at one configuration z (nz,): ``jacobian_cols``' column."""
+        """Φ_z (m, nz) dense at one configuration z (nz,): ``jacobian_cols``' column, on its
+        pattern."""
         x = np.empty(self.nz + 1)
         x[:self.nz] = z
         x[self.nz] = 1.0
@@ -262,13 +274,8 @@ class Terms:
             self._jp_c1 * x[self._jp_i],
             self._js_c1 * np.sin(x[self._js_b] + self._js_alpha1),
             self._jc_c1 * x[self._jc_a] * np.cos(x[self._jc_b] + self._jc_alpha1)])
-        return np.bincount(self.entry_index, weights=values, minlength=len(self.rows))
-
-    def dense_one(self, data: np.ndarray) -> np.ndarray:
-        """Φ_z (m, nz) from its data (nnz,) at one step."""
-        J = np.zeros((self.m, self.nz))
-        J[self.rows, self.cols] = data
-        return J
+        return np.bincount(self._dense_index, weights=values,
+                           minlength=self.m * self.nz).reshape(self.m, self.nz)
 
     def gamma_one(self, z: np.ndarray, zd: np.ndarray, g2: np.ndarray | None) -> np.ndarray:
         """γ (m,) at one step: ``gamma_cols``' column; g2: ``targets(t, 2)[:, 0]``."""
