@@ -269,7 +269,8 @@ class Natural(Backend):
             fi[c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
             raw[:, s] = np.arctan2(pose[4 * free + 3], pose[4 * free + 2])
         if free.size:
-            raw = np.unwrap(raw, axis=1)
+            if len(z) > 1:                               # (one step: nothing to unwrap)
+                raw = np.unwrap(raw, axis=1)
             raw += 2 * np.pi * np.rint((start[ANGLES][free] - raw[:, 0]) / (2 * np.pi))[:, None]
             qT[column(free, 2)] = raw
         return qT.T
