@@ -176,3 +176,23 @@ def test_the_run_starts_from_the_assembly_it_solved(monkeypatch):
     model = pam2exu.load(ROOT / "examples" / "four_bar.toml")
     res = pam2exu.run(model, analysis="kinematic", steps=100, backend="natural")
     assert at.count(0.0) == 1 and len(res.t) == 101
+
+
+def test_a_run_asks_its_law_once(four_bar_mech):
+    """A 101-step run evaluates the actuator's law once, at all its times (``tabulate``): its
+    coarse steps and its fill read their rows (before: once per coarse step and once for
+    the fill), the same values as an evaluation at those times alone."""
+    form, solver = solver_of(four_bar_mech)
+    terms = form.terms
+    r, law, power = terms.laws[0]
+    counted = CountedLaw(law)
+    terms.laws[0] = (r, counted, power)
+    t = np.linspace(0.0, 1.0, 101)
+    z0, _ = solver.newton(t[:1], form.from_q(four_bar_mech.initial_q()[None]))
+    counted.calls = 0
+    z, solved = solver.run(t, z0[0])
+    assert solved == len(t) and counted.calls == 1
+    for rows in ([37], [3, 50, 99]):
+        for order in range(3):
+            assert terms.targets(t[rows], order).tobytes() == \
+                np.array([law(t[rows])[order]]).tobytes()

@@ -260,6 +260,7 @@ class Solver(LinearSolves):
         self.miss = np.zeros(n)
         if self._batched() and self.terms.m:     # the order at the start: ``solve``
             self.order = self.pivot_orders(z0[None])[0]
+        self.terms.tabulate(t)                   # the laws at every step, once
         if n < SHORT:
             return self._sequential(t, z, 0, n)
         stride = max(4, n // COARSE)

@@ -68,6 +68,7 @@ class Terms:
         self.row_index = np.concatenate([self.pr, self.sr])
         self.law_rows = np.array([r for r, _, _ in self.laws], dtype=int)
         self._last_times, self._last_laws = None, []
+        self._table = None                   # ``tabulate``
         # the terms' constants as columns, kept (evaluations broadcast them over the steps)
         self._pc, self._sc, self._alpha = self.pc[:, None], self.sc[:, None], self.salpha[:, None]
         self._apc, self._asc = np.abs(self._pc), np.abs(self._sc)
@@ -147,10 +148,28 @@ class Terms:
         flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
         return np.bincount(flat, weights=values.ravel(), minlength=size * n).reshape(size, n)
 
+    def tabulate(self, t: np.ndarray) -> None:
+        """Evaluate the laws once at all the times t of a run (ascending): a later ask at one
+        of them (``_law_values``, a step of the coarse pass) reads its row, the same values (a
+        law's value at a time does not depend on the times evaluated beside it)."""
+        self._table = (t, [law(t) for _, law, _ in self.laws]) \
+            if self.laws and len(t) > 1 else None
+
     def _law_values(self, t: np.ndarray) -> list:
-        """[(f, f', f'')] of every law at the times t; for a few steps, the values at the
-        times last asked are kept (a step's Newton iteration, velocities and accelerations
-        ask for the same times)."""
+        """[(f, f', f'')] of every law at the times t; one of the times ``tabulate`` was
+        given is read from its table; for a few steps, the values at the times last asked
+        are kept (a step's Newton iteration, velocities and accelerations ask for the same
+        times)."""
+        if self._table is not None and len(t) <= BINCOUNT_STEPS:
+            times, values = self._table
+            if len(t) == 1:                      # a slice: no index array
+                i = int(np.searchsorted(times, t[0]))
+                if i < len(times) and times[i] == t[0]:
+                    return [(f[i:i + 1], df[i:i + 1], ddf[i:i + 1]) for f, df, ddf in values]
+            else:
+                i = np.minimum(np.searchsorted(times, t), len(times) - 1)
+                if np.array_equal(times[i], t):
+                    return [(f[i], df[i], ddf[i]) for f, df, ddf in values]
         if len(t) > BINCOUNT_STEPS:
             return [law(t) for _, law, _ in self.laws]
         key = np.asarray(t, dtype=float).tobytes()
