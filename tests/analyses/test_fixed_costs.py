@@ -143,3 +143,18 @@ def test_the_pivot_order_at_one_configuration_is_the_batched_one(natural_solver)
     assert any((o != np.arange(form.m)).any() for o in batched)
     for k, zk in enumerate(many):
         assert (solver.pivot_orders(zk[None])[0] == batched[k]).all()
+
+
+def test_a_singular_step_gives_nan_quietly(natural_solver):
+    """At a configuration where Φ_z is singular (every coordinate 0), Newton at one step
+    fails and the rates at one step are NaN, as a batch's (least squares: NaN), without a
+    numpy warning (the one-step solves run LAPACK's gesv without numpy's wrapper)."""
+    form, solver, _ = natural_solver
+    t, z = np.array([0.01]), np.zeros((1, form.nz))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        zd, zdd = solver.rates(t, z)
+        many = solver.rates(np.r_[t, t], np.r_[z, z])
+        _, ok = solver.newton(t, z)
+    assert np.isnan(zd).all() and np.isnan(zdd).all() and not ok[0]
+    assert np.isnan(many[0]).all() and np.isnan(many[1]).all()
