@@ -165,7 +165,8 @@ class LinearSolves:
         the memory of the Jacobians."""
         terms = self.terms
         if len(t) == 1 and terms.nz:              # one step (the coarse pass's)
-            return tuple(x[None] for x in self.rates_one(t, z[0]))
+            with np.errstate(all="ignore"):       # a singular Φ_z: NaN
+                return tuple(x[None] for x in self.rates_one(t, z[0]))
         zd, zdd = np.empty_like(z), np.empty_like(z)
         rows = self.rows_per_chunk()
         for a in range(0, len(t), rows):
@@ -177,16 +178,15 @@ class LinearSolves:
 
     def rates_one(self, t, z):
         """(ż, z̈) (nz,) at one step (t (1,), z (nz,) solved, nz > 0): ``rates``' arithmetic
-        on 1-D arrays."""
+        on 1-D arrays (under ``numpy.errstate(all="ignore")``: a singular Φ_z gives NaN)."""
         terms = self.terms
         J = terms.jacobian_one(z)
         b = np.zeros(terms.m)
         if terms.laws:
             b[terms.law_rows] = terms.targets(t, 1)[:, 0]
         g2 = terms.targets(t, 2)[:, 0] if terms.laws else None
-        with np.errstate(all="ignore"):               # a singular Φ_z: NaN
-            zd = self.solve_one(J, b)
-            return zd, self.solve_one(J, terms.gamma_one(z, zd, g2))
+        zd = self.solve_one(J, b)
+        return zd, self.solve_one(J, terms.gamma_one(z, zd, g2))
 
     def _bulk(self, t, z, order, iterations: int = 4):
         """(z, ż, z̈, ok) for a block of steps of a small square system from good guesses

@@ -283,6 +283,11 @@ class Solver(LinearSolves):
         every ``stride`` steps (fewer where the motion is fast), each from the Taylor
         predictor z + h ż + h²/2 z̈; their rates kept. intervals: (k, j, miss) to fill in;
         end: the first step not solved (len(t) when all are)."""
+        with np.errstate(all="ignore"):          # entered once (Newton, the rates)
+            return self._coarse_steps(t, z, k, last, stride)
+
+    def _coarse_steps(self, t, z, k: int, last: int, stride: int):
+        """``_coarse``' loop."""
         base, intervals = stride, []
         longest = max(base, min(COARSE_LONGEST * base, COARSE_LONGEST_STEPS))
         while k < last:
@@ -296,21 +301,21 @@ class Solver(LinearSolves):
                 continue
             h = t[j] - t[k]
             guess = z[k] + h * self.zd[k] + 0.5 * h * h * self.zdd[k]
-            zj, ok = self.newton(t[j:j + 1], guess[None])
-            miss = float((np.abs(zj[0] - guess) * self.w).max()) if ok[0] else np.inf
+            zj, ok = self._iterate_one(t[j:j + 1], guess[None])      # ``newton`` at one time
+            miss = float((np.abs(zj - guess) * self.w).max()) if ok else np.inf
             if miss > COARSE_MISS:             # a shorter interval
                 stride = max(1, stride // 4)
                 continue
             if miss < COARSE_MISS / COARSE_GROW:
                 stride = min(longest, 2 * stride)
-            z[j] = zj[0]
+            z[j] = zj
             self._keep_rates(t, z, j)
             intervals.append((k, j, miss))
             k = j
         return intervals, len(t)
 
     def _keep_rates(self, t, z, j: int):
-        """Solve and keep the rates at the step j (solved)."""
+        """Solve and keep the rates at the step j (solved; under ``numpy.errstate``)."""
         self.zd[j], self.zdd[j] = self.rates_one(t[j:j + 1], z[j])
         self.own_rates[j] = True
 

@@ -156,26 +156,32 @@ class Terms:
             if self.laws and len(t) > 1 else None
 
     def _law_values(self, t: np.ndarray) -> list:
-        """[(f, f', f'')] of every law at the times t; one of the times ``tabulate`` was
-        given is read from its table; for a few steps, the values at the times last asked
-        are kept (a step's Newton iteration, velocities and accelerations ask for the same
-        times)."""
-        if self._table is not None and len(t) <= BINCOUNT_STEPS:
-            times, values = self._table
-            if len(t) == 1:                      # a slice: no index array
-                i = int(np.searchsorted(times, t[0]))
-                if i < len(times) and times[i] == t[0]:
-                    return [(f[i:i + 1], df[i:i + 1], ddf[i:i + 1]) for f, df, ddf in values]
-            else:
-                i = np.minimum(np.searchsorted(times, t), len(times) - 1)
-                if np.array_equal(times[i], t):
-                    return [(f[i], df[i], ddf[i]) for f, df, ddf in values]
+        """[(f, f', f'')] of every law at the times t; for a few steps, the values at the
+        times last asked are kept (a step's Newton iteration, velocities and accelerations
+        ask for the same times), and times ``tabulate`` was given are read from its table."""
         if len(t) > BINCOUNT_STEPS:
             return [law(t) for _, law, _ in self.laws]
         key = np.asarray(t, dtype=float).tobytes()
         if self._last_times != key:
-            self._last_times, self._last_laws = key, [law(t) for _, law, _ in self.laws]
+            self._last_times, self._last_laws = key, self._tabulated(t) or \
+                [law(t) for _, law, _ in self.laws]
         return self._last_laws
+
+    def _tabulated(self, t: np.ndarray) -> list | None:
+        """``_law_values`` at times t from the table of ``tabulate`` (None where it has not
+        all of them)."""
+        if self._table is None:
+            return None
+        times, values = self._table
+        if len(t) == 1:                          # a slice: no index array
+            i = int(np.searchsorted(times, t[0]))
+            if i < len(times) and times[i] == t[0]:
+                return [(f[i:i + 1], df[i:i + 1], ddf[i:i + 1]) for f, df, ddf in values]
+            return None
+        i = np.minimum(np.searchsorted(times, t), len(times) - 1)
+        if np.array_equal(times[i], t):
+            return [(f[i], df[i], ddf[i]) for f, df, ddf in values]
+        return None
 
     def targets(self, t: np.ndarray, order: int) -> np.ndarray:
         """g^(order)(t) (laws, n) of the rows with a law (``law_rows``): g = f or f²."""
