@@ -1,9 +1,9 @@
 """What a run evaluates once (issue 25, the per-run fixed costs), checked by counting the
 evaluations and comparing bits, never by time: the mobility check's one evaluation of the
 equations at the guess, a short run's condition numbers from the Jacobian the rates were
-computed with, the natural backend's one-pass Φ and Φ_z for a few steps. References: the
-same quantities evaluated separately (``native.equations``, ``Terms.residual_cols`` and
-``jacobian_cols``)."""
+computed with, the natural backend's one-pass Φ and Φ_z for a few steps and at one step
+(Newton step by step). References: the same quantities evaluated separately
+(``native.equations``, ``Terms.residual_cols`` and ``jacobian_cols``, a batch of steps)."""
 from __future__ import annotations
 
 import warnings
@@ -67,7 +67,7 @@ def test_a_short_run_takes_its_condition_numbers_from_the_rates_jacobian(four_ba
     assert res.info["max_condition_number"] == float(np.max(apart))
 
 
-@pytest.mark.parametrize("steps", [1, 7, 32, 33, 40])
+@pytest.mark.parametrize("steps", [1, 7, 32, 33, 40, 257, 300])
 def test_phi_and_its_jacobian_in_one_pass_are_the_separate_bits(four_bar, steps):
     """``residual_jacobian_cols`` (one gather, one bincount for a few steps) gives Φ and
     Φ_z bit for bit as ``residual_cols`` and ``jacobian_cols``."""
@@ -80,3 +80,81 @@ def test_phi_and_its_jacobian_in_one_pass_are_the_separate_bits(four_bar, steps)
     phi, data = terms.residual_jacobian_cols(t, z)
     assert phi.tobytes() == terms.residual_cols(t, z).tobytes()
     assert data.tobytes() == terms.jacobian_cols(z).tobytes()
+
+
+@pytest.fixture(scope="module", params=["four_bar", "slider_crank", "chain_4"])
+def natural_solver(request):
+    """(formulation, Solver, z near the assembly (nz, 3)) of a model."""
+    from benchmarks.cases import chain_model
+    from pam2exu.backend.natural.solver import NaturalSettings, Solver
+    model = chain_model(4) if request.param == "chain_4" else \
+        pam2exu.load(ROOT / "examples" / f"{request.param}.toml")
+    mech = model.mechanism()
+    backend = Natural()
+    form = backend.formulation(mech)
+    solver = Solver(form.terms, backend.weights(form, mech), NaturalSettings(), False)
+    rng = np.random.default_rng(7)
+    z = form.from_q(mech.initial_q()[None]).T + 0.01 * rng.standard_normal((form.nz, 3))
+    return form, solver, z
+
+
+def test_one_step_evaluations_are_their_column_of_many(natural_solver):
+    """Φ, Φ_z and γ at one step (``residual_jacobian_one``, ``jacobian_one``,
+    ``gamma_one``: 1-D arrays, for Newton step by step) are, bit for bit, that step's
+    column of the evaluation of three steps (``*_cols``)."""
+    form, _, z = natural_solver
+    terms = form.terms
+    t = np.array([0.01, 0.02, 0.05])
+    zd = np.cos(z)                                   # any rates
+    phi, data = terms.residual_jacobian_cols(t, z)
+    gamma = terms.gamma_cols(t, z, zd)
+    g0, g2 = terms.targets(t, 0), terms.targets(t, 2)
+    for k in range(3):
+        phi1, J1 = terms.residual_jacobian_one(z[:, k], g0[:, k])
+        dense = terms.dense_cols(data[:, k:k + 1])[:, :, 0]
+        assert phi1.tobytes() == phi[:, k].tobytes()
+        assert J1.tobytes() == dense.tobytes()
+        assert terms.jacobian_one(z[:, k]).tobytes() == dense.tobytes()
+        assert terms.gamma_one(z[:, k], zd[:, k], g2[:, k]).tobytes() == gamma[:, k].tobytes()
+
+
+def test_newton_and_rates_at_one_step_are_the_batch_bits(natural_solver):
+    """Newton's iteration and the rates at one step (the coarse pass's) give, bit for bit,
+    what the same step gives solved in a batch of two (numpy's batched dense solve)."""
+    form, solver, z = natural_solver
+    t = np.array([0.02])
+    one, ok = solver.newton(t, z[:, :1].T)
+    two, ok2 = solver.newton(np.r_[t, t], np.repeat(z[:, :1].T, 2, axis=0))
+    assert ok[0] and ok2.all()
+    assert one[0].tobytes() == two[0].tobytes()
+    zd, zdd = solver.rates(t, one)
+    zd2, zdd2 = solver.rates(np.r_[t, t], np.repeat(one, 2, axis=0))
+    assert zd[0].tobytes() == zd2[0].tobytes() and zdd[0].tobytes() == zdd2[0].tobytes()
+
+
+def test_the_pivot_order_at_one_configuration_is_the_batched_one(natural_solver):
+    """The equations' pivot order at the run's start (one configuration, eliminated in 2-D)
+    is the batched elimination's (``batched.lu_factor``) for that configuration, exchanges
+    included."""
+    form, solver, z = natural_solver
+    rng = np.random.default_rng(3)
+    many = np.concatenate([z.T, z.T[:1] + rng.standard_normal((20, form.nz))])
+    batched = solver.pivot_orders(many)
+    assert any((o != np.arange(form.m)).any() for o in batched)
+    for k, zk in enumerate(many):
+        assert (solver.pivot_orders(zk[None])[0] == batched[k]).all()
+
+
+def test_a_singular_step_gives_nan_quietly(natural_solver):
+    """At a configuration where Φ_z is singular (every coordinate 0), Newton at one step
+    fails and the rates at one step are NaN, as a batch's (least squares: NaN), without a
+    numpy warning (the one-step solves run LAPACK's gesv without numpy's wrapper)."""
+    form, solver, _ = natural_solver
+    t, z = np.array([0.01]), np.zeros((1, form.nz))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        zd, zdd = solver.rates(t, z)
+        many = solver.rates(np.r_[t, t], np.r_[z, z])
+        _, ok = solver.newton(t, z)
+    assert np.isnan(zd).all() and np.isnan(zdd).all() and not ok[0]
+    assert np.isnan(many[0]).all() and np.isnan(many[1]).all()

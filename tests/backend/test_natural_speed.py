@@ -15,6 +15,7 @@ from benchmarks.cases import chain_model
 from pam2exu.backend.natural import Natural
 from pam2exu.backend.natural.linear import SPARSE_FROM
 from pam2exu.backend.natural.solver import NaturalSettings, Solver
+from pam2exu.backend.natural.terms import BINCOUNT_STEPS
 from references.closed_form import FOUR_BAR, four_bar
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -101,16 +102,17 @@ def test_a_step_of_a_larger_system_is_solved_dense():
 
 def test_few_steps_sum_to_the_same_bits_as_many(four_bar_mech):
     """Φ, Φ_z and γ of one step (summed by bincount) equal, bit for bit, that step's column
-    of a 40-step evaluation (summed by the sparse matrix): a run's results do not depend
-    on how its steps are grouped."""
+    of an evaluation of more than BINCOUNT_STEPS steps (summed by the sparse matrix): a
+    run's results do not depend on how its steps are grouped."""
     form, _ = solver_of(four_bar_mech)
     terms = form.terms
+    n = BINCOUNT_STEPS + 8
     rng = np.random.default_rng(7)
-    z = form.from_q(four_bar_mech.initial_q()[None]).T + 0.1 * rng.standard_normal((form.nz, 40))
-    zd = rng.standard_normal((form.nz, 40))
-    t = np.linspace(0.0, 0.5, 40)
+    z = form.from_q(four_bar_mech.initial_q()[None]).T + 0.1 * rng.standard_normal((form.nz, n))
+    zd = rng.standard_normal((form.nz, n))
+    t = np.linspace(0.0, 0.5, n)
     many = (terms.residual_cols(t, z), terms.jacobian_cols(z), terms.gamma_cols(t, z, zd))
-    for k in (0, 17, 39):
+    for k in (0, 17, n - 1):
         s = slice(k, k + 1)
         few = (terms.residual_cols(t[s], z[:, s]), terms.jacobian_cols(z[:, s]),
                terms.gamma_cols(t[s], z[:, s], zd[:, s]))
@@ -131,3 +133,66 @@ def test_a_large_system_gets_its_rates_with_its_positions():
     zd, zdd = solver.rates(t, z)
     for mine, fresh in ((solver.zd, zd), (solver.zdd, zdd)):
         assert np.max(np.abs(mine - fresh)) <= 1e-10 * np.max(np.abs(fresh))
+
+
+def test_newton_stops_where_quadratic_convergence_says_the_next_step_is_below(
+        four_bar_mech, monkeypatch):
+    """Newton at one time stops after the step whose successor, step³ / last², would be 1000
+    times below the tolerance (the iteration that would only confirm it is not taken): a
+    coarse step of the four-bar takes 3 iterations instead of 4, and lands within round-off
+    of the 4-iteration answer."""
+    from pam2exu.backend.natural import solver as solver_module
+    form, solver = solver_of(four_bar_mech)
+    z0 = form.from_q(four_bar_mech.initial_q()[None])
+    t = np.array([0.0, 0.04])
+    start, _ = solver.newton(t[:1], z0)
+    zd, zdd = solver.rates(t[:1], start)
+    h = t[1] - t[0]
+    guess = start + h * zd + 0.5 * h * h * zdd            # the coarse pass's predictor
+    answers = {}
+    for converged in (solver_module.CONVERGED, 0.0):     # 0: every step must be below tol
+        monkeypatch.setattr(solver_module, "CONVERGED", converged)
+        solver.iterations = 0
+        z, ok = solver.newton(t[1:], guess)
+        assert ok[0]
+        answers[converged] = (z[0], solver.iterations)
+    (fast, n_fast), (slow, n_slow) = answers.values()
+    assert (n_fast, n_slow) == (3, 4)
+    assert np.max(np.abs(fast - slow) * solver.w) <= 1e-15
+
+
+def test_the_run_starts_from_the_assembly_it_solved(monkeypatch):
+    """The run after the assembly starts from the assembly's natural coordinates (its angle
+    coordinates those of the start, whole turns added) instead of solving t0 again: Newton
+    at t0 once a run (before: twice)."""
+    at = []
+    iterate = Solver._iterate_one
+
+    def counted(self, t, z):
+        at.append(float(t[0]))
+        return iterate(self, t, z)
+
+    monkeypatch.setattr(Solver, "_iterate_one", counted)
+    model = pam2exu.load(ROOT / "examples" / "four_bar.toml")
+    res = pam2exu.run(model, analysis="kinematic", steps=100, backend="natural")
+    assert at.count(0.0) == 1 and len(res.t) == 101
+
+
+def test_a_run_asks_its_law_once(four_bar_mech):
+    """A 101-step run evaluates the actuator's law once, at all its times (``tabulate``): its
+    coarse steps and its fill read their rows (before: once per coarse step and once for
+    the fill), the same values as an evaluation at those times alone."""
+    form, solver = solver_of(four_bar_mech)
+    terms = form.terms
+    r, law, power = terms.laws[0]
+    counted = CountedLaw(law)
+    terms.laws[0] = (r, counted, power)
+    t = np.linspace(0.0, 1.0, 101)
+    z0, _ = solver.newton(t[:1], form.from_q(four_bar_mech.initial_q()[None]))
+    counted.calls = 0
+    z, solved = solver.run(t, z0[0])
+    assert solved == len(t) and counted.calls == 1
+    for rows in ([37], [3, 50, 99]):
+        for order in range(3):
+            assert terms.targets(t[rows], order).tobytes() == \
+                np.array([law(t[rows])[order]]).tobytes()

@@ -49,6 +49,9 @@ class Natural(Backend):
 
     def __init__(self, answered: Answered | None = None):
         self._forms: dict = {}
+        #: (formulation, t0, tolerance, q, z) of the last plain solve's first step
+        #: (``_solved_start``)
+        self._solved = None
         #: a run solved beforehand with other variants (``variants.Answered``): the positions
         #: it asks for exactly are read from it, not solved again
         self.answered = answered
@@ -82,22 +85,25 @@ class Natural(Backend):
         solver = Solver(form.terms, w, settings, least_squares=redundant)
         n = len(times)
         q = np.full((n, mech.nq), np.nan)
-        z_start = form.from_q(start)[0]
-        try:
-            if anchor_stiffness > 0:
-                z0 = self._anchored(form, mech, times[0], z_start, settings, w)
-            else:
-                found, ok = solver.newton(times[:1], z_start[None])
-                z1, ok = found[0], ok[0]
-                if not ok:                     # a poor guess: shorter steps
-                    z1, ok = solver.damped(times[0], z_start)
-                z0 = z1 if ok else None
-        except SolverError as exc:
-            return Positions(q, 0, str(exc), start)
-        if z0 is None:                   # where Newton stopped: the diagnosis starts there
-            last = self.to_q(form, mech, z1[None], start)[0]
-            return Positions(q, 0, self._failed(form, solver, times[0], z1, settings),
-                             last if np.isfinite(last).all() else start)
+        plain = not (redundant or anchor_stiffness)
+        z0 = self._solved_start(form, times[0], start, settings) if plain else None
+        if z0 is None:
+            z_start = form.from_q(start)[0]
+            try:
+                if anchor_stiffness > 0:
+                    z0 = self._anchored(form, mech, times[0], z_start, settings, w)
+                else:
+                    found, ok = solver.newton(times[:1], z_start[None])
+                    z1, ok = found[0], ok[0]
+                    if not ok:                     # a poor guess: shorter steps
+                        z1, ok = solver.damped(times[0], z_start)
+                    z0 = z1 if ok else None
+            except SolverError as exc:
+                return Positions(q, 0, str(exc), start)
+            if z0 is None:               # where Newton stopped: the diagnosis starts there
+                last = self.to_q(form, mech, z1[None], start)[0]
+                return Positions(q, 0, self._failed(form, solver, times[0], z1, settings),
+                                 last if np.isfinite(last).all() else start)
         if form.nz == 0:                 # every solid held: nothing moves, nothing to solve
             z, solved = np.zeros((n, 0)), n
         else:
@@ -109,8 +115,33 @@ class Natural(Backend):
         if rates and solved:
             zd, zdd = (solver.run_rates(times[:solved], z[:solved]) if form.nz
                        else (z[:solved], z[:solved]))
-        return self._found(form, mech, times, start, z[:solved], forces, rates, zd, zdd,
-                           error, solver.iterations)
+        found = self._found(form, mech, times, start, z[:solved], forces, rates, zd, zdd,
+                            error, solver.iterations)
+        if plain and solved:
+            self._solved = (form, float(times[0]), settings.tolerance, found.q[0].copy(),
+                            z[0].copy())
+        return found
+
+    def _solved_start(self, form, t0, start, settings):
+        """z at t0 already solved for ``start`` by this backend's last run (the assembly the
+        analysis starts from: its q, whole turns added to angles), else None: the run does not
+        solve it again (its z, its angle coordinates those of ``start``)."""
+        if self._solved is None:
+            return None
+        kept_form, t, tolerance, q, z = self._solved
+        if kept_form is not form or t != t0 or tolerance != settings.tolerance:
+            return None
+        turns = (start[ANGLES] - q[ANGLES]) / (2 * np.pi)
+        xy = np.ones(len(q), dtype=bool)
+        xy[ANGLES] = False
+        kind = self._angle_kinds(form)
+        fi = column(kind.coordinate, 2)
+        if not (np.array_equal(start[xy], q[xy]) and np.all(np.abs(turns - np.rint(turns)) <= 1e-9)
+                and np.array_equal(z[kind.columns], q[fi])):
+            return None
+        z0 = z.copy()
+        z0[kind.columns] = start[fi]
+        return z0
 
     def _found(self, form, mech, times, start, z, forces, rates, zd, zdd, error=None,
                iterations=0) -> Positions:
@@ -218,7 +249,7 @@ class Natural(Backend):
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
         value in the whole turn nearest ``start`` (in chunks of steps: bounded memory; one
         row per quantity inside, the step axis last)."""
-        K = _kept(form, "pose_sum", lambda: _summing(form.pose_forms()))
+        K = _kept(form, "pose_sum", lambda: _summing(_pose_forms(form)))
         kind = self._angle_kinds(form)
         qT = np.empty((mech.nq, len(z)))             # one row per x, y, fi
         free, c = kind.free, kind.coordinate
@@ -238,7 +269,8 @@ class Natural(Backend):
             fi[c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
             raw[:, s] = np.arctan2(pose[4 * free + 3], pose[4 * free + 2])
         if free.size:
-            raw = np.unwrap(raw, axis=1)
+            if len(z) > 1:                               # (one step: nothing to unwrap)
+                raw = np.unwrap(raw, axis=1)
             raw += 2 * np.pi * np.rint((start[ANGLES][free] - raw[:, 0]) / (2 * np.pi))[:, None]
             qT[column(free, 2)] = raw
         return qT.T
@@ -263,8 +295,8 @@ class Natural(Backend):
     def to_rates(self, form: Formulation, mech, z, zd, zdd):
         """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
         (in chunks of steps: bounded memory; one row per quantity inside)."""
-        K = _kept(form, "pose_sum", lambda: _summing(form.pose_forms()))
-        Kz = _kept(form, "pose_rate_sum", lambda: _summing(form.pose_forms()[:, :form.nz]))
+        K = _kept(form, "pose_sum", lambda: _summing(_pose_forms(form)))
+        Kz = _kept(form, "pose_rate_sum", lambda: _summing(_pose_forms(form)[:, :form.nz]))
         kind = self._angle_kinds(form)
         qdT, qddT = np.empty((mech.nq, len(z))), np.empty((mech.nq, len(z)))
         f, c = kind.free, kind.coordinate
@@ -297,6 +329,11 @@ def _kept(form: Formulation, name: str, make):
     if name not in kept:
         kept[name] = make()
     return kept[name]
+
+
+def _pose_forms(form: Formulation) -> np.ndarray:
+    """``form.pose_forms()``, made once per formulation (to_q and to_rates both sum it)."""
+    return _kept(form, "pose_forms", form.pose_forms)
 
 
 def _ext(zT: np.ndarray) -> np.ndarray:

@@ -85,11 +85,18 @@ class Expr:
             k = float(other)
             return Expr({key: c * k for key, c in self.products.items() if c * k},
                         {key: c * k for key, c in self.sines.items() if c * k})
-        out = Expr()
+        products: dict = {}
         for a, ca in self.linear().items():
             for b, cb in other.linear().items():
-                out = out + Expr({_key(a, b): ca * cb})
-        return out
+                # out + Expr({key: ca cb}) term after term: a sum that is 0 leaves the dict
+                # (and a later term enters at its end, as the sum's new dict would have it)
+                key = _key(a, b)
+                c = products.get(key, 0.0) + ca * cb
+                if c:
+                    products[key] = c
+                else:
+                    products.pop(key, None)
+        return Expr(products)
 
     __rmul__ = __mul__
 

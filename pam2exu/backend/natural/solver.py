@@ -60,6 +60,9 @@ BLOCK = 8192
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
 COARSE_GAP = 64
+#: Newton stops where quadratic convergence puts its next step below CONVERGED × tolerance
+#: (``next_below``): the answer is then as accurate as a step below the tolerance makes it
+CONVERGED = 1e-3
 #: the machine epsilon (the size of round-off relative to a value)
 EPS = float(np.finfo(float).eps)
 
@@ -72,7 +75,8 @@ class NaturalSettings:
     ----------
     tolerance : float
         Newton stops when its step is below this, relative to the mechanism's length (angles
-        and unit vectors: the step itself), or when the residual is at round-off.
+        and unit vectors: the step itself), when quadratic convergence puts its next step
+        1000 times below it (``next_below``), or when the residual is at round-off.
     max_iterations : int
         Newton iterations per step before the step is cut into sub-steps.
     verbose : int
@@ -82,6 +86,14 @@ class NaturalSettings:
     tolerance: float = 1e-13
     max_iterations: int = 25
     verbose: int = 0
+
+
+def next_below(step, last, tol: float):
+    """Whether Newton's next step, quadratic convergence's step³ / last², is below tol / 1000
+    (with the step below last / 1000: the convergence is quadratic); then the iterate after
+    this step is the answer, and the iteration that would only confirm it is not taken."""
+    return (step < 1e-3 * last) & (last < math.inf) & \
+        (step * step * step <= CONVERGED * tol * last * last)
 
 
 class Solver(LinearSolves):
@@ -119,6 +131,8 @@ class Solver(LinearSolves):
                 dz = self.solve(terms.jacobian(za), -phi)
                 step = np.max(np.abs(dz) * self.w, axis=1, initial=0.0)
                 small = step <= tol
+                if not self.least_squares:
+                    small |= next_below(step, last[active], tol)
                 # |Φ| relative to its terms: wanted where the step alone does not decide
                 ask = ~small | self.least_squares
                 size = np.zeros_like(phi)
@@ -159,18 +173,18 @@ class Solver(LinearSolves):
         done_below = max(64 * EPS, 100 * tol)
         last = np.inf
         g = terms.targets(t, 0)
+        g1 = g[:, 0]
         for _ in range(self.settings.max_iterations):
-            zc = x[:, None]
-            phi, data = terms.residual_jacobian_cols(t, zc, g)
-            phi = phi[:, 0]
-            dz = self.solve(data.T, -phi[None])[0]
+            phi, J = terms.residual_jacobian_one(x, g1)
+            dz = self.solve_one(J, -phi)
             step = float((np.abs(dz) * w).max(initial=0.0))   # exact: the same max
-            small = step <= tol
+            small = step <= tol or (not self.least_squares and next_below(step, last, tol))
             # Φ within round-off of its terms: it decides only a step that did not
             # shrink (``stalled``) or a least-squares one
             floor = True
             if self.least_squares or (not small and step > 0.7 * last):
-                magnitude = np.maximum(terms.magnitude_cols(t, zc, g)[:, 0], self.floor[:, 0])
+                magnitude = np.maximum(terms.magnitude_cols(t, x[:, None], g)[:, 0],
+                                       self.floor[:, 0])
                 size = np.divide(np.abs(phi), magnitude, out=np.abs(phi) * np.inf,
                                  where=magnitude > 0)
                 size[phi == 0] = 0.0
@@ -246,6 +260,7 @@ class Solver(LinearSolves):
         self.miss = np.zeros(n)
         if self._batched() and self.terms.m:     # the order at the start: ``solve``
             self.order = self.pivot_orders(z0[None])[0]
+        self.terms.tabulate(t)                   # the laws at every step, once
         if n < SHORT:
             return self._sequential(t, z, 0, n)
         stride = max(4, n // COARSE)
@@ -268,6 +283,11 @@ class Solver(LinearSolves):
         every ``stride`` steps (fewer where the motion is fast), each from the Taylor
         predictor z + h ż + h²/2 z̈; their rates kept. intervals: (k, j, miss) to fill in;
         end: the first step not solved (len(t) when all are)."""
+        with np.errstate(all="ignore"):          # entered once (Newton, the rates)
+            return self._coarse_steps(t, z, k, last, stride)
+
+    def _coarse_steps(self, t, z, k: int, last: int, stride: int):
+        """``_coarse``' loop."""
         base, intervals = stride, []
         longest = max(base, min(COARSE_LONGEST * base, COARSE_LONGEST_STEPS))
         while k < last:
@@ -281,24 +301,23 @@ class Solver(LinearSolves):
                 continue
             h = t[j] - t[k]
             guess = z[k] + h * self.zd[k] + 0.5 * h * h * self.zdd[k]
-            zj, ok = self.newton(t[j:j + 1], guess[None])
-            miss = float((np.abs(zj[0] - guess) * self.w).max()) if ok[0] else np.inf
+            zj, ok = self._iterate_one(t[j:j + 1], guess[None])      # ``newton`` at one time
+            miss = float((np.abs(zj - guess) * self.w).max()) if ok else np.inf
             if miss > COARSE_MISS:             # a shorter interval
                 stride = max(1, stride // 4)
                 continue
             if miss < COARSE_MISS / COARSE_GROW:
                 stride = min(longest, 2 * stride)
-            z[j] = zj[0]
+            z[j] = zj
             self._keep_rates(t, z, j)
             intervals.append((k, j, miss))
             k = j
         return intervals, len(t)
 
-    def _keep_rates(self, t, z, *steps: int):
-        """Solve and keep the rates at these steps (solved)."""
-        at = list(steps)
-        self.zd[at], self.zdd[at] = self.rates(t[at], z[at])
-        self.own_rates[at] = True
+    def _keep_rates(self, t, z, j: int):
+        """Solve and keep the rates at the step j (solved; under ``numpy.errstate``)."""
+        self.zd[j], self.zdd[j] = self.rates_one(t[j:j + 1], z[j])
+        self.own_rates[j] = True
 
     def _fill(self, t, z, intervals) -> list[int]:
         """Solve the steps inside every interval at once from cubic Hermite guesses; the

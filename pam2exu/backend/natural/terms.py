@@ -20,8 +20,10 @@ from .forms import ONE
 
 #: up to this many steps, terms are summed by ``numpy.bincount`` (one call, no sparse-matrix
 #: overhead); above, by the sparse summing matrix (``_summer``): both add each row's terms
-#: one after the other in the terms' order, so the two give the same bits
-BINCOUNT_STEPS = 32
+#: one after the other in the terms' order, so the two give the same bits. A short run's
+#: fill (86 steps of a 100-step run) stays below it and never builds the summing matrices
+#: (~0.1-0.3 ms each); the two sums cost alike at ~200 steps (four-bar, measured)
+BINCOUNT_STEPS = 256
 
 
 def _summer(index: np.ndarray, size: int) -> sparse.csr_matrix:
@@ -63,9 +65,10 @@ class Terms:
         self.pc = p[:, 3]
         self.sr, self.sa, self.sb = (s[:, k].astype(int) for k in range(3))
         self.salpha, self.sc = s[:, 3], s[:, 4]
-        self.row_index = np.r_[self.pr, self.sr]
+        self.row_index = np.concatenate([self.pr, self.sr])
         self.law_rows = np.array([r for r, _, _ in self.laws], dtype=int)
         self._last_times, self._last_laws = None, []
+        self._table = None                   # ``tabulate``
         # the terms' constants as columns, kept (evaluations broadcast them over the steps)
         self._pc, self._sc, self._alpha = self.pc[:, None], self.sc[:, None], self.salpha[:, None]
         self._apc, self._asc = np.abs(self._pc), np.abs(self._sc)
@@ -87,20 +90,37 @@ class Terms:
         # derivatives in one gather), then c sin(z_b + α) and c z_a cos(z_b + α)
         kb, ka = self.pa != nz, self.pb != nz
         ks, kc = self.sa != nz, self.sb != nz
-        self._jp_c = np.r_[self.pc[kb], self.pc[ka]][:, None]
-        self._jp_i = np.r_[self.pb[kb], self.pa[ka]]
+        self._jp_c = np.concatenate([self.pc[kb], self.pc[ka]])[:, None]
+        self._jp_i = np.concatenate([self.pb[kb], self.pa[ka]])
         self._js_c, self._js_b, self._js_alpha = self._sc[ks], self.sb[ks], self._alpha[ks]
         self._jc_c, self._jc_a, self._jc_b = self._sc[kc], self.sa[kc], self.sb[kc]
         self._jc_alpha = self._alpha[kc]
         self._keeps = (kb, ka, ks, kc)
-        self._jp_keep = np.r_[kb, ka]
+        # the same constants 1-D, for the evaluations at one step (``*_one``)
+        self._jp_c1, self._js_c1, self._js_alpha1, self._jc_c1, self._jc_alpha1 = (
+            a[:, 0] for a in (self._jp_c, self._js_c, self._js_alpha, self._jc_c,
+                              self._jc_alpha))
+        self._jp_keep = np.concatenate([kb, ka])
+        # ``residual_jacobian_one``: its values are [c z_a z_b, c z_a sin, c z_a, c z_b,
+        # c sin, c z_a cos] (products over all terms); the sums' weights pick, in the order of
+        # ``residual_jacobian_cols``, Φ's terms, then Φ_z's: c z_b, c z_a (kept), c sin (ks),
+        # c z_a cos (kc)
+        P, S = len(self.pa), len(self.sa)
+        self._pc2 = np.concatenate([self.pc, self.pc])
+        jp = np.concatenate([P + S + P + np.arange(P), P + S + np.arange(P)])[self._jp_keep]
+        self._one_pick = np.concatenate([np.arange(P + S), jp, 3 * P + S + np.nonzero(ks)[0],
+                                         3 * P + 2 * S + np.nonzero(kc)[0]])
         # ``residual_jacobian_cols``: the coordinates of every term in one gather, and the
         # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
         # adds the same terms in the same order as two calls)
-        self._gather = np.r_[self.pa, self.pb, self.sb, self.sa]
+        self._gather = np.concatenate([self.pa, self.pb, self.sb, self.sa])
         edges = np.cumsum([0, len(self.pa), len(self.pb), len(self.sb), len(self.sa)])
         self._parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
-        self._both_index = np.r_[self.row_index, self.m + self.entry_index]
+        self._both_index = np.concatenate([self.row_index, self.m + self.entry_index])
+        # the same sums straight into a dense Φ_z (m, nz), row by row (``*_one``): each
+        # position gets its entry's terms in the same order
+        self._dense_index = (self.rows * nz + self.cols)[self.entry_index]
+        self._both_dense = np.concatenate([self.row_index, self.m + self._dense_index])
 
     # ---- evaluation: one column per step --------------------------------------------------
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
@@ -128,16 +148,40 @@ class Terms:
         flat = index if n == 1 else (index[:, None] * n + np.arange(n)).ravel()
         return np.bincount(flat, weights=values.ravel(), minlength=size * n).reshape(size, n)
 
+    def tabulate(self, t: np.ndarray) -> None:
+        """Evaluate the laws once at all the times t of a run (ascending): a later ask at one
+        of them (``_law_values``, a step of the coarse pass) reads its row, the same values (a
+        law's value at a time does not depend on the times evaluated beside it)."""
+        self._table = (t, [law(t) for _, law, _ in self.laws]) \
+            if self.laws and len(t) > 1 else None
+
     def _law_values(self, t: np.ndarray) -> list:
         """[(f, f', f'')] of every law at the times t; for a few steps, the values at the
         times last asked are kept (a step's Newton iteration, velocities and accelerations
-        ask for the same times)."""
+        ask for the same times), and times ``tabulate`` was given are read from its table."""
         if len(t) > BINCOUNT_STEPS:
             return [law(t) for _, law, _ in self.laws]
         key = np.asarray(t, dtype=float).tobytes()
         if self._last_times != key:
-            self._last_times, self._last_laws = key, [law(t) for _, law, _ in self.laws]
+            self._last_times, self._last_laws = key, self._tabulated(t) or \
+                [law(t) for _, law, _ in self.laws]
         return self._last_laws
+
+    def _tabulated(self, t: np.ndarray) -> list | None:
+        """``_law_values`` at times t from the table of ``tabulate`` (None where it has not
+        all of them)."""
+        if self._table is None:
+            return None
+        times, values = self._table
+        if len(t) == 1:                          # a slice: no index array
+            i = int(np.searchsorted(times, t[0]))
+            if i < len(times) and times[i] == t[0]:
+                return [(f[i:i + 1], df[i:i + 1], ddf[i:i + 1]) for f, df, ddf in values]
+            return None
+        i = np.minimum(np.searchsorted(times, t), len(times) - 1)
+        if np.array_equal(times[i], t):
+            return [(f[i], df[i], ddf[i]) for f, df, ddf in values]
+        return None
 
     def targets(self, t: np.ndarray, order: int) -> np.ndarray:
         """g^(order)(t) (laws, n) of the rows with a law (``law_rows``): g = f or f²."""
@@ -172,10 +216,16 @@ class Terms:
         return out
 
     def magnitude_at(self, scales: np.ndarray) -> np.ndarray:
-        """Σ |terms| per row (m,) with every coordinate at its scale (nz,)."""
-        x = np.r_[scales, 1.0][:, None]
-        values = np.concatenate([self._apc * x[self.pa] * x[self.pb], self._asc * x[self.sa]])
-        return self._sum(values, "row")[:, 0]
+        """Σ |terms| per row (m,) with every coordinate at its scale (nz,); the last answer is
+        kept (a run's assembly and its steps ask with the same scales; not to be modified)."""
+        key = scales.tobytes()
+        kept = self.__dict__.get("_magnitude_at")
+        if kept is None or kept[0] != key:
+            x = np.r_[scales, 1.0][:, None]
+            values = np.concatenate([self._apc * x[self.pa] * x[self.pb],
+                                     self._asc * x[self.sa]])
+            kept = self._magnitude_at = (key, self._sum(values, "row")[:, 0])
+        return kept[1]
 
     def jacobian_cols(self, z: np.ndarray) -> np.ndarray:
         """Φ_z as data (nnz, n) on the pattern (``rows``, ``cols``)."""
@@ -212,6 +262,63 @@ class Terms:
         if self.laws:
             out[self.law_rows] -= self.targets(t, 0) if g is None else g
         return out, data
+
+    # ---- evaluation at one step: 1-D arrays (Newton and the rates step by step) ---------------
+    # The same arithmetic as the ``*_cols`` methods' column of that step (the same products
+    # in the same order, the same bincount): the same bits, with fewer numpy calls.
+    def residual_jacobian_one(self, z: np.ndarray, g: np.ndarray | None = None
+                              ) -> tuple[np.ndarray, np.ndarray]:
+        """(Φ (m,), Φ_z (m, nz) dense) at one configuration z (nz,): ``residual_jacobian_cols``'
+        column, Φ_z's data on its pattern; g: ``targets(t, 0)[:, 0]`` of the step (its laws'
+        rows). Every product is made once over all terms and the summed ones picked by one
+        index (``_one_pick``)."""
+        P, S = len(self.pa), len(self.sa)
+        x = np.empty(self.nz + 1)
+        x[:self.nz] = z
+        x[self.nz] = 1.0
+        gathered = x[self._gather]                   # z_a, z_b of the products; z_b, z_a of sines
+        ab = self._pc2 * gathered[:2 * P]            # c z_a, c z_b
+        arg = gathered[2 * P:2 * P + S] + self.salpha
+        sin, cs = np.sin(arg), self.sc * gathered[2 * P + S:]
+        values = np.concatenate([ab[:P] * gathered[P:2 * P], cs * sin, ab, self.sc * sin,
+                                 cs * np.cos(arg)])
+        both = np.bincount(self._both_dense, weights=values[self._one_pick],
+                           minlength=self.m * (1 + self.nz))
+        out = both[:self.m]
+        if self.laws:
+            out[self.law_rows] -= g
+        return out, both[self.m:].reshape(self.m, self.nz)
+
+    def jacobian_one(self, z: np.ndarray) -> np.ndarray:
+        """Φ_z (m, nz) dense at one configuration z (nz,): ``jacobian_cols``' column, on its
+        pattern."""
+        x = np.empty(self.nz + 1)
+        x[:self.nz] = z
+        x[self.nz] = 1.0
+        values = np.concatenate([
+            self._jp_c1 * x[self._jp_i],
+            self._js_c1 * np.sin(x[self._js_b] + self._js_alpha1),
+            self._jc_c1 * x[self._jc_a] * np.cos(x[self._jc_b] + self._jc_alpha1)])
+        return np.bincount(self._dense_index, weights=values,
+                           minlength=self.m * self.nz).reshape(self.m, self.nz)
+
+    def gamma_one(self, z: np.ndarray, zd: np.ndarray, g2: np.ndarray | None) -> np.ndarray:
+        """γ (m,) at one step: ``gamma_cols``' column; g2: ``targets(t, 2)[:, 0]``."""
+        pc, sc, alpha = self.pc, self.sc, self.salpha
+        x = np.empty(self.nz + 1)
+        x[:self.nz] = z
+        x[self.nz] = 1.0
+        v = np.zeros(self.nz + 1)
+        v[:self.nz] = zd
+        arg = x[self.sb] + alpha
+        wb = v[self.sb]
+        values = np.concatenate([
+            2.0 * pc * v[self.pa] * v[self.pb],
+            sc * wb * (2.0 * v[self.sa] * np.cos(arg) - x[self.sa] * wb * np.sin(arg))])
+        out = -np.bincount(self.row_index, weights=values, minlength=self.m)
+        if self.laws:
+            out[self.law_rows] += g2
+        return out
 
     def _residual_jacobian_many(self, t, z, g=None):
         """``residual_jacobian_cols`` for many steps (each sum by its sparse summing matrix)."""
