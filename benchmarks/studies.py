@@ -37,6 +37,8 @@ import datetime
 import importlib.metadata
 import math
 import os
+import pickle
+import subprocess
 import sys
 import tempfile
 import time
@@ -114,6 +116,11 @@ class ExecutorRow:
     @property
     def per_second(self) -> float:
         return self.variants / self.seconds
+
+    @property
+    def total(self) -> float:
+        """From asking for the executor until it is closed [s]."""
+        return self.start + self.seconds + self.stop
 
     @property
     def us_per_variant_step(self) -> float:
@@ -209,6 +216,53 @@ def run_on(label: str, workers: int, dask_local: int | None, study, reference=No
             row.identical = same_table(table, reference)
     except Exception as exc:  # noqa: BLE001 (the section reports it)
         row.failure = f"{type(exc).__name__}: {exc}"
+    row.load = (before, load_average())
+    return row, table
+
+
+#: ``run_fresh``'s process: the study (a pickle) on the executor of ``workers``, timed from
+#: asking for the executor until it is closed, the result's table and times pickled back
+FRESH = """
+import pickle, sys, time
+from pam2exu.studies.execute import open_executor
+from pam2exu.studies.runner import study as run_study
+if __name__ == "__main__":
+    study, workers, out = pickle.load(open(sys.argv[1], "rb")), int(sys.argv[2]), sys.argv[3]
+    begin = time.perf_counter()
+    with open_executor(workers) as executor:
+        ready, cpu = time.perf_counter(), time.process_time()
+        result = run_study(study, executor=executor, workers=workers)
+        done, cpu = time.perf_counter(), time.process_time() - cpu
+    closed = time.perf_counter()
+    pickle.dump({"start": ready - begin, "seconds": done - ready, "stop": closed - done,
+                 "cpu": cpu, "table": result.table}, open(out, "wb"))
+"""
+
+
+def run_fresh(label: str, workers: int, study, reference=None):
+    """``run_on`` in a fresh interpreter (``FRESH``; pam2exu imported before the clock
+    starts): every run starts its executor cold, as ``pam2exu study`` does, whatever ran
+    before it in this process (a process pool's fork server, once started, serves every
+    later pool of its process, with the study's modules imported). ``ExecutorRow.total``
+    is the time from asking for the executor until it is closed."""
+    row = ExecutorRow(label, study.samples, study.steps, workers)
+    before = load_average()
+    table = None
+    with tempfile.TemporaryDirectory(prefix="pam2exu-fresh-") as folder:
+        given, back = Path(folder, "study.pkl"), Path(folder, "out.pkl")
+        given.write_bytes(pickle.dumps(study))
+        done = subprocess.run([sys.executable, "-c", FRESH, str(given), str(workers),
+                               str(back)], capture_output=True, text=True, cwd=ROOT)
+        if done.returncode != 0 or not back.exists():
+            row.failure = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        else:
+            out = pickle.loads(back.read_bytes())
+            row.start, row.seconds, row.stop, row.cpu = (out[k] for k in ("start", "seconds",
+                                                                           "stop", "cpu"))
+            table = out["table"]
+            row.ok = int(np.sum(table["status"] == "ok"))
+            if reference is not None:
+                row.identical = same_table(table, reference)
     row.load = (before, load_average())
     return row, table
 

@@ -17,9 +17,12 @@ One row per row of the issue's table, each ratio's two sides timed in this run, 
   Exudyn backend's kinetostatic run beside, the three in rotation;
 - the issue's study as shipped (``STUDY_FILE``: the four-bar's kinetostatic tolerance study,
   2,000 variants × 100 steps, natural backend, variants in one pass) through the studies API
-  (``studies.run_on``: ``pam2exu.studies``' ``study`` on the executor the command line would
-  open, in-process and 2 worker processes), its time per variant-step / the plain script's
-  positions per step (timed just before and after it), and 1 worker / 2 workers; beside it the
+  (``studies.run_fresh``: ``pam2exu.studies``' ``study`` on the executor the command line would
+  open, in-process and 2 worker processes, each in a fresh interpreter with pam2exu imported,
+  so each pays its own executor's start as ``pam2exu study`` does, never one an earlier run
+  left warm; the order swapped every other pass), its time per variant-step / the plain
+  script's positions per step (timed just before and after it), and 1 worker / 2 workers
+  (from asking for the executor until it is closed, each side); beside it the
   same study on the Exudyn backend (in-process) and pylinkage's ``analyze_tolerance`` where
   pylinkage imports (``studies.pylinkage_rows``);
 - the Exudyn backend's positions (``predictor.pam_seconds``, the predictor as the run decides)
@@ -205,7 +208,7 @@ def study_rows(s: Sizes, m: Measured):
     runs = [("in-process", 1), ("2 worker processes", 2)]
     done, table = {}, None
     for label, workers in (reversed(runs) if second else runs):
-        row, out = studies.run_on(label, workers, None, study, table)
+        row, out = studies.run_fresh(label, workers, study, table)
         done[workers], table = row, table if table is not None else out
     exudyn, _ = studies.run_on("in-process", 1, None, replace(study, backend="exudyn"))
     plain = min(plain, plain_seconds(s.long_steps))
@@ -231,8 +234,11 @@ def study_rows(s: Sizes, m: Measured):
     if one.failure or two.failure:
         yield Figure("workers", float("nan"), f"failed: {one.failure or two.failure}")
     else:
-        yield Figure("workers", one.seconds / two.seconds,
-                     f"1 worker's time / 2 workers': {one.seconds:.1f} s / {two.seconds:.1f} s",
+        yield Figure("workers", one.total / two.total,
+                     f"1 worker's time / 2 workers': {one.total:.1f} s / {two.total:.1f} s "
+                     f"(of which the pool's start and stop outside the study "
+                     f"{two.start + two.stop:.2f} s; load {loads(one.load)} / "
+                     f"{loads(two.load)})",
                      "tables bit-identical: "
                      + ("yes" if done[1 if second else 2].identical else "**no**"))
 
