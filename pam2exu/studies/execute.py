@@ -27,7 +27,8 @@ local pool's workers are forked from a server process that imports what they nee
 (``WORKER_MODULES``) once, as soon as the pool is opened, while the caller goes on (its
 nominal run, its checks): a worker then starts in milliseconds, instead of importing
 pam2exu, NumPy and SciPy itself (about 2 s of CPU each, measured), all of them at once on
-the same cores, before its first chunk.
+the same cores, before its first chunk. ``warm`` starts that server earlier, before the
+caller's own checks.
 
 Every finished chunk is written whole as its part file under ``parts`` as soon as it
 arrives (``pam2exu/studies/parts.py``: temporary file, then renamed), so an interrupted study
@@ -123,17 +124,31 @@ def workers_of(executor, default: int) -> int:
     return default
 
 
-def local_pool(workers: int, preload=WORKER_MODULES) -> ProcessPoolExecutor:
-    """A ``ProcessPoolExecutor`` of ``workers`` processes started the ``START_METHOD`` way.
-    With "forkserver", the server its processes are forked from is started now with
-    ``preload`` imported, in the background (this call does not wait for it): each worker
-    then inherits the modules instead of importing them. A server already running (started
-    by an earlier pool of this process) is reused as it is."""
-    context = get_context(START_METHOD)
+def start_server(preload=WORKER_MODULES) -> None:
+    """With the start method "forkserver": start the server a local pool's processes are
+    forked from, with ``preload`` imported, in the background (this call does not wait for
+    it): each worker then inherits the modules instead of importing them. A server already
+    running (started earlier in this process) is kept as it is."""
     if START_METHOD == "forkserver":
-        context.set_forkserver_preload(list(preload))
+        get_context(START_METHOD).set_forkserver_preload(list(preload))
         multiprocessing.forkserver.ensure_running()
-    return ProcessPoolExecutor(workers, mp_context=context)
+
+
+def warm(workers: int | None = None, dask: str | None = None,
+         dask_local: int | None = None) -> None:
+    """Start now what ``open_executor`` with the same options will use and can start
+    early: a local pool's server (``start_server``), which then imports the workers'
+    modules while this process does its own serial part (its imports, the study's checks
+    and nominal run). Nothing for in-process or Dask."""
+    if dask is None and dask_local is None and workers != 1:
+        start_server()
+
+
+def local_pool(workers: int) -> ProcessPoolExecutor:
+    """A ``ProcessPoolExecutor`` of ``workers`` processes started the ``START_METHOD`` way,
+    its server started now if it is not yet (``start_server``)."""
+    start_server()
+    return ProcessPoolExecutor(workers, mp_context=get_context(START_METHOD))
 
 
 @contextlib.contextmanager

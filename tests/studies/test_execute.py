@@ -305,3 +305,33 @@ def test_a_pools_workers_start_with_the_studys_modules_imported(tmp_path):
     out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
                          timeout=120)
     assert out.stdout.strip() == "[True, True, False]", out.stderr
+
+
+WARMED = """
+import multiprocessing.forkserver, sys
+sys.path[:0] = {paths!r}
+import chunk_tasks
+from pam2exu.studies import execute
+if __name__ == "__main__":
+    execute.warm({workers})
+    multiprocessing.forkserver.set_forkserver_preload([])    # a server started later: bare
+    execute.start_server = lambda preload=(): None
+    with execute.open_executor(2) as pool:
+        print(pool.submit(chunk_tasks.imported, ["pam2exu.studies.runner"]).result())
+"""
+
+
+@pytest.mark.long
+@pytest.mark.skipif(execute.START_METHOD != "forkserver", reason="no fork server here")
+@pytest.mark.parametrize("workers, started", [(2, True), (None, True), (1, False)])
+def test_warm_starts_the_servers_imports_before_the_pool_opens(tmp_path, workers, started):
+    """``warm`` (what ``pam2exu study`` calls before its checks) starts the workers' server
+    with the study's modules when the options ask for a local pool, and nothing for one
+    process; the pool opened after it forks from that server."""
+    import subprocess
+    script = tmp_path / "warm.py"
+    script.write_text(WARMED.format(paths=[str(Path(__file__).parent),
+                                           str(Path(__file__).parents[2])], workers=workers))
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=120)
+    assert out.stdout.strip() == f"[{started}]", out.stderr
