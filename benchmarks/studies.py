@@ -224,6 +224,7 @@ def run_on(label: str, workers: int, dask_local: int | None, study, reference=No
 #: asking for the executor until it is closed, the result's table and times pickled back
 FRESH = """
 import pickle, sys, time
+import scipy.stats, pam2exu.analyses, pam2exu.backend.natural    # what any study's process has
 from pam2exu.studies.execute import open_executor
 from pam2exu.studies.runner import study as run_study
 if __name__ == "__main__":
@@ -240,11 +241,13 @@ if __name__ == "__main__":
 
 
 def run_fresh(label: str, workers: int, study, reference=None):
-    """``run_on`` in a fresh interpreter (``FRESH``; pam2exu imported before the clock
-    starts): every run starts its executor cold, as ``pam2exu study`` does, whatever ran
-    before it in this process (a process pool's fork server, once started, serves every
-    later pool of its process, with the study's modules imported). ``ExecutorRow.total``
-    is the time from asking for the executor until it is closed."""
+    """``run_on`` in a fresh interpreter (``FRESH``): every run starts its executor cold,
+    as ``pam2exu study`` does, whatever ran before it in this process (a process pool's
+    fork server, once started, serves every later pool of its process with the study's
+    modules imported). What this process needs whichever executor runs the variants
+    (pam2exu's studies, analyses and natural backend, scipy.stats for the draws) is
+    imported before the clock starts. ``ExecutorRow.total`` is the time from asking for the
+    executor until it is closed."""
     row = ExecutorRow(label, study.samples, study.steps, workers)
     before = load_average()
     table = None
@@ -265,6 +268,28 @@ def run_fresh(label: str, workers: int, study, reference=None):
                 row.identical = same_table(table, reference)
     row.load = (before, load_average())
     return row, table
+
+
+def spin(seconds: float) -> float:
+    """Wall time [s] this process takes to burn ``seconds`` of CPU in Python."""
+    cpu, begin = time.process_time(), time.perf_counter()
+    while time.process_time() - cpu < seconds:
+        pass
+    return time.perf_counter() - begin
+
+
+def cores_free(seconds: float = 2.0) -> float:
+    """The cores two processes get at once on this machine now: 2 × (the wall time one
+    process takes to burn ``seconds`` of CPU) / (the wall time two take at once, the
+    slower): 2.0 on an idle 2-core machine, 1.0 when other work leaves only one. A pool of
+    2 workers cannot be more times faster than this (beside the workers' row)."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+    with ProcessPoolExecutor(2, mp_context=get_context("spawn")) as pool:
+        list(pool.map(spin, [0.05, 0.05]))                  # both started
+        one = pool.submit(spin, seconds).result()
+        two = max(pool.map(spin, [seconds, seconds]))
+    return 2 * one / two
 
 
 def same_table(a: dict, b: dict) -> bool:

@@ -22,7 +22,9 @@ One row per row of the issue's table, each ratio's two sides timed in this run, 
   so each pays its own executor's start as ``pam2exu study`` does, never one an earlier run
   left warm; the order swapped every other pass), its time per variant-step / the plain
   script's positions per step (timed just before and after it), and 1 worker / 2 workers
-  (from asking for the executor until it is closed, each side); beside it the
+  (from asking for the executor until it is closed, each side), with the cores two
+  processes got at once just before and after (``studies.cores_free``: on a shared machine,
+  the most a pool of 2 can gain then); beside it the
   same study on the Exudyn backend (in-process) and pylinkage's ``analyze_tolerance`` where
   pylinkage imports (``studies.pylinkage_rows``);
 - the Exudyn backend's positions (``predictor.pam_seconds``, the predictor as the run decides)
@@ -206,10 +208,11 @@ def study_rows(s: Sizes, m: Measured):
     plain = plain_seconds(s.long_steps)
     second = len(m.loads) % 2 == 1              # every other pass: 2 workers first
     runs = [("in-process", 1), ("2 worker processes", 2)]
-    done, table = {}, None
+    done, table, free = {}, None, [studies.cores_free()]
     for label, workers in (reversed(runs) if second else runs):
         row, out = studies.run_fresh(label, workers, study, table)
         done[workers], table = row, table if table is not None else out
+    free.append(studies.cores_free())
     exudyn, _ = studies.run_on("in-process", 1, None, replace(study, backend="exudyn"))
     plain = min(plain, plain_seconds(s.long_steps))
     plain_us = 1e6 * plain / s.long_steps
@@ -240,7 +243,9 @@ def study_rows(s: Sizes, m: Measured):
                      f"{two.start + two.stop:.2f} s; load {loads(one.load)} / "
                      f"{loads(two.load)})",
                      "tables bit-identical: "
-                     + ("yes" if done[1 if second else 2].identical else "**no**"))
+                     + ("yes" if done[1 if second else 2].identical else "**no**")
+                     + "; the cores two processes got at once just before and after "
+                     f"(studies.cores_free, 2.0 idle): {free[0]:.2f}, {free[1]:.2f}")
 
 
 def exudyn_rows(s: Sizes, _m: Measured):
