@@ -270,6 +270,40 @@ def run_fresh(label: str, workers: int, study, reference=None):
     return row, table
 
 
+#: ``pool_ready``'s process: (a) a pool opened at once, (b) as ``pam2exu study`` does, the
+#: workers' server warmed, the study's checks run, then the pool opened; the seconds from
+#: opening the pool until both workers ran a pam2exu task
+READY = """
+import sys, time, warnings
+from concurrent.futures import wait
+from dataclasses import replace
+from pam2exu.studies import execute, load_study      # what pam2exu study has imported then
+from pam2exu.studies.runner import checked, warned
+if __name__ == "__main__":
+    warnings.simplefilter("ignore")
+    if sys.argv[1] == "cli":
+        execute.warm(2)
+        checked(replace(load_study(sys.argv[2]), samples=8))
+    begin = time.perf_counter()
+    with execute.open_executor(2) as pool:
+        wait([pool.submit(time.sleep, 0.3) for _ in range(2)])   # both workers started
+        wait([pool.submit(warned, []) for _ in range(2)])
+        print(time.perf_counter() - begin - 0.3)
+"""
+
+
+def pool_ready(after_checks: bool) -> float:
+    """Seconds from opening a local pool of 2 until both its workers ran a pam2exu task, in
+    a fresh interpreter (``READY``): at once (``after_checks`` False: the server's imports
+    all on the way), or after the checks of STUDY_FILE's study as ``pam2exu study`` runs
+    them (with their first imports), its workers' server warmed before them
+    (``execute.warm``)."""
+    study = ROOT / "examples" / "studies" / "four_bar_tolerance.toml"
+    done = subprocess.run([sys.executable, "-c", READY, "cli" if after_checks else "api",
+                           str(study)], capture_output=True, text=True, cwd=ROOT, check=True)
+    return float(done.stdout.split()[-1])
+
+
 def spin(seconds: float) -> float:
     """Wall time [s] this process takes to burn ``seconds`` of CPU in Python."""
     cpu, begin = time.process_time(), time.perf_counter()
@@ -526,7 +560,15 @@ def main(argv=None):
                                                                 "(default 100)")
     parser.add_argument("--out", type=Path, default=None,
                         help="directory holding performance.md (default: docs/)")
+    parser.add_argument("--pool-start", type=int, default=0, metavar="ROUNDS",
+                        help="only print a local pool's start (pool_ready), ROUNDS rounds")
     args = parser.parse_args(argv)
+    if args.pool_start:
+        workers_see_this_clone()
+        for _ in range(args.pool_start):
+            print(f"pool of 2 ready: opened at once {pool_ready(False):.2f} s, after the "
+                  f"checks {pool_ready(True):.2f} s; load {load_average():.2f}")
+        return
     plan = QUICK if args.quick else FULL
     resized = args.quick or args.variants or args.steps
     out_dir = args.out or (Path(tempfile.mkdtemp(prefix="pam2exu-studies-")) if resized
