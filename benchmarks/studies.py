@@ -116,6 +116,11 @@ class ExecutorRow:
         return self.variants / self.seconds
 
     @property
+    def total(self) -> float:
+        """From asking for the executor until it is closed [s]."""
+        return self.start + self.seconds + self.stop
+
+    @property
     def us_per_variant_step(self) -> float:
         return 1e6 * self.seconds / (self.variants * self.steps)
 

@@ -17,9 +17,14 @@ One row per row of the issue's table, each ratio's two sides timed in this run, 
   Exudyn backend's kinetostatic run beside, the three in rotation;
 - the issue's study as shipped (``STUDY_FILE``: the four-bar's kinetostatic tolerance study,
   2,000 variants × 100 steps, natural backend, variants in one pass) through the studies API
-  (``studies.run_on``: ``pam2exu.studies``' ``study`` on the executor the command line would
-  open, in-process and 2 worker processes), its time per variant-step / the plain script's
-  positions per step (timed just before and after it), and 1 worker / 2 workers; beside it the
+  (``workers.run_fresh``: ``pam2exu.studies``' ``study`` on the executor the command line would
+  open, in-process and 2 worker processes, each in a fresh interpreter with pam2exu imported,
+  so each pays its own executor's start as ``pam2exu study`` does, never one an earlier run
+  left warm; the order swapped every other pass), its time per variant-step / the plain
+  script's positions per step (timed just before and after it), and 1 worker / 2 workers
+  (from asking for the executor until it is closed, each side), with the cores two
+  processes got at once just before and after (``workers.cores_free``: on a shared machine,
+  the most a pool of 2 can gain then); beside it the
   same study on the Exudyn backend (in-process) and pylinkage's ``analyze_tolerance`` where
   pylinkage imports (``studies.pylinkage_rows``);
 - the Exudyn backend's positions (``predictor.pam_seconds``, the predictor as the run decides)
@@ -48,7 +53,7 @@ if __package__ in (None, ""):          # python benchmarks/targets.py: the clone
 
 import pam2exu  # noqa: E402
 
-from benchmarks import clearance_speed, natural_speed, predictor, studies  # noqa: E402
+from benchmarks import clearance_speed, natural_speed, predictor, studies, workers  # noqa: E402
 from benchmarks.dynamics import replace_section  # noqa: E402
 from benchmarks.measure import ROOT, log, machine  # noqa: E402
 from benchmarks.plain_exudyn import plain_exudyn_four_bar  # noqa: E402
@@ -203,10 +208,11 @@ def study_rows(s: Sizes, m: Measured):
     plain = plain_seconds(s.long_steps)
     second = len(m.loads) % 2 == 1              # every other pass: 2 workers first
     runs = [("in-process", 1), ("2 worker processes", 2)]
-    done, table = {}, None
-    for label, workers in (reversed(runs) if second else runs):
-        row, out = studies.run_on(label, workers, None, study, table)
-        done[workers], table = row, table if table is not None else out
+    done, table, free = {}, None, [workers.cores_free()]
+    for label, count in (reversed(runs) if second else runs):
+        row, out = workers.run_fresh(label, count, study, table)
+        done[count], table = row, table if table is not None else out
+    free.append(workers.cores_free())
     exudyn, _ = studies.run_on("in-process", 1, None, replace(study, backend="exudyn"))
     plain = min(plain, plain_seconds(s.long_steps))
     plain_us = 1e6 * plain / s.long_steps
@@ -231,10 +237,15 @@ def study_rows(s: Sizes, m: Measured):
     if one.failure or two.failure:
         yield Figure("workers", float("nan"), f"failed: {one.failure or two.failure}")
     else:
-        yield Figure("workers", one.seconds / two.seconds,
-                     f"1 worker's time / 2 workers': {one.seconds:.1f} s / {two.seconds:.1f} s",
+        yield Figure("workers", one.total / two.total,
+                     f"1 worker's time / 2 workers': {one.total:.1f} s / {two.total:.1f} s "
+                     f"(of which the pool's start and stop outside the study "
+                     f"{two.start + two.stop:.2f} s; load {loads(one.load)} / "
+                     f"{loads(two.load)})",
                      "tables bit-identical: "
-                     + ("yes" if done[1 if second else 2].identical else "**no**"))
+                     + ("yes" if done[1 if second else 2].identical else "**no**")
+                     + "; the cores two processes got at once just before and after "
+                     f"(workers.cores_free, 2.0 idle): {free[0]:.2f}, {free[1]:.2f}")
 
 
 def exudyn_rows(s: Sizes, _m: Measured):

@@ -51,7 +51,7 @@ def command(args, warnings) -> int:
     from ..console import UsageError
     from ..studies.result import summary_path
     from ..studies.series import series_path
-    from ..studies.execute import open_executor, workers_of
+    from ..studies.execute import open_executor, warm, workers_of
     from ..studies.runner import checked, run_checked
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be ≥ 1, got {args.workers}")
@@ -59,6 +59,7 @@ def command(args, warnings) -> int:
         raise UsageError("--resume needs -o OUT: the finished chunks are under OUT.parts/")
     if args.workers is not None and (args.dask or args.dask_local is not None):
         raise UsageError("--workers and --dask/--dask-local do not go together: give one")
+    warm(args.workers, args.dask, args.dask_local)     # the workers' imports, meanwhile
     run_as, names, units, out = checked(args.study, args.output, args.resume, args.samples)
     pictures = planned_pictures(args, run_as, names)
     workers = args.dask_local or args.workers or os.cpu_count() or 1

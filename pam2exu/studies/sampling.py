@@ -16,8 +16,6 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import stats
-from scipy.stats import qmc
 
 #: the distributions a parameter may have
 DISTRIBUTIONS = ("normal", "uniform", "triangular", "values")
@@ -82,6 +80,9 @@ class Parameter:
 
     def distribution_object(self):
         """The frozen ``scipy.stats`` distribution (a ``values`` one: of the list's index)."""
+        # imported here, not with the module: the worker processes that run the variants
+        # import this module but never draw (scipy.stats costs about 1 s to import)
+        from scipy import stats
         if self._frozen is None:
             if self.distribution == "normal":
                 sigma = self.std if self.std is not None else normal_std(self.tol)
@@ -126,6 +127,7 @@ def unit_design(method: str, dimensions: int, samples: int, seed: int, start: in
     Carlo advances PCG64 by ``start · d`` draws; Sobol' fast-forwards ``start`` points;
     the Latin hypercube is made whole (its strata span every row) and sliced.
     """
+    from scipy.stats import qmc                  # with the draws only (distribution_object)
     n = stop - start
     if method == "monte_carlo":
         bits = np.random.PCG64(seed)

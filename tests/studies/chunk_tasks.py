@@ -6,6 +6,7 @@ as a study's variant does; every call leaves a file in the payload's ``calls`` f
 a test counts the chunks computed.
 """
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -53,3 +54,9 @@ def short(payload, start, stop):
     columns = rows(payload, start, stop)
     columns["x"] = columns["x"][1:]
     return columns
+
+
+def imported(names):
+    """Which of the modules ``names`` this process had imported when it ran this task
+    (this module imports none of pam2exu)."""
+    return [name in sys.modules for name in names]

@@ -277,3 +277,61 @@ def test_one_pass_chunks_are_large_and_shared_equally(variants, workers, sizes):
     chunks = plan_chunks(variants, 0.15, workers, least=400)
     assert [b - a for a, b in chunks] == sizes
     assert chunks[0][0] == 0 and chunks[-1][1] == variants
+
+
+WORKERS_IMPORT = """
+import sys
+sys.path[:0] = {paths!r}
+import chunk_tasks
+from pam2exu.studies.execute import open_executor
+if __name__ == "__main__":
+    with open_executor(2) as pool:
+        print(pool.submit(chunk_tasks.imported, ["pam2exu.studies.runner", "pam2exu.analyses",
+                                                 "scipy.stats"]).result())
+"""
+
+
+@pytest.mark.long
+@pytest.mark.skipif(execute.START_METHOD != "forkserver", reason="no fork server here")
+def test_a_pools_workers_start_with_the_studys_modules_imported(tmp_path):
+    """The server a local pool's workers are forked from has imported the study's task and
+    the analyses (``WORKER_MODULES``: a worker does not import pam2exu, NumPy and SciPy
+    itself), and not scipy.stats, which only the study's draws need (in this process); in a
+    fresh interpreter, whose fork server the pool starts."""
+    import subprocess
+    script = tmp_path / "pool.py"
+    script.write_text(WORKERS_IMPORT.format(paths=[str(Path(__file__).parent),
+                                                   str(Path(__file__).parents[2])]))
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=120)
+    assert out.stdout.strip() == "[True, True, False]", out.stderr
+
+
+WARMED = """
+import multiprocessing.forkserver, sys
+sys.path[:0] = {paths!r}
+import chunk_tasks
+from pam2exu.studies import execute
+if __name__ == "__main__":
+    execute.warm({workers})
+    multiprocessing.forkserver.set_forkserver_preload([])    # a server started later: bare
+    execute.start_server = lambda preload=(): None
+    with execute.open_executor(2) as pool:
+        print(pool.submit(chunk_tasks.imported, ["pam2exu.studies.runner"]).result())
+"""
+
+
+@pytest.mark.long
+@pytest.mark.skipif(execute.START_METHOD != "forkserver", reason="no fork server here")
+@pytest.mark.parametrize("workers, started", [(2, True), (None, True), (1, False)])
+def test_warm_starts_the_servers_imports_before_the_pool_opens(tmp_path, workers, started):
+    """``warm`` (what ``pam2exu study`` calls before its checks) starts the workers' server
+    with the study's modules when the options ask for a local pool, and nothing for one
+    process; the pool opened after it forks from that server."""
+    import subprocess
+    script = tmp_path / "warm.py"
+    script.write_text(WARMED.format(paths=[str(Path(__file__).parent),
+                                           str(Path(__file__).parents[2])], workers=workers))
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=120)
+    assert out.stdout.strip() == f"[{started}]", out.stderr

@@ -1,0 +1,152 @@
+"""A study on 2 workers against 1, paired fairly on a shared machine (issue 25's row
+"workers" of benchmarks/targets.py, docs/performance.md "Studies on 2 workers").
+
+    python benchmarks/workers.py --pool-start 3    # a local pool's start, 3 rounds
+
+- ``run_fresh``: ``studies.run_on`` in a fresh interpreter, so every run starts its executor
+  cold, as ``pam2exu study`` does;
+- ``pool_ready``: the seconds from opening a local pool of 2 until both workers ran a
+  pam2exu task, opened at once or after the study's checks as ``pam2exu study`` does;
+- ``cores_free``: the cores two processes get at once on this machine now, the most a pool
+  of 2 can gain then.
+"""
+from __future__ import annotations
+
+import argparse
+import pickle
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import numpy as np  # noqa: E402
+
+from benchmarks.measure import ROOT  # noqa: E402
+from benchmarks.studies import (ExecutorRow, load_average, same_table,  # noqa: E402
+                                workers_see_this_clone)
+
+
+#: ``run_fresh``'s process: the study (a pickle) on the executor of ``workers``, timed from
+#: asking for the executor until it is closed, the result's table and times pickled back
+FRESH = """
+import pickle, sys, time
+import scipy.stats, pam2exu.analyses, pam2exu.backend.natural    # what any study's process has
+from pam2exu.studies.execute import open_executor
+from pam2exu.studies.runner import study as run_study
+if __name__ == "__main__":
+    study, workers, out = pickle.load(open(sys.argv[1], "rb")), int(sys.argv[2]), sys.argv[3]
+    begin = time.perf_counter()
+    with open_executor(workers) as executor:
+        ready, cpu = time.perf_counter(), time.process_time()
+        result = run_study(study, executor=executor, workers=workers)
+        done, cpu = time.perf_counter(), time.process_time() - cpu
+    closed = time.perf_counter()
+    pickle.dump({"start": ready - begin, "seconds": done - ready, "stop": closed - done,
+                 "cpu": cpu, "table": result.table}, open(out, "wb"))
+"""
+
+
+def run_fresh(label: str, workers: int, study, reference=None):
+    """``run_on`` in a fresh interpreter (``FRESH``): every run starts its executor cold,
+    as ``pam2exu study`` does, whatever ran before it in this process (a process pool's
+    fork server, once started, serves every later pool of its process with the study's
+    modules imported). What this process needs whichever executor runs the variants
+    (pam2exu's studies, analyses and natural backend, scipy.stats for the draws) is
+    imported before the clock starts. ``ExecutorRow.total`` is the time from asking for the
+    executor until it is closed."""
+    row = ExecutorRow(label, study.samples, study.steps, workers)
+    before = load_average()
+    table = None
+    with tempfile.TemporaryDirectory(prefix="pam2exu-fresh-") as folder:
+        given, back = Path(folder, "study.pkl"), Path(folder, "out.pkl")
+        given.write_bytes(pickle.dumps(study))
+        done = subprocess.run([sys.executable, "-c", FRESH, str(given), str(workers),
+                               str(back)], capture_output=True, text=True, cwd=ROOT)
+        if done.returncode != 0 or not back.exists():
+            row.failure = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        else:
+            out = pickle.loads(back.read_bytes())
+            row.start, row.seconds, row.stop, row.cpu = (out[k] for k in ("start", "seconds",
+                                                                           "stop", "cpu"))
+            table = out["table"]
+            row.ok = int(np.sum(table["status"] == "ok"))
+            if reference is not None:
+                row.identical = same_table(table, reference)
+    row.load = (before, load_average())
+    return row, table
+
+
+#: ``pool_ready``'s process: (a) a pool opened at once, (b) as ``pam2exu study`` does, the
+#: workers' server warmed, the study's checks run, then the pool opened; the seconds from
+#: opening the pool until both workers ran a pam2exu task
+READY = """
+import sys, time, warnings
+from concurrent.futures import wait
+from dataclasses import replace
+from pam2exu.studies import execute, load_study      # what pam2exu study has imported then
+from pam2exu.studies.runner import checked, warned
+if __name__ == "__main__":
+    warnings.simplefilter("ignore")
+    if sys.argv[1] == "cli":
+        execute.warm(2)
+        checked(replace(load_study(sys.argv[2]), samples=8))
+    begin = time.perf_counter()
+    with execute.open_executor(2) as pool:
+        wait([pool.submit(time.sleep, 0.3) for _ in range(2)])   # both workers started
+        wait([pool.submit(warned, []) for _ in range(2)])
+        print(time.perf_counter() - begin - 0.3)
+"""
+
+
+def pool_ready(after_checks: bool) -> float:
+    """Seconds from opening a local pool of 2 until both its workers ran a pam2exu task, in
+    a fresh interpreter (``READY``): at once (``after_checks`` False: the server's imports
+    all on the way), or after the checks of STUDY_FILE's study as ``pam2exu study`` runs
+    them (with their first imports), its workers' server warmed before them
+    (``execute.warm``)."""
+    study = ROOT / "examples" / "studies" / "four_bar_tolerance.toml"
+    done = subprocess.run([sys.executable, "-c", READY, "cli" if after_checks else "api",
+                           str(study)], capture_output=True, text=True, cwd=ROOT, check=True)
+    return float(done.stdout.split()[-1])
+
+
+def spin(seconds: float) -> float:
+    """Wall time [s] this process takes to burn ``seconds`` of CPU in Python."""
+    cpu, begin = time.process_time(), time.perf_counter()
+    while time.process_time() - cpu < seconds:
+        pass
+    return time.perf_counter() - begin
+
+
+def cores_free(seconds: float = 2.0) -> float:
+    """The cores two processes get at once on this machine now: 2 × (the wall time one
+    process takes to burn ``seconds`` of CPU) / (the wall time two take at once, the
+    slower): 2.0 on an idle 2-core machine, 1.0 when other work leaves only one. A pool of
+    2 workers cannot be more times faster than this (beside the workers' row)."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+    with ProcessPoolExecutor(2, mp_context=get_context("spawn")) as pool:
+        list(pool.map(spin, [0.05, 0.05]))                  # both started
+        one = pool.submit(spin, seconds).result()
+        two = max(pool.map(spin, [seconds, seconds]))
+    return 2 * one / two
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--pool-start", type=int, default=3, metavar="ROUNDS",
+                        help="rounds of pool_ready, each way (default 3)")
+    args = parser.parse_args(argv)
+    workers_see_this_clone()
+    for _ in range(args.pool_start):
+        print(f"pool of 2 ready: opened at once {pool_ready(False):.2f} s, after the checks "
+              f"{pool_ready(True):.2f} s; load {load_average():.2f}; cores free "
+              f"{cores_free():.2f}")
+
+
+if __name__ == "__main__":
+    main()
