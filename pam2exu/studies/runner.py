@@ -23,7 +23,7 @@ from ..errors import (InputWarning, ModelError, OutputError, Pam2ExuError, Probl
                       warn_outside)
 from ..registry import ANALYSES, analysis_type
 from .batch import answered, one_pass, one_pass_of
-from .execute import open_executor, run_chunks, workers_of
+from .execute import open_executor, run_chunks, warm, workers_of
 from .messages import WARNINGS, kind
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
@@ -379,6 +379,8 @@ def study(study_or_path, executor=None, out=None, resume: bool = False,
     >>> result.yield_.share                                              # doctest: +SKIP
     1.0
     """
+    if executor is None:                 # the pool's server imports meanwhile
+        warm(workers or 1)
     run_as, names, units, out = checked(study_or_path, out, resume, samples)
     if executor is not None:
         return run_checked(run_as, names, units, out, executor, resume,
