@@ -201,9 +201,13 @@ def test_long_runs_stay_on_the_grid(request):
 
 # ---- the predictor decided by measurement (predictor = "auto") -------------------------------
 
-def test_predictor_pays_when_its_median_step_is_clearly_shorter():
-    """The median, not the mean: one step slowed by the machine does not decide; and shorter
-    by more than MARGIN (the pre-step call only the predictor's way pays after the probe)."""
+def test_predictor_pays_when_its_own_steps_are_clearly_shorter():
+    """The lower quartile, not the mean nor the median: steps slowed by the machine's other
+    work do not decide, even when they are most of one way's; and shorter by more than
+    MARGIN (the pre-step call only the predictor's way pays after the probe)."""
+    slowed = [1.0] * 4 + [9.0] * 5             # five of nine steps slowed by the machine
+    assert predictor.predictor_pays(slowed, [1.2] * 4 + [8.0] * 5)
+    assert not predictor.predictor_pays([1.2] * 4 + [8.0] * 5, slowed)
     assert predictor.predictor_pays([1.0, 1.0, 1.0], [2.0, 2.0, 2.0])
     assert not predictor.predictor_pays([1.0, 3.0, 3.0], [2.0, 2.0, 2.0])
     assert predictor.predictor_pays([1.0, 1.0, 50.0], [2.0, 2.0, 2.0])

@@ -141,8 +141,9 @@ class ExudynSystem:
     """
 
     items = items
-    #: the clock that times the predictor's probe (``predictor.Probe``)
-    clock = staticmethod(time.perf_counter)
+    #: the clock that times the predictor's probe (``predictor.Probe``): this thread's CPU
+    #: time, which other processes on the machine do not stop
+    clock = staticmethod(time.thread_time)
 
     def __init__(self, mech, forces: bool = False, velocity_forces: bool = True,
                  anchor_stiffness: float = 0.0, start=None, start_rates=None,
