@@ -111,6 +111,9 @@ def test_which_studies_take_the_pass():
     assert not one_pass({**p, "batched": False})
     assert not one_pass({**p, "backend": "exudyn"})        # it solves one run at a time
     assert not one_pass({**p, "analysis": "dynamic"})      # it integrates, no grid solve
+    # the clearance analysis solves each variant's parts as made alone: batched = true or
+    # false runs the same per-variant runs, so its tables are the reference's
+    assert not one_pass({**p, "analysis": "clearance"})
 
 
 @pytest.mark.parametrize("line, says", [
