@@ -35,7 +35,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import sparse
 
-from ...kinematics import ANGLES, column, cross, perp, pose
+from ...kinematics import ANGLES, column, cross, pose
 from ..base import Reactions
 from . import inverse
 from .forms import ONE, Expr, Vec
@@ -110,6 +110,8 @@ class _Pin:
     solids: list
     revolutes: list               # indices into mech.constraints
     inverse: np.ndarray           # (revolutes, solids)
+    #: where the point's columns are in each solid's ``Plan.copied`` columns
+    at: list | None = None
 
 
 class Plan:
@@ -135,6 +137,7 @@ class Plan:
         self.rows_of = {k: np.array(v) for k, v in self.rows_of.items()}
         self._pins(form, mech, index)
         self._fixed(form, mech)
+        self._copied(form)
         K = form.pose_forms()
         angles = np.zeros((len(self.angle_cols), form.nz))
         for r, c in enumerate(self.angle_cols.values()):
@@ -173,6 +176,25 @@ class Plan:
         # a column point's coordinates are exactly one z column each
         self.ok &= all(p.columns is None or len(p.columns) == 2 for p in self.pins)
 
+    def _copied(self, form) -> None:
+        """The columns of each solid's copy of its basic points that the reactions read (its
+        column pins'), with A_s's nonzero entries there: ``copied`` {solid: (columns, [[(k,
+        A_s[k, c])] per column c])}; the pins, column points first (``ordered_pins``), each with where its
+        columns are in its solids' (``_Pin.at``)."""
+        bd = inverse.bodies(form)
+        wanted: dict[int, list] = {}
+        for pin in self.pins:
+            for i in pin.solids if pin.columns is not None else ():
+                wanted.setdefault(i, [])
+                wanted[i] += [c for c in pin.columns if c not in wanted[i]]
+        self.copied = {i: (np.array(cols), [[(k, bd.A[i][k, c]) for k in range(4)
+                                              if bd.A[i][k, c]] for c in cols])
+                       for i, cols in wanted.items()}
+        for pin in self.pins:
+            if pin.columns is not None:
+                pin.at = [[wanted[i].index(c) for c in pin.columns] for i in pin.solids]
+        self.ordered_pins = sorted(self.pins, key=lambda p: p.columns is None)
+
     def _fixed(self, form, mech) -> None:
         held = [el.holds for el in mech.constraints if el.grounds]
         self.ok &= len(set(held)) == len(held)
@@ -208,12 +230,32 @@ def natural_rates(pl: Plan, q, qd, qdd):
     return tuple(inverse.times(v, pl.rates) for v in y)
 
 
-def _about_origin(p, v, force_p, force_v, moment=0.0):
-    """(n, 3): forces (force_p, force_v) on a frame's (p, v) (and a moment on its angle) as
-    a force and a moment about the global origin: (F, p × F + G_v·Ω v + M)."""
-    out = np.empty(p.shape[:1] + (3,))
-    out[:, :2] = force_p
-    out[:, 2] = cross(p, force_p) + np.sum(force_v * perp(v), axis=1) + moment
+def _about_origin(zeta, force_p, force_v, moment=0.0):
+    """(3, n): forces (force_p, force_v) (2, n) on a frame's (p, v) (zeta (4, n)), and a
+    moment on its angle, as a force and a moment about the global origin:
+    (F, p × F + G_v·Ω v + M) (one row per quantity, the steps along it)."""
+    out = np.empty((3, zeta.shape[-1]))
+    out[0], out[1] = force_p
+    out[2] = (_cross(zeta[:2], force_p) + (force_v[0] * -zeta[3] + force_v[1] * zeta[2])
+              + moment)
+    return out
+
+
+def _cross(a, b):
+    """a × b (n,) of two vectors given as rows (2, n) (a: also a constant (2,))."""
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def _combined(rows, terms) -> np.ndarray:
+    """(len(terms), n): row r = Σ rows[k] c over the (k, c) of terms[r], k ascending (the
+    nonzero terms of an einsum over k: the same sums)."""
+    out = np.zeros((len(terms), rows.shape[-1]))
+    for r, pairs in enumerate(terms):
+        for number, (k, c) in enumerate(pairs):
+            if number:
+                out[r] += rows[k] * c
+            else:
+                out[r] = rows[k] * c
     return out
 
 
@@ -268,61 +310,63 @@ def _chunk(pl: Plan, t, q, qd, qdd, extra: int):
 
 
 def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
-    """Each constraint element's wrench on its receiver, about the receiver's origin, from
-    the solids' constraint forces W and the multipliers μ (linear in both: module doc)."""
+    """Each constraint element's wrench (n, elements, 3) on its receiver, about the
+    receiver's origin, from the solids' constraint forces W and the multipliers μ (linear in
+    both: module doc). Inside, one row per quantity with the steps along it (step-last
+    copies of the inputs): every operation runs along the steps, none along an axis of 2."""
     form, mech = pl.form, pl.mech
-    bd = inverse.bodies(form)
-    n, ns = len(z), len(form.frames)
-    wrench = np.zeros((n, len(mech.constraints), 3))            # about O, on the receiver
+    n, nc = len(z), len(mech.constraints)
+    Wt, Zt = (np.ascontiguousarray(np.moveaxis(x, 0, -1)) for x in (W, zeta))  # (ns, 4, n)
+    mut, zt = np.ascontiguousarray(mu.T), z.T
+    wrench = np.zeros((nc, 3, n))                              # about O, on the receiver
     on = {}                                                    # (element, solid) -> about O
-    copies = np.zeros((n, ns, form.nz))                         # A_sᵀ W_s per solid
-    for i in pl.moving:
-        copies[:, i] = np.einsum("nk,kz->nz", W[:, i], bd.A[i])
+    # A_sᵀ W_s per solid, on the columns of its column pins only (``Plan.copied``)
+    copies = {i: _combined(Wt[i], terms) for i, (_, terms) in pl.copied.items()}
     for r, i in enumerate(pl.rigid):                           # s's rigid rows on its copy
-        copies[:, i] += J[:, r] * mu[:, r, None]
+        if i in copies:
+            for a, c in enumerate(pl.copied[i][0]):
+                copies[i][a] += J[:, r, c] * mut[r]
+    if pl.rows_of:
+        Jht = np.ascontiguousarray(np.moveaxis(Jh, 0, -1))     # (rows, ζ̂, n)
     for k, rows in pl.rows_of.items():
         el = mech.constraints[k]
-        g = np.einsum("nr,nrj->nj", mu[:, pl.first + rows], Jh[:, rows])
-        total = np.zeros((n, 3))
+        total = np.zeros((3, n))
         for i in el.solids:
             if i in form.grounds or (k, i) in on:
                 continue
             j = pl.frame_eq.start[i]
             f = pl.frame_eq.frames[i]
-            moment = -g[:, f.angle] if f.angle is not None else 0.0
-            on[(k, i)] = w = _about_origin(zeta[:, i, :2], zeta[:, i, 2:], -g[:, j:j + 2],
-                                           -g[:, j + 2:j + 4], moment)
+            wanted = list(range(j, j + 4)) + ([f.angle] if f.angle is not None else [])
+            g = _summed(mut[pl.first + rows], Jht[rows][:, wanted])   # (Φ_ζ̂ᵀ μ) there
+            moment = -g[4] if f.angle is not None else 0.0
+            on[(k, i)] = w = _about_origin(Zt[i], -g[0:2], -g[2:4], moment)
             total += w
-            copies[:, i] += np.einsum("nk,kz->nz", g[:, j:j + 4], bd.A[i])
-            if f.angle is not None:
-                copies[:, i, pl.angle_cols[i]] += g[:, f.angle]
-        wrench[:, k] = -total if el.receiver in form.grounds else on[(k, el.receiver)]
+            if i in copies:                # (its angle column is no pin's)
+                copies[i] += _combined(g, pl.copied[i][1])
+        wrench[k] = -total if el.receiver in form.grounds else on[(k, el.receiver)]
         for i in el.solids:
             if i in form.grounds:
                 on[(k, i)] = on.get((k, i), 0.0) - total
-    balance = _about_origin(zeta[:, :, :2].reshape(-1, 2), zeta[:, :, 2:].reshape(-1, 2),
-                            W[:, :, :2].reshape(-1, 2), W[:, :, 2:].reshape(-1, 2)
-                            ).reshape(n, ns, 3)
+    balance = np.stack([_about_origin(Zt[i], Wt[i, :2], Wt[i, 2:])
+                        for i in range(len(form.frames))])
     left = balance.copy()                                      # what the pins must give
     for (k, i), w in on.items():
-        left[:, i] -= w
-    pins = sorted(pl.pins, key=lambda p: p.columns is None)    # column points first
-    for pin in pins:
+        left[i] -= w
+    for pin in pl.ordered_pins:                                # column points first
         if pin.columns is not None:
-            point = z[:, pin.columns]
-            force = np.stack([copies[:, i][:, pin.columns] for i in pin.solids], axis=1)
+            point = zt[pin.columns]
+            force = [copies[i][at] for i, at in zip(pin.solids, pin.at)]
             for r, i in enumerate(pin.solids):
-                left[:, i, :2] -= force[:, r]
-                left[:, i, 2] -= cross(point, force[:, r])
+                left[i, :2] -= force[r]
+                left[i, 2] -= _cross(point, force[r])
         else:
-            point = np.broadcast_to(pin.constant, (n, 2))
-            force = np.stack([left[:, i, :2] for i in pin.solids], axis=1)
-        revolute = np.einsum("es,nsd->ned", pin.inverse, force)  # on each receiver
-        for e, k in enumerate(pin.revolutes):
+            point = pin.constant
+            force = [left[i, :2].copy() for i in pin.solids]
+        for e, k in enumerate(pin.revolutes):                  # on each receiver
             el = mech.constraints[k]
-            w = np.zeros((n, 3))
-            w[:, :2], w[:, 2] = revolute[:, e], cross(point, revolute[:, e])
-            wrench[:, k] = w
+            w = wrench[k]
+            w[:2] = _mixed(pin.inverse[e], force)
+            w[2] = _cross(point, w[:2])
             for i in el.solids:
                 if i in form.grounds:
                     sign = 1.0 if i == el.receiver else -1.0
@@ -330,11 +374,31 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
     for k, el in enumerate(mech.constraints):
         if el.grounds:                                         # the held solid's balance
             g = el.holds
-            w = balance[:, g].copy()
+            w = balance[g].copy()
             for (kk, i), other in on.items():
                 if i == g and kk != k:
                     w -= other
-            wrench[:, k] = w
+            wrench[k] = w
+    out = np.empty((n, nc, 3))
     for k, origin in enumerate(origins):                       # about the receiver's origin
-        wrench[:, k, 2] -= cross(origin, wrench[:, k, :2])
-    return wrench
+        wrench[k, 2] -= origin[:, 0] * wrench[k, 1] - origin[:, 1] * wrench[k, 0]
+        for d in range(3):
+            out[:, k, d] = wrench[k, d]
+    return out
+
+
+def _summed(weights, rows) -> np.ndarray:
+    """Σ_r weights[r] rows[r] (rows (R, k, n), weights (R, n)), r ascending from 0 (as
+    numpy.einsum: no negative zeros)."""
+    out = np.zeros(rows.shape[1:])
+    for r in range(len(weights)):
+        out += weights[r] * rows[r]
+    return out
+
+
+def _mixed(weights, vectors) -> np.ndarray:
+    """Σ_s weights[s] vectors[s] (weights (S,), vectors S of (2, n)), s ascending."""
+    out = weights[0] * vectors[0]
+    for s in range(1, len(weights)):
+        out = out + weights[s] * vectors[s]
+    return out
