@@ -214,20 +214,23 @@ def plan(form: Formulation) -> Plan:
 def natural_rates(pl: Plan, q, qd, qdd):
     """(z, ż, z̈) of the motion q, q̇, q̈: the least-squares solutions of K z = y − k,
     K ż = ẏ, K z̈ = ÿ, y = (x, y, cos fi, sin fi) of every solid and the angle coordinates
-    (exact: they are linear in z, ``Formulation.pose_forms``)."""
-    ns = len(pl.form.frames)
-    i, angles = np.arange(ns), pl.angle_solids
-    fi, w, a = q[:, ANGLES], qd[:, ANGLES], qdd[:, ANGLES]
-    c, s = np.cos(fi), np.sin(fi)
-    y = np.empty((3, len(q), 4 * ns + len(angles)))
+    (exact: they are linear in z, ``Formulation.pose_forms``). y is built one row per
+    quantity with the steps along it (no operation along an axis of 4 solids)."""
+    ns, n = len(pl.form.frames), len(q)
+    y = np.empty((3, 4 * ns + len(pl.angle_solids), n))
     for out, v in zip(y, (q, qd, qdd)):
-        out[:, 0:4 * ns:4], out[:, 1:4 * ns:4] = v[:, column(i, 0)], v[:, column(i, 1)]
-        out[:, 4 * ns:] = v[:, column(angles, 2)]
-    y[0, :, 2:4 * ns:4], y[0, :, 3:4 * ns:4] = c, s
-    y[1, :, 2:4 * ns:4], y[1, :, 3:4 * ns:4] = -s * w, c * w
-    y[2, :, 2:4 * ns:4], y[2, :, 3:4 * ns:4] = -s * a - c * w * w, c * a - s * w * w
-    y[0] -= pl.offsets
-    return tuple(inverse.times(v, pl.rates) for v in y)
+        for i in range(ns):
+            out[4 * i], out[4 * i + 1] = v[:, column(i, 0)], v[:, column(i, 1)]
+        for r, i in enumerate(pl.angle_solids):
+            out[4 * ns + r] = v[:, column(i, 2)]
+    for i in range(ns):
+        fi, w, a = q[:, column(i, 2)], qd[:, column(i, 2)], qdd[:, column(i, 2)]
+        c, s = np.cos(fi), np.sin(fi)
+        y[0, 4 * i + 2], y[0, 4 * i + 3] = c, s
+        y[1, 4 * i + 2], y[1, 4 * i + 3] = -s * w, c * w
+        y[2, 4 * i + 2], y[2, 4 * i + 3] = -s * a - c * w * w, c * a - s * w * w
+    y[0] -= pl.offsets[:, None]
+    return tuple((pl.rates @ v).T for v in y)      # (n, nz) views, as ``inverse.times``
 
 
 def _about_origin(zeta, force_p, force_v, moment=0.0):
