@@ -141,8 +141,7 @@ class ExudynSystem:
     """
 
     items = items
-    #: the clock that times the predictor's probe (``predictor.Probe``): this thread's CPU
-    #: time, which other processes on the machine do not stop
+    #: the predictor's probe's clock (``predictor.Probe``): this thread's CPU time
     clock = staticmethod(time.thread_time)
 
     def __init__(self, mech, forces: bool = False, velocity_forces: bool = True,
