@@ -17,7 +17,7 @@ from .job import Job, warn_redundant
 
 #: steps solved by one call of the backend: a longer run is solved in parts, one tick of its
 #: progress bar each (a part takes a few seconds: 5 s for the four-bar on a slow machine;
-#: each part costs the Exudyn backend a new system, about 0.2 s, so parts are not made smaller)
+#: each part costs the Exudyn backend a new system, about 5 ms, and its predictor's probe)
 PART_STEPS = 50_000
 
 #: stiffness tying each coordinate to its guess when degrees of freedom are free, so that
