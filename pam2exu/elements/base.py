@@ -10,8 +10,6 @@ builder, ``draw`` a pen (``pictures.pen.Pen``).
 """
 from __future__ import annotations
 
-import functools
-
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -129,13 +127,6 @@ def constants(value, size: int = 4) -> tuple[float, ...]:
     values = list(value) if isinstance(value, (list, tuple, np.ndarray)) else [value]
     values = [scalar(v) for v in values]
     return tuple(values + [0.0] * (size - len(values)))
-
-
-@functools.lru_cache(maxsize=1024)
-def _law(name: str, C: tuple) -> Law:
-    """The law ``name`` with constants C, made once (a ``Law`` is frozen: shared safely; a
-    run asks its actuators' laws a dozen times, a study thousands)."""
-    return Law(name, C)
 
 
 def number(value) -> float:
@@ -456,7 +447,7 @@ class Actuator(Element):
 
     def time_law(self) -> Law:
         """The law f(t) with this element's constants (subclasses have ``law`` and ``C``)."""
-        return _law(self.law, constants(self.C))
+        return Law(self.law, constants(self.C))
 
     def compute(self, st, names):
         f, df, _ = self.time_law()(st.t)
