@@ -77,9 +77,9 @@ def fold(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | None:
     differences, step ``STEP`` · ``scale`` (the residuals stay exact, so the point does)."""
     nq = mech.nq
     v0 = null_motion(_jacobian(mech, t0, q0)[1])
-    x = np.concatenate([q0, [t0], v0])
     h = STEP * scale
-    for _ in range(ITERATIONS):
+
+    def system(x):
         q, t, v = x[:nq], x[nq], x[nq + 1:]
         eq = _stencil(mech, q, t, h)
         C, J, Ct = eq.residual[0], eq.jacobian[0], eq.c_t[0]
@@ -90,14 +90,13 @@ def fold(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | None:
         A[:m, :nq], A[:m, nq] = J, Ct
         A[m:2 * m, :nq], A[m:2 * m, nq], A[m:2 * m, nq + 1:] = d_q, d_t, J
         A[-1, nq + 1:] = v0
-        step = np.linalg.lstsq(A, -F, rcond=None)[0]
-        x = x + step
-        if not np.all(np.isfinite(x)):
-            return None
-        if abs(step[nq]) < TIME_TOL and np.max(np.abs(step[:nq])) < 1e-12 * scale:
-            q, v = x[:nq], x[nq + 1:]
-            return Singular("dead point", float(x[nq]), q, v / np.linalg.norm(v))
-    return None
+        return F, A
+
+    x = _converged(system, np.concatenate([q0, [t0], v0]), nq, scale)
+    if x is None:
+        return None
+    v = x[nq + 1:]
+    return Singular("dead point", float(x[nq]), x[:nq], v / np.linalg.norm(v))
 
 
 def branch_point(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | None:
@@ -107,9 +106,9 @@ def branch_point(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | No
     when it does not converge. Derivatives by central differences, as ``fold``."""
     nq, m = mech.nq, mech.n_equations
     w0 = np.linalg.svd(_jacobian(mech, t0, q0)[1])[0][:, -1]
-    x = np.concatenate([q0, [t0], w0])
     h = STEP * scale
-    for _ in range(ITERATIONS):
+
+    def system(x):
         q, t, w = x[:nq], x[nq], x[nq + 1:]
         eq = _stencil(mech, q, t, h)
         C, J, Ct = eq.residual[0], eq.jacobian[0], eq.c_t[0]
@@ -123,14 +122,28 @@ def branch_point(mech, t0: float, q0: np.ndarray, scale: float) -> Singular | No
         A[m + nq, :nq], A[m + nq, nq] = _central(Ctw, nq, h)
         A[m + nq, nq + 1:] = Ct
         A[-1, nq + 1:] = w0
+        return F, A
+
+    x = _converged(system, np.concatenate([q0, [t0], w0]), nq, scale)
+    if x is None:
+        return None
+    q = x[:nq]
+    return Singular("change point", float(x[nq]), q,
+                    null_motion(_jacobian(mech, float(x[nq]), q)[1]))
+
+
+def _converged(system, x: np.ndarray, nq: int, scale: float) -> np.ndarray | None:
+    """x (q, t, then the extra unknowns) after Gauss–Newton steps A s = −F (least squares,
+    (F, A) = ``system(x)``) until the step is below TIME_TOL in t and 1e-12 · scale in q;
+    None when x stops being finite or ITERATIONS steps do not get there."""
+    for _ in range(ITERATIONS):
+        F, A = system(x)
         step = np.linalg.lstsq(A, -F, rcond=None)[0]
         x = x + step
         if not np.all(np.isfinite(x)):
             return None
         if abs(step[nq]) < TIME_TOL and np.max(np.abs(step[:nq])) < 1e-12 * scale:
-            q = x[:nq]
-            return Singular("change point", float(x[nq]), q,
-                            null_motion(_jacobian(mech, float(x[nq]), q)[1]))
+            return x
     return None
 
 
