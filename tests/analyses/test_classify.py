@@ -162,12 +162,17 @@ def test_slider_crank_grashof_with_offset(offset):
     assert atlas.assembly_modes == 2 and loop.selected == "open"
 
 
+def _folded_rocker(d, a, b, c):
+    """ψ of the rocker-driven crank-rocker's dead point: the crank and coupler in line,
+    |O2 B| = b − a with B = O4 + c (cos ψ, sin ψ)."""
+    return np.arccos(((b - a) ** 2 - d * d - c * c) / (2 * d * c))
+
+
 def test_dead_points_of_a_rocker_driven_crank_rocker():
     d, a, b, c = 0.4, 0.1, 0.35, 0.3
     atlas = classify(four_bar(d, a, b, c, rocker_driven=True, psi0=2.0, speed=1.0,
                               t_end=1.0, steps=10))
-    # the crank and coupler in line: |O2 B| = b − a, B = O4 + c (cos ψ, sin ψ)
-    psi = np.arccos(((b - a) ** 2 - d * d - c * c) / (2 * d * c))
+    psi = _folded_rocker(d, a, b, c)
     (point,) = atlas.dead_points
     assert point["kind"] == "dead point" and point["joint"] == "A" and point["loop"] == 1
     assert point["t"] == pytest.approx(psi - 2.0, abs=1e-9)
@@ -334,7 +339,7 @@ def test_a_dead_point_far_past_the_last_solved_step_is_still_found():
     d, a, b, c = 0.4, 0.1, 0.35, 0.3
     atlas = classify(four_bar(d, a, b, c, rocker_driven=True, psi0=2.0, speed=1.0,
                               t_end=1.0, steps=2))
-    psi = np.arccos(((b - a) ** 2 - d * d - c * c) / (2 * d * c))
+    psi = _folded_rocker(d, a, b, c)
     (point,) = atlas.dead_points
     assert point["t"] == pytest.approx(psi - 2.0, abs=1e-9) and atlas.note == ""
 

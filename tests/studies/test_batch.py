@@ -59,9 +59,9 @@ tol = 3e-3
 """
 
 
-def _both(text: str):
+def _both(text: str, folder: Path = EXAMPLES):
     """The study run in one pass, and with every variant alone."""
-    s = loads_study(text, folder=EXAMPLES)
+    s = loads_study(text, folder=folder)
     return study(s, workers=1), study(dataclasses.replace(s, batched=False), workers=1)
 
 
@@ -193,8 +193,7 @@ tol = 2e-3
     p = payload(s, nominal(s)[0])
     assert all(b is not None for b in answered(p, [m for m, _ in
                                                    (made_variant(p, v) for v in p["values"])]))
-    batched, alone = study(s, workers=1), study(dataclasses.replace(s, batched=False),
-                                                 workers=1)
+    batched, alone = _both(text, tmp_path)
     _same(batched, alone)
     assert batched.table["status"].tolist() == ["ok"] * 3
 
