@@ -8,7 +8,11 @@
 - ``pool_ready``: the seconds from opening a local pool of 2 until both workers ran a
   pam2exu task, opened at once or after the study's checks as ``pam2exu study`` does;
 - ``cores_free``: the cores two processes get at once on this machine now, the most a pool
-  of 2 can gain then.
+  of 2 can gain then;
+- ``sending``: what sending a study's chunks costs a Dask cluster when each chunk carries
+  every variant's values (as before the engine's ``rows``) against its own rows only.
+
+    python benchmarks/workers.py --pool-start 0 --sending 1000000
 """
 from __future__ import annotations
 
@@ -136,11 +140,52 @@ def cores_free(seconds: float = 2.0) -> float:
     return 2 * one / two
 
 
+def values_sum(payload, start, stop, rows=None):
+    """A chunk's task that only reads its variants' values: from every variant's values in
+    the payload (``rows`` None), or from its own rows."""
+    mine = payload["values"][start:stop] if rows is None else rows
+    return {"sum": mine.sum(axis=1)}
+
+
+def sending(variants: int, chunks: int = 100, parameters: int = 3) -> dict:
+    """{way: seconds} to run ``chunks`` chunks of 400 variants of a study of ``variants``
+    variants through ``execute.run_chunks`` on a Dask LocalCluster of 2 workers, each chunk
+    sent every variant's values in its payload ("whole") or its own rows ("own rows")."""
+    import warnings
+    from pam2exu.studies.execute import open_executor, run_chunks
+    values = np.random.default_rng(1).random((variants, parameters))
+    todo = [(400 * k, 400 * (k + 1)) for k in range(chunks)]
+    out = {}
+    with open_executor(dask_local=2) as client, tempfile.TemporaryDirectory() as folder:
+        run_chunks(values_sum, {}, todo[:2], Path(folder, "warm"), client, rows=values,
+                   progress=False)
+        for way in ("whole", "own rows"):
+            begin = time.perf_counter()
+            with warnings.catch_warnings():          # Dask's "large graph" warning
+                warnings.simplefilter("ignore")
+                if way == "whole":
+                    run_chunks(values_sum, {"values": values}, todo, Path(folder, way),
+                               client, progress=False)
+                else:
+                    run_chunks(values_sum, {}, todo, Path(folder, way), client, rows=values,
+                               progress=False)
+            out[way] = time.perf_counter() - begin
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--pool-start", type=int, default=3, metavar="ROUNDS",
                         help="rounds of pool_ready, each way (default 3)")
+    parser.add_argument("--sending", type=int, default=0, metavar="VARIANTS",
+                        help="time sending 100 chunks of a study of VARIANTS variants to a "
+                             "Dask cluster, whole values against each chunk's own rows")
     args = parser.parse_args(argv)
+    if args.sending:
+        took = sending(args.sending)
+        print(f"100 chunks of a {args.sending:,}-variant study on a Dask LocalCluster of 2: "
+              f"every variant's values in each chunk {took['whole']:.2f} s, each chunk's own "
+              f"rows {took['own rows']:.2f} s; load {load_average():.2f}")
     workers_see_this_clone()
     for _ in range(args.pool_start):
         print(f"pool of 2 ready: opened at once {pool_ready(False):.2f} s, after the checks "

@@ -1,12 +1,16 @@
 """The engine that runs a study's chunks: in-process, on a local process pool or on Dask.
 
-``run_chunks(task, payload, chunks, parts)`` computes ``task(payload, start, stop)`` for
-every chunk ``(start, stop)`` and returns the merged columns in row order. The task is a
-picklable top-level function returning ``{column name: values}`` with one entry per row
-``start … stop − 1`` along the first axis (numbers or fixed-width strings, no objects);
-``payload`` is what every worker needs to compute any chunk (the model's text and the
-variants' parameter values, never solver objects: the worker builds the mechanism). The
-engine knows nothing of what a chunk computes.
+``run_chunks(task, payload, chunks, parts, rows=…)`` computes
+``task(payload, start, stop, rows[start:stop])`` for every chunk ``(start, stop)`` and
+returns the merged columns in row order. The task is a picklable top-level function
+returning ``{column name: values}`` with one entry per row ``start … stop − 1`` along the
+first axis (numbers or fixed-width strings, no objects); ``payload`` is what every worker
+needs to compute any chunk (the model's text, the analysis settings: small, never solver
+objects: the worker builds the mechanism), ``rows`` what only one row needs (the variants'
+parameter values): each chunk is sent its own rows only, so that what a chunk costs to send
+does not grow with the study (a million variants' values are 24 MB: sent with each of
+2,500 chunks they cost a Dask cluster 94 ms a chunk and its "large graph" warning, against
+4 ms for the chunk's own rows, measured). The engine knows nothing of what a chunk computes.
 
 Where it runs (``executor``):
 
@@ -202,20 +206,36 @@ def open_executor(workers: int | None = None, dask: str | None = None,
             pool.shutdown(wait=True, cancel_futures=True)
 
 
+class Work(NamedTuple):
+    """What ``run_chunks`` computes: the task, what every chunk needs, what each row needs."""
+
+    task: Callable
+    payload: object
+    rows: object = None
+
+    def arguments(self, start: int, stop: int) -> tuple:
+        """The task's arguments for rows ``start … stop − 1``: the payload and the chunk's
+        own rows only."""
+        if self.rows is None:
+            return self.payload, start, stop
+        return self.payload, start, stop, self.rows[start:stop]
+
+
 def run_chunks(task: Callable, payload, chunks, parts, executor=None, resume: bool = False,
                progress: bool = True, key: str | None = None,
-               retries: int = RETRIES) -> Chunked:
-    """Compute ``task(payload, start, stop)`` for every chunk, each written whole under
-    ``parts`` as it finishes, and return the columns merged in row order.
+               retries: int = RETRIES, rows=None) -> Chunked:
+    """Compute ``task(payload, start, stop, rows[start:stop])`` for every chunk (without
+    ``rows``: ``task(payload, start, stop)``), each written whole under ``parts`` as it
+    finishes, and return the columns merged in row order.
 
     Parameters
     ----------
     task : callable
-        A picklable top-level function ``task(payload, start, stop) -> dict[str, ndarray]``
-        (rows ``start … stop − 1`` along each array's first axis; the same names in every
-        chunk).
+        A picklable top-level function ``task(payload, start, stop[, rows]) ->
+        dict[str, ndarray]`` (rows ``start … stop − 1`` along each array's first axis; the
+        same names in every chunk).
     payload : object
-        Small and picklable: what every chunk needs (model text, parameter values).
+        Small and picklable: what every chunk needs (model text, analysis settings).
     chunks : list of (int, int)
         ``(start, stop)`` tiling rows 0 … n − 1 (``parts.plan_chunks``).
     parts : str or Path
@@ -229,9 +249,12 @@ def run_chunks(task: Callable, payload, chunks, parts, executor=None, resume: bo
         Show the variants done, their rate and the time left (on a terminal only).
     key : str, optional
         The study's fingerprint, stored in every part; a part with another key is not
-        reused. Default: a hash of the task's name and the payload.
+        reused. Default: a hash of the task's name, the payload and the rows.
     retries : int
         Times a chunk is run again after its worker process was lost (process pool).
+    rows : array (n, …), optional
+        What only row i needs, at ``rows[i]`` (a study's variants' values): each chunk is
+        sent its own rows only (module docstring).
 
     Returns
     -------
@@ -247,7 +270,9 @@ def run_chunks(task: Callable, payload, chunks, parts, executor=None, resume: bo
     chunks = checked_chunks(chunks)
     variants = chunks[-1][1] if chunks else 0
     folder = Path(parts)
-    key = key or fingerprint(task.__module__, task.__qualname__, payload)
+    work = Work(task, payload, rows)
+    key = key or fingerprint(task.__module__, task.__qualname__, payload,
+                             *(() if rows is None else (np.asarray(rows),)))
     if not resume:
         clear_parts(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -269,13 +294,13 @@ def run_chunks(task: Callable, payload, chunks, parts, executor=None, resume: bo
     bar.update(sum(p.stop - p.start for p in done))     # the rate counts from here
     try:
         if is_dask_client(executor):
-            run_on_dask(executor, task, payload, todo, finish, folder)
+            run_on_dask(executor, work, todo, finish, folder)
         elif isinstance(executor, Executor):
-            run_on_pool(executor, task, payload, todo, finish, folder, retries)
+            run_on_pool(executor, work, todo, finish, folder, retries)
         elif executor is None:
             for start, stop in todo:
                 try:
-                    columns = task(payload, start, stop)
+                    columns = work.task(*work.arguments(start, stop))
                 except Exception as exc:
                     raise task_error(start, stop, exc, folder) from exc
                 finish(start, stop, columns)
@@ -344,7 +369,7 @@ def lost_error(start: int, stop: int, times: str, folder: Path) -> ChunkError:
                       f"out){kept(folder)}", start, stop)
 
 
-def run_on_pool(executor: Executor, task, payload, todo, finish, folder: Path,
+def run_on_pool(executor: Executor, work: Work, todo, finish, folder: Path,
                 retries: int) -> None:
     """The chunks on a ``concurrent.futures`` executor, at most its workers in flight.
 
@@ -358,7 +383,7 @@ def run_on_pool(executor: Executor, task, payload, todo, finish, folder: Path,
     try:
         while pending or suspects:
             queue = suspects if suspects else pending
-            broken = pool_round(pool, task, payload, queue, finish, folder,
+            broken = pool_round(pool, work, queue, finish, folder,
                                 1 if queue is suspects else workers(pool))
             if broken is None:
                 continue
@@ -392,7 +417,7 @@ def replacement(executor: Executor) -> Executor:
     return ProcessPoolExecutor(executor._max_workers, mp_context=executor._mp_context)
 
 
-def pool_round(pool: Executor, task, payload, pending: deque, finish, folder: Path,
+def pool_round(pool: Executor, work: Work, pending: deque, finish, folder: Path,
                width: int):
     """Run chunks from ``pending`` on ``pool``, ``width`` in flight, until it is empty
     (None) or the pool breaks: then the chunks that were in flight (the unsubmitted ones
@@ -403,7 +428,7 @@ def pool_round(pool: Executor, task, payload, pending: deque, finish, folder: Pa
             while pending and len(flight) < width and broken is None and error is None:
                 chunk = pending.popleft()
                 try:
-                    flight[pool.submit(task, payload, *chunk)] = chunk
+                    flight[pool.submit(work.task, *work.arguments(*chunk))] = chunk
                 except BrokenExecutor:
                     pending.appendleft(chunk)
                     broken = []
@@ -429,12 +454,12 @@ def pool_round(pool: Executor, task, payload, pending: deque, finish, folder: Pa
     return None if broken is None else sorted(broken)
 
 
-def run_on_dask(client, task, payload, todo, finish, folder: Path) -> None:
+def run_on_dask(client, work: Work, todo, finish, folder: Path) -> None:
     """The chunks on a Dask cluster, all submitted at once, finished as they arrive; on an
     error, the chunks finished meanwhile are kept before it is raised."""
     distributed = dask_module()
     run = uuid.uuid4().hex[:12]
-    futures = {client.submit(task, payload, start, stop, pure=False,
+    futures = {client.submit(work.task, *work.arguments(start, stop), pure=False,
                              key=f"pam2exu-chunk-{start}-{stop}-{run}"):
                (start, stop) for start, stop in todo}
     try:

@@ -3,8 +3,9 @@ worker from the model's text and its values, the chunks of variants run and merg
 variant order, the result (``result.StudyResult``).
 
 A worker receives a payload of plain data (``payload``: the model's text, the analysis
-settings, the reductions, the requirements, the parameters' names and every variant's
-values), never solver objects, and runs rows ``start … stop − 1`` (``run_variants``). A
+settings, the reductions, the requirements, the parameters' names), never solver objects,
+with its chunk's variants' values only, and runs rows ``start … stop − 1``
+(``run_variants``). A
 variant that fails is a row with status ``error``: a pam2exu error with its class and
 message, any other exception named as a fault of pam2exu. It never stops the study.
 """
@@ -117,7 +118,8 @@ def warned(caught: list) -> str:
     return "\n".join(lines.values())
 
 
-def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
+def run_variants(payload: dict, start: int, stop: int, values: np.ndarray
+                 ) -> dict[str, np.ndarray]:
     """The per-variant columns of rows ``start … stop − 1`` (``reduce.variant_table``),
     their warnings (the column ``messages.WARNINGS``, which ``StudyResult`` takes out) and,
     with a study that keeps them, the series' 2-D columns (``series.chunk_series``): the
@@ -127,22 +129,24 @@ def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
     ----------
     payload : dict
         ``payload(study, outputs)``: model text and source, analysis, t_end, steps,
-        outputs, reduce, requirements, the parameters' names, every variant's values,
-        the rows of a variant's series (None: no series).
+        outputs, reduce, requirements, the parameters' names, the rows of a variant's
+        series (None: no series).
     start, stop : int
         The rows.
+    values : array (stop − start, parameters)
+        The chunk's variants' values (its rows of ``Study.variants``).
     """
     rows, warned_rows, kept = [], [], []
     made = solved = [None] * (stop - start)
     if one_pass(payload):                  # the chunk's positions in one pass
-        made = [made_variant(payload, payload["values"][i]) for i in range(start, stop)]
+        made = [made_variant(payload, v) for v in values]
         solved = answered(payload, [model for model, _ in made])
     for i in range(start, stop):
-        values = payload["values"][i]
-        reduced, outcome, warned_text, series = run_variant(payload, values, made[i - start],
+        row = values[i - start]
+        reduced, outcome, warned_text, series = run_variant(payload, row, made[i - start],
                                                             solved[i - start])
-        rows.append(Variant(i, ERROR, outcome, tuple(values), None) if reduced is None
-                    else Variant(i, outcome, "", tuple(values), reduced))
+        rows.append(Variant(i, ERROR, outcome, tuple(row), None) if reduced is None
+                    else Variant(i, outcome, "", tuple(row), reduced))
         warned_rows.append(warned_text)
         kept.append(series)
     table = variant_table(payload["names"], payload["reduced"], rows)
@@ -154,12 +158,13 @@ def run_variants(payload: dict, start: int, stop: int) -> dict[str, np.ndarray]:
 
 
 def payload(study: Study, reduced: list[str]) -> dict:
-    """What every worker receives: plain data, no solver objects."""
+    """What every worker receives: plain data, no solver objects, and not the variants'
+    values (each chunk is sent its own rows of ``Study.variants``: ``run_chunks``' rows)."""
     return {"model_text": study.model_text, "source": str(study.model_path),
             "analysis": study.analysis, "t_end": study.t_end, "steps": study.steps,
             "outputs": study.outputs, "reduce": list(study.reduce),
             "requirements": [tuple(r) for r in study.requirements], "names": study.names,
-            "reduced": reduced, "values": study.variants(),
+            "reduced": reduced,
             "series": series_rows(analysis_type(study.analysis).at_start, study.steps)
             if study.series else None,
             "as_made": analysis_type(study.analysis).parts_as_made,
@@ -309,7 +314,8 @@ def run_checked(run_as: Study, names: list[str], units: dict, out=None, executor
         parts = Path(f"{out}.parts") if out is not None else \
             Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="pam2exu-study-")))
         done = run_chunks(run_variants, payload(run_as, names), chunks_of(run_as, workers),
-                          parts, executor, resume=resume, progress=progress)
+                          parts, executor, resume=resume, progress=progress,
+                          rows=run_as.variants())
     table, series = split(done.columns)
     result = StudyResult(run_as, table, names, units,
                          long_table(table, series, series_outputs(names)) if series else None,

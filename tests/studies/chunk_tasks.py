@@ -22,6 +22,13 @@ def rows(payload, start, stop):
             "status": np.where(draws[:, 0] > 0, "ok", "rejected")}
 
 
+def own_rows(payload, start, stop, rows):
+    """Rows start … stop − 1 from the chunk's ``rows`` (``run_chunks``' rows): ``x`` = 2 ×
+    its first column, ``sent`` the rows the chunk was sent, ``first`` the first one's x."""
+    return {"sample": np.arange(start, stop), "x": 2.0 * rows[:, 0],
+            "sent": np.full(stop - start, len(rows)), "first": np.full(stop - start, rows[0, 0])}
+
+
 def dies_once(payload, start, stop):
     """``rows``, but the first attempt at the chunk holding row ``payload["die_at"]`` kills
     its process (the marker file ``payload["marker"]`` tells the first attempt)."""

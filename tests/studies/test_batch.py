@@ -94,7 +94,7 @@ def test_the_pass_solves_the_variants_it_can(four_bar):
     s = loads_study(FOUR_BAR, folder=EXAMPLES)
     p = payload(s, nominal(s)[0])
     assert one_pass(p)
-    made = [made_variant(p, v) for v in p["values"]]
+    made = [made_variant(p, v) for v in s.variants()]
     found = answered(p, [m for m, _ in made])
     # the non-Grashof variants fail in the pass (their runs say why); the others are solved
     assert [b is not None for b in found] == [True, False, False, False, True, False]
@@ -192,7 +192,7 @@ tol = 2e-3
     s = loads_study(text, folder=tmp_path)
     p = payload(s, nominal(s)[0])
     assert all(b is not None for b in answered(p, [m for m, _ in
-                                                   (made_variant(p, v) for v in p["values"])]))
+                                                   (made_variant(p, v) for v in s.variants())]))
     batched, alone = _both(text, tmp_path)
     _same(batched, alone)
     assert batched.table["status"].tolist() == ["ok"] * 3

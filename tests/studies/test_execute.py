@@ -15,6 +15,7 @@ from pathlib import Path
 
 import chunk_tasks
 import distributed
+import numpy as np
 import pytest
 
 from pam2exu.errors import OutputError
@@ -66,6 +67,34 @@ def assert_same_bytes(columns: dict, reference: dict) -> None:
     for name, values in reference.items():
         assert columns[name].dtype == values.dtype and columns[name].shape == values.shape
         assert columns[name].tobytes() == values.tobytes(), name
+
+
+def test_each_chunk_is_sent_its_own_rows_only(tmp_path, cluster):
+    # a study's variants' values go to the chunk that runs them, not to every chunk: what a
+    # chunk is sent does not grow with the study
+    rows = np.arange(2.0 * ROWS).reshape(ROWS, 2)
+    sizes = np.concatenate([np.full(stop - start, stop - start) for start, stop in CHUNKS])
+    firsts = np.concatenate([np.full(stop - start, rows[start, 0]) for start, stop in CHUNKS])
+    with ProcessPoolExecutor(2, mp_context=get_context(execute.START_METHOD)) as pool, \
+            open_executor(dask=cluster.scheduler_address) as client:
+        for name, executor in (("in-process", None), ("pool", pool), ("dask", client)):
+            run = run_chunks(chunk_tasks.own_rows, {}, CHUNKS, tmp_path / name,
+                             executor=executor, rows=rows)
+            assert run.columns["x"].tolist() == (2.0 * rows[:, 0]).tolist(), name
+            assert run.columns["sent"].tolist() == sizes.tolist(), name
+            assert run.columns["first"].tolist() == firsts.tolist(), name
+
+
+def test_the_rows_are_part_of_the_key(tmp_path):
+    # parts of a study with other values are not reused by resume
+    rows = np.arange(2.0 * ROWS).reshape(ROWS, 2)
+    run_chunks(chunk_tasks.own_rows, {}, CHUNKS, tmp_path / "p", rows=rows)
+    again = run_chunks(chunk_tasks.own_rows, {}, CHUNKS, tmp_path / "p", rows=rows,
+                       resume=True)
+    assert again.reused == tuple(CHUNKS) and again.computed == ()
+    other = run_chunks(chunk_tasks.own_rows, {}, CHUNKS, tmp_path / "p", rows=rows + 1.0,
+                       resume=True)
+    assert other.reused == () and other.columns["x"].tolist() == (2.0 * rows[:, 0] + 2.0).tolist()
 
 
 def test_the_docstring_examples():

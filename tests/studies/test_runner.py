@@ -239,15 +239,16 @@ def test_a_failure_is_an_error_row_and_a_fault_names_itself(monkeypatch):
     payload = {"model_text": (EXAMPLES / "four_bar.toml").read_text(), "source": "f.toml",
                "analysis": "kinematic", "t_end": 0.1, "steps": 2, "outputs": ["rocker.fi"],
                "reduce": ["max"], "requirements": [], "names": ["coupler.B.x"],
-               "reduced": ["rocker.fi.max"], "values": np.array([[0.35], [0.7], [0.36]])}
-    table = run_variants(payload, 1, 3)
+               "reduced": ["rocker.fi.max"]}
+    values = np.array([[0.35], [0.7], [0.36]])
+    table = run_variants(payload, 1, 3, values[1:3])
     assert table["status"].tolist() == ["error", "ok"] and table["sample"].tolist() == [1, 2]
     assert table["error"][0].startswith("SolverError: ") and np.isnan(table["rocker.fi.max"][0])
 
     def broken(*args):
         raise ValueError("boom")
     monkeypatch.setattr("pam2exu.studies.runner.reduce_run", broken)
-    table = run_variants(payload, 0, 1)
+    table = run_variants(payload, 0, 1, values[:1])
     assert table["error"].tolist() == [f"{FAULT}: ValueError: boom"]
 
 
