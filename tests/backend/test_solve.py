@@ -295,3 +295,22 @@ def test_auto_keeps_the_multipliers_across_the_probe(long_four_bar):
     np.testing.assert_allclose(runs["auto"][0], runs[False][0], rtol=0, atol=1e-12)
     scale = np.max(np.abs(runs[False][1]))
     np.testing.assert_allclose(runs["auto"][1], runs[False][1], rtol=0, atol=1e-10 * scale)
+
+
+def test_the_angle_gain_is_computed_once_per_mechanism_and_run(monkeypatch):
+    """An analysis solves its assembly, then its run, each on a new Exudyn system: the
+    round-off floor's angle coefficient (a native evaluation of every constraint) is the
+    mechanism's, evaluated once. Reference: examples/all_elements.toml's transmission
+    'mesh', fi_planet − fi_arm = T (fi_sun − fi_arm), T = −1.5, puts 1 − T = 2.5 on the
+    arm's angle, above every lever arm (< 1 m)."""
+    from pam2exu.backend import exudyn as backend
+    calls = []
+
+    def counted(mech):
+        calls.append(mech)
+        return system.angle_gain(mech)
+    monkeypatch.setattr(backend, "angle_gain", counted)
+    pam2exu.run(pam2exu.load("examples/four_bar.toml"), "kinematic", steps=10)
+    assert len(calls) == 1
+    assert system.angle_gain(pam2exu.load("examples/four_bar.toml").mechanism()) == 1.0
+    assert system.angle_gain(pam2exu.load("examples/all_elements.toml").mechanism()) == 2.5

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base import Backend, Integrator, Positions
-from .system import ExudynSystem, SolveSettings
+from .system import ExudynSystem, SolveSettings, angle_gain
 
 
 class Exudyn(Backend):
@@ -30,7 +30,8 @@ class Exudyn(Backend):
                         anchor_stiffness=0.0, rates=False) -> Positions:
         """See ``Backend.solve_positions``."""
         system = ExudynSystem(mech, forces=forces, velocity_forces=False,
-                              anchor_stiffness=anchor_stiffness, start=start)
+                              anchor_stiffness=anchor_stiffness, start=start,
+                              angle_gain=self.angle_gain(mech))
         q, solved = system.solve_positions(times, settings, redundant=redundant,
                                            multipliers=forces)
         lam = None
@@ -40,6 +41,15 @@ class Exudyn(Backend):
         error = None if system.error is None else str(system.error)
         return Positions(q, solved, error, system.coordinates(), lam,
                          system.newton_iterations)
+
+    def angle_gain(self, mech) -> float:
+        """The mechanism's ``system.angle_gain``, computed once per mechanism for this
+        backend's runs (an analysis solves its assembly, then its run: 0.5 ms each for
+        the four-bar, measured)."""
+        kept = self.__dict__.setdefault("_gains", {})
+        if id(mech) not in kept:
+            kept[id(mech)] = (mech, angle_gain(mech))     # mech kept: its id is not reused
+        return kept[id(mech)][1]
 
     def static_equilibrium(self, mech, t, start, settings, *, redundant=False,
                            anchor_stiffness=0.0) -> Positions:

@@ -14,105 +14,20 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
 import exudyn as exu
 from exudyn import itemInterface as items
 
-from ...kinematics import State, column, pose
+from ...kinematics import column, pose
+from .settings import (DENSE_UP_TO, MIN_STEP_FRACTION, SolveSettings,  # noqa: F401
+                       angle_gain, modified_newton, solver_options)
 from .predictor import PROBE_FROM, PROBE_STEPS, Predictor, Probe, extrapolate  # noqa: F401
 from .symbolic import ON_GRID, offset_function
 
 log = logging.getLogger("pam2exu")
-
-#: Exudyn's dense linear solver up to this many coordinates, the sparse one above (measured:
-#: sparse is faster from 27–51 coordinates on, 14× faster at 300; docs/performance.md)
-DENSE_UP_TO = 40
-#: Exudyn's static solver may cut a load step that fails into smaller ones: not below this
-#: fraction of a step (bounds the work of a step that cannot be solved)
-MIN_STEP_FRACTION = 1.0 / 64
-
-
-@dataclass
-class SolveSettings:
-    """Settings of Exudyn's static (position) solver.
-
-    Parameters
-    ----------
-    tolerance : float
-        Newton's absolute tolerance on the constraint residual, relative to the
-        mechanism's length scale (never below the round-off floor, ``ExudynSystem.roundoff``).
-    max_iterations : int
-        Newton iterations per step before Exudyn subdivides the step.
-    dense : bool | None
-        Dense linear solver (None: dense up to DENSE_UP_TO coordinates, sparse above).
-    verbose : int
-        Exudyn's solver output (0: quiet).
-    predictor : bool | str
-        True: start each step's Newton iteration from the quadratic extrapolation of the
-        last three solved steps (``extrapolate``) instead of the previous step's solution:
-        one Newton iteration per step instead of two on smooth motions, for a Python call
-        per step (docs/performance.md). False: from the previous step's solution. "auto"
-        (the default): a run of ``PROBE_FROM`` steps or more first times blocks of steps
-        each way (``predictor.Probe``) and goes on with the predictor only if its steps
-        were clearly the faster (``predictor.predictor_pays``); shorter runs predict.
-        Not used with redundant constraints, which Exudyn solves with a singular Jacobian:
-        there one iteration from the prediction can stop on the tolerance with a position
-        error of ~5e-12 rad after a change point (the redundant parallelogram), where two
-        from the previous step reach round-off.
-    modified_newton : bool
-        True (the default): a run's steps by Exudyn's modified Newton (one Jacobian per
-        step, reused by its further iterations; the same positions to the tolerance); False:
-        full Newton (a Jacobian per iteration). One time alone (an assembly, from a guess),
-        redundant constraints and a run whose round-off floor is above the tolerance (angles
-        of many turns: modified Newton would stop at the floor, full Newton's last iteration
-        goes below it) always use full Newton (``modified_newton``).
-    """
-
-    tolerance: float = 1e-13
-    max_iterations: int = 25
-    dense: bool | None = None
-    verbose: int = 0
-    predictor: bool | str = "auto"
-    modified_newton: bool = True
-
-
-def modified_newton(settings: SolveSettings, redundant: bool, run: bool, roundoff: float,
-                    scale: float) -> bool:
-    """asked ∧ a run (not one time) ∧ not redundant ∧ roundoff ≤ tolerance · scale."""
-    return (bool(settings.modified_newton) and run and not redundant
-            and roundoff <= settings.tolerance * scale)
-
-
-def solver_options(mech, settings: SolveSettings, redundant: bool,
-                   roundoff: float = 0.0, run: bool = True) -> dict:
-    """The SimulationSettings that differ from Exudyn's defaults, {dotted path: value}.
-
-    roundoff: the residual floor of ``ExudynSystem.roundoff`` (a lower bound of the
-    absolute tolerance); run: a run of steps (False: one time alone, e.g. an assembly).
-    """
-    dense = settings.dense if settings.dense is not None else mech.nq <= DENSE_UP_TO
-    options = {
-        "solution.file.write": False,
-        "solution.sensors.writePeriod": 0.0,
-        "staticSolver.useLoadFactor": False,       # loads in full at every step, no ramp
-        "staticSolver.verboseMode": settings.verbose,
-        "staticSolver.newton.absoluteTolerance": max(settings.tolerance * mech.scale(),
-                                                     roundoff),
-        "staticSolver.newton.relativeTolerance": settings.tolerance,
-        "staticSolver.newton.maxIterations": settings.max_iterations,
-    }
-    if modified_newton(settings, redundant, run, roundoff, mech.scale()):
-        options["staticSolver.newton.useModifiedNewton"] = True
-        options["staticSolver.newton.modifiedNewtonJacUpdatePerStep"] = True
-    if redundant:
-        dense = True
-        options["linearSolver.ignoreSingularJacobian"] = True
-    options["linearSolver.solverType"] = (exu.LinearSolverType.EigenDense if dense
-                                          else exu.LinearSolverType.EigenSparse)
-    return options
 
 
 class ExudynSystem:
@@ -146,9 +61,11 @@ class ExudynSystem:
 
     def __init__(self, mech, forces: bool = False, velocity_forces: bool = True,
                  anchor_stiffness: float = 0.0, start=None, start_rates=None,
-                 ground_fixed: bool = False):
+                 ground_fixed: bool = False, angle_gain: float | None = None):
         exu.config.printToConsole = False
         self.mech = mech
+        #: the mechanism's ``angle_gain`` when already known (None: computed when needed)
+        self.angle_gain = angle_gain
         self.forces, self.velocity_forces = forces, velocity_forces
         self.mbs = mbs = self.new_system()
         items = self.items
@@ -311,13 +228,10 @@ class ExudynSystem:
 
         Angles are never wrapped, so the angle equations (actuators, transmissions) add up
         terms that grow with every turn: about the largest |q0| or law value over the run,
-        times the largest angle coefficient of the constraint Jacobian (a gear ratio).
+        times the largest angle coefficient of the constraint Jacobian (``angle_gain``).
         """
         q0 = self.mech.initial_q()
-        st = State([0.0], q0[None])
-        gain = max([1.0, *(float(np.max(np.abs(block[..., 2])))
-                           for el in self.mech.constraints
-                           for block in el.constraint(st)[0].jac.values())])
+        gain = angle_gain(self.mech) if self.angle_gain is None else self.angle_gain
         size = max([1.0, *np.abs(q0), *(float(np.max(np.abs(law(times)[0] + shift)))
                                         for *_, law, shift in self.drivers)])
         return 16.0 * np.finfo(float).eps * size * gain
