@@ -54,12 +54,12 @@ def driver_unit(el) -> tuple[str, float]:
     return ("rad", MAX_ANGLE_STEP) if el.angular else ("m", MAX_LENGTH_STEP)
 
 
-def motion_per_step(law, times: np.ndarray) -> float:
+def motion_per_step(law, times: np.ndarray, values=None) -> float:
     """max_k max(|f(t_k+1) − f(t_k)|, |f'(t)| Δt): the most the law moves in one step, f'
     taken at the grid's times and inside its transition (C1 … C2, which may fall between
-    two of them)."""
+    two of them); ``values``: (f, f', f'') at ``times`` when already evaluated."""
     with np.errstate(all="ignore"):
-        f, df, _ = law(times)
+        f, df, _ = law(times) if values is None else values
         dt = float(times[1] - times[0])
         inside = transition_times(law, float(times[0]), float(times[-1]))
         rate = max(np.max(np.abs(df)), np.max(np.abs(law(inside)[1]), initial=0.0))
@@ -92,14 +92,22 @@ def jump(el, dt: float) -> str | None:
             f"and ends [s]), or check the constants")
 
 
-def check_laws(mech, times: np.ndarray, ranges: bool = True) -> None:
-    """ModelError unless every law is finite (and, with ``ranges``, within range) at every
-    time of the grid."""
-    problems = []
+def law_values(mech, times: np.ndarray) -> list[tuple]:
+    """(law, (f, f', f'') at ``times``) of every actuator (``mech.drivers`` order), evaluated
+    once for the checks and the motion per step of a plan."""
+    out = []
     for el in mech.drivers:
         law = el.time_law()
         with np.errstate(all="ignore"):
-            values = law(times)
+            out.append((law, law(times)))
+    return out
+
+
+def check_laws(mech, times: np.ndarray, ranges: bool = True, evaluated=None) -> None:
+    """ModelError unless every law is finite (and, with ``ranges``, within range) at every
+    time of the grid; ``evaluated``: ``law_values(mech, times)`` when already evaluated."""
+    problems = []
+    for el, (law, values) in zip(mech.drivers, evaluated or law_values(mech, times)):
         unit, _ = driver_unit(el)
         limit = limits.LENGTH if unit == "m" else limits.ANGLE
         for order, v in enumerate(values):
@@ -132,12 +140,13 @@ def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
     ``columns`` is the number of result columns, for the memory bound.
     """
     user = np.linspace(0.0, float(t_end), int(steps) + 1)
-    check_laws(mech, user, ranges=False)     # the motion per step is said first
+    evaluated = law_values(mech, user)       # each law once on the user's grid
+    check_laws(mech, user, ranges=False, evaluated=evaluated)  # the motion per step first
     every, worst = 1, None
-    for el in mech.drivers:
+    for el, (law, values) in zip(mech.drivers, evaluated):
         unit, most = driver_unit(el)
         size = most * (mech.scale() if unit == "m" else 1.0)
-        moved = motion_per_step(el.time_law(), user)
+        moved = motion_per_step(law, user, values)
         # (a motion of exactly the limit, up to round-off, needs no sub-step)
         needed = math.ceil(moved / size - 1e-9) if math.isfinite(moved) else math.inf
         if needed > every or worst is None:
@@ -164,7 +173,7 @@ def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
             f"(were degrees given where radians are expected?)."), mech.model.source)
     every = int(every)
     times = np.linspace(0.0, float(t_end), int(steps) * every + 1) if every > 1 else user
-    check_laws(mech, times)
+    check_laws(mech, times, evaluated=evaluated if every == 1 else None)
 
     memory = 8 * (len(times) * (4 * mech.nq + mech.n_equations) + len(user) * (columns + 1))
     if memory > limits.MEMORY:
