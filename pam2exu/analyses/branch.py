@@ -82,7 +82,9 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
     warning); False: they raise a SolverError (force analyses).
     """
     mech, t = job.mech, job.times
-    q, found = positions(job, redundant, check=False, partial=True)
+    # the rates are wanted here whatever the outputs (the branch is followed on them): the
+    # backend's, as for the parts solved again (``_resolve``), not a native pass besides
+    q, found = positions(job, redundant, check=False, partial=True, with_rates=True)
     solved = found.solved
     own = found if found.qd is not None else None       # the backend's rates, if any
     breakpoints = _breakpoints(mech)

@@ -26,14 +26,15 @@ GUESS_STIFFNESS = 1.0
 
 
 def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
-              check: bool = True, partial: bool = False):
+              check: bool = True, partial: bool = False, with_rates: bool | None = None):
     """Positions at every time from the backend; raises SolverError on failure.
 
     ``check=False`` leaves the residual check to ``velocities`` (which has the residual).
     ``partial``: a failure after the first step is not raised; returns (q, Positions) with
     the rows from ``Positions.solved`` on NaN (``branch.motion`` may still repair it).
-    When the analysis needs velocities and the backend ``gives_rates``, it is asked for
-    them too (``Positions.qd``, ``qdd``; ``rates`` uses them).
+    When the analysis needs velocities (``with_rates``, default: when it outputs some) and
+    the backend ``gives_rates``, it is asked for them too (``Positions.qd``, ``qdd``;
+    ``rates`` uses them).
     """
     mech = job.mech
     clock = _time.perf_counter()
@@ -42,8 +43,9 @@ def positions(job: Job, redundant: bool, anchor_stiffness: float = 0.0,
     if len(job.times) == 1:                      # the assembly itself
         found = Positions(start[None], 1, None, start)
     else:
-        found = solve_in_parts(job, start, redundant,
-                               VELOCITY in job.levels and job.backend.gives_rates)
+        if with_rates is None:
+            with_rates = VELOCITY in job.levels
+        found = solve_in_parts(job, start, redundant, with_rates and job.backend.gives_rates)
         if found.solved:         # step 0 is the assembly (Newton moved it by round-off)
             found.q[0] = start
     job.info["backend_seconds"] = _time.perf_counter() - clock

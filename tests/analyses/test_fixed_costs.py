@@ -158,3 +158,19 @@ def test_a_singular_step_gives_nan_quietly(natural_solver):
         _, ok = solver.newton(t, z)
     assert np.isnan(zd).all() and np.isnan(zdd).all() and not ok[0]
     assert np.isnan(many[0]).all() and np.isnan(many[1]).all()
+
+
+def test_a_kinetostatic_run_of_positions_only_takes_the_backends_rates(four_bar, monkeypatch):
+    """Positions only (``rocker.fi``): the branch is still followed on the rates, now the
+    natural backend's (as for the full run), not a native pass besides; the column is the
+    full run's, bit for bit, and so are the warnings."""
+    passes, rates = [], native.rates
+    monkeypatch.setattr(native, "rates", lambda *a, **k: passes.append(1) or rates(*a, **k))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        alone = pam2exu.run(four_bar, "kinetostatic", steps=40, backend="natural",
+                            outputs=["rocker.fi"])
+        full = pam2exu.run(four_bar, "kinetostatic", steps=40, backend="natural")
+    assert passes == []
+    assert alone["rocker.fi"].tobytes() == full["rocker.fi"].tobytes()
+    assert alone.warnings == full.warnings
