@@ -50,11 +50,16 @@ class Equations:
 
 
 def target_values(target, t, m):
-    """(f, f', f'') of a constraint's right-hand side, each (n, m) or broadcastable."""
+    """(f, f', f'') of a constraint's right-hand side, each (n, m) or broadcastable to it
+    (a constant: a read-only view of it, not ``np.broadcast_to``'s, 5 µs a constraint)."""
     if isinstance(target, Law):
         f, df, ddf = target(t)
         return f[:, None], df[:, None], ddf[:, None]
     target = as_array(target)                  # (m,), or (n, m) where it varies by row
+    if target.ndim == 0 or target.shape == (m,):    # read-only, broadcast where used
+        view = target.view()
+        view.flags.writeable = False
+        return view, 0.0, 0.0
     return np.broadcast_to(target, np.broadcast_shapes(target.shape, (m,))), 0.0, 0.0
 
 
