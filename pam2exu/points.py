@@ -368,7 +368,9 @@ def columns(mech, t, q, qd, qdd, wanted) -> tuple[dict[str, np.ndarray], list[st
     out, notes = {}, []
     length = mech.scale()
     st = None
-    for c in couplers(mech):
+    angles = {v.name for v in COUPLER_OUTPUTS}
+    asked = any(c.rpartition(".")[2] in angles for c in wanted)   # else no coupler is sought
+    for c in couplers(mech) if asked else ():
         name = f"{mech.solids[c.solid].name}.transmission_angle"
         if name in wanted:
             if st is None:

@@ -301,7 +301,7 @@ def _interpolate_singular(t, qd, qdd, singular):
 def condition_samples(mech) -> int:
     """Steps of a run whose condition numbers are computed (equally spaced; an SVD costs
     ~nq³: fewer for large mechanisms)."""
-    return int(np.clip(2e7 / max(1, mech.nq) ** 3, 1, CONDITION_SAMPLES))
+    return int(min(max(2e7 / max(1, mech.nq) ** 3, 1), CONDITION_SAMPLES))
 
 
 def _warn_ill_conditioned(job: Job, q, singular, near=(), jacobian=None) -> None:
