@@ -316,10 +316,8 @@ def _warn_ill_conditioned(job: Job, q, singular, near=(), jacobian=None) -> None
     steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), samples)).astype(int),
                             np.asarray(near, dtype=int)[:samples]])
     steps = steps[~singular[steps]]
-    condition = rank.condition_numbers(mech, t[steps], q[steps],
-                                       None if jacobian is None else jacobian[steps])
-    i = int(np.argmax(condition))
-    worst = float(condition[i])
+    i, worst = rank.largest_condition(mech, t[steps], q[steps],
+                                      None if jacobian is None else jacobian[steps])
     job.info["max_condition_number"] = worst
     # well-conditioned large mechanisms (long chains) still have condition numbers that
     # grow with their size: the threshold grows as √(coordinates / 12)

@@ -25,12 +25,68 @@ def condition_numbers(mech, t, q, jacobian: np.ndarray | None = None) -> np.ndar
     J = equations(mech, State(t, q)).jacobian if jacobian is None else jacobian
     if J.shape[1] == 0:
         return np.full(len(J), np.inf)
+    return _kappa(_equilibrated(J), min(J.shape[1], mech.nq))
+
+
+def largest_condition(mech, t, q, jacobian: np.ndarray | None = None) -> tuple[int, float]:
+    """(k, κ_k): the step of the largest ``condition_numbers`` (the first of equal ones) and
+    its value, the same bits, with the SVD only at the steps that can be it.
+
+    The eigenvalues of the Gram matrix of each equilibrated Cq (σ², cheaper than its SVD)
+    bound every κ to within their error (``_candidates``); the steps whose upper bound
+    reaches the largest lower bound get their SVD, the others are below them for certain.
+    """
+    J = equations(mech, State(t, q)).jacobian if jacobian is None else jacobian
+    if J.shape[1] == 0:
+        return 0, np.inf
+    A, rank = _equilibrated(J), min(J.shape[1], mech.nq)
+    steps = _candidates(A)
+    kappa = _kappa(A if steps is None else A[steps], rank)
+    i = int(np.argmax(kappa))
+    return (i if steps is None else int(steps[i])), float(kappa[i])
+
+
+#: relative error allowed the Gram matrices' eigenvalues (of ‖A‖_F²; LAPACK's is ~n ε) and
+#: the SVD's condition numbers (~n ε κ) in ``_candidates``, with margins of 10⁴ and more
+GRAM_ERROR, SVD_ERROR = 1e-10, 1e-8
+#: ``_candidates`` bounds condition numbers up to about this; beyond, every step's SVD
+BOUNDED = 1e3
+
+
+def _candidates(A: np.ndarray) -> np.ndarray | None:
+    """The steps whose κ(A) can be the largest (None: every step), from the eigenvalues λ
+    of A Aᵀ or Aᵀ A (the smaller: λ = σ², λ_min = σ_r²) within ±GRAM_ERROR ‖A‖_F²; a step
+    whose κ may exceed about BOUNDED is one of them (its bounds are not tight)."""
+    n, m, nq = A.shape
+    if n == 0 or np.iscomplexobj(A) or not np.isfinite(A).all():
+        return None
+    lam = np.linalg.eigvalsh(A @ A.transpose(0, 2, 1) if m < nq else A.transpose(0, 2, 1) @ A)
+    size = np.einsum("nij,nij->n", A, A)             # ‖A‖_F² ≥ λ_max
+    error = GRAM_ERROR * size
+    low, high = lam[:, 0], lam[:, -1]
+    bounded = low > size / BOUNDED ** 2                # then low − error > 0
+    if not bounded.any():
+        return None
+    with np.errstate(divide="ignore", invalid="ignore"):     # (steps not bounded)
+        upper = np.sqrt((high + error) / (low - error))
+        lower = np.sqrt(np.maximum(high - error, 0.0) / (low + error))
+    reach = np.max(lower[bounded]) * (1 - SVD_ERROR)
+    return np.nonzero(~bounded | (upper * (1 + SVD_ERROR) >= reach))[0]
+
+
+def _equilibrated(J: np.ndarray) -> np.ndarray:
+    """J with its rows and columns scaled to unit length, three passes (a copy)."""
     for _ in range(3):
         J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
         J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
-    s = np.linalg.svd(J, compute_uv=False)
+    return J
+
+
+def _kappa(A: np.ndarray, rank: int) -> np.ndarray:
+    """σ_1 / σ_rank of each matrix A (the SVD's; ∞ or NaN where σ_rank = 0)."""
+    s = np.linalg.svd(A, compute_uv=False)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return s[:, 0] / s[:, min(J.shape[1], mech.nq) - 1]
+        return s[:, 0] / s[:, rank - 1]
 
 
 @dataclass

@@ -174,3 +174,50 @@ def test_a_kinetostatic_run_of_positions_only_takes_the_backends_rates(four_bar,
     assert passes == []
     assert alone["rocker.fi"].tobytes() == full["rocker.fi"].tobytes()
     assert alone.warnings == full.warnings
+
+
+def _jacobians(rng, steps, m, nq, drift):
+    """Cq along a straight path between two random matrices of very different column
+    scales (``drift``: how far), with exact ties, a nearly singular step and a zero row."""
+    base = rng.standard_normal((m, nq)) * rng.choice([1e-3, 1.0, 1e3], size=nq)
+    J = base + np.linspace(0.0, 1.0, steps)[:, None, None] * drift * rng.standard_normal((m, nq))
+    J[steps // 2] = J[0]                                   # the largest may be tied
+    J[steps // 3, :, 0] = J[steps // 3, :, 1] * (1 + 1e-12)   # κ ~ 1e12 at one step
+    J[-1, 0] = 0.0
+    return J
+
+
+@pytest.mark.parametrize("m, nq", [(12, 12), (9, 12), (14, 12)])
+@pytest.mark.parametrize("drift", [1e-9, 1e-3, 1.0])
+def test_the_largest_condition_number_is_the_one_of_every_steps_svd(m, nq, drift):
+    """rank.largest_condition (SVDs only where the Gram eigenvalues cannot rule a step
+    out) gives the bits and the first step of the largest of condition_numbers (an SVD at
+    every step): tied, flat, varying, singular steps, fewer or more equations than q."""
+    rng = np.random.default_rng(m * 100 + nq + int(-np.log10(drift)))
+
+    class Mech:
+        pass
+
+    mech = Mech()
+    mech.nq = nq
+    for steps in (1, 7, 40):
+        J = _jacobians(rng, steps, m, nq, drift)
+        for rows in (slice(None), [0, -1], [steps - 1]):
+            every = rank.condition_numbers(mech, None, None, J[rows])
+            k = int(np.argmax(every))
+            assert rank.largest_condition(mech, None, None, J[rows]) == (k, float(every[k]))
+
+
+def test_a_short_run_takes_the_svd_of_the_steps_that_can_be_the_worst(four_bar, monkeypatch):
+    """The 100-step four-bar's condition check: one SVD, of one step (101 before), and the
+    run's largest condition number is that of every step's SVD."""
+    svds, kappa = [], rank._kappa
+    monkeypatch.setattr(rank, "_kappa", lambda A, r: svds.append(len(A)) or kappa(A, r))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = pam2exu.run(four_bar, "kinematic", steps=100, backend="natural")
+    assert svds == [1, 1]                     # the guess's (mobility), then the run's
+    mech = four_bar.mechanism()
+    q = np.column_stack([res[f"{s.name}.{v}"] for s in mech.solids for v in ("x", "y", "fi")])
+    every = rank.condition_numbers(mech, res.t, q)
+    assert res.info["max_condition_number"] == float(np.max(every))
