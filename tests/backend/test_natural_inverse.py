@@ -204,3 +204,27 @@ def test_a_mechanism_whose_every_solid_is_held_gets_the_reference_point_pass():
     assert "reactions_from" not in res.info
     np.testing.assert_allclose(res["hold.Fy"], 2.0 * 9.81, rtol=1e-14)
     np.testing.assert_allclose(res["hold.Mz"], 2.0 * 9.81 * 0.05, rtol=1e-14)
+
+
+def test_csr_is_scipys_matrix_of_the_dense_array():
+    """inverse.csr builds the matrix scipy.sparse.csr_matrix(dense) makes: the same data,
+    column indices and row starts (so the same sums in every product), zeros and negative
+    zeros left out, an empty row kept."""
+    from scipy import sparse
+    dense = np.array([[0.0, 2.5, -0.0, 1.0], [0.0, 0.0, 0.0, 0.0], [-3.0, 0.0, 0.125, 0.0]])
+    ours, theirs = inverse.csr(dense), sparse.csr_matrix(dense)
+    for name in ("data", "indices", "indptr"):
+        assert np.array_equal(getattr(ours, name), getattr(theirs, name))
+    assert ours.shape == theirs.shape and ours.has_sorted_indices
+    x = np.array([[1.0, -2.0, 3.0, 0.5], [0.1, 0.2, 0.3, 0.4]])
+    assert np.array_equal(inverse.times(x, ours), inverse.times(x, theirs))
+
+
+@pytest.mark.parametrize("d", [1.0, -1.0])
+def test_one_revolute_incidence_is_its_own_inverse(d):
+    """A pin of one revolute on one moving solid: D = [[±1]], D⁺ = D exactly (pinv's)."""
+    from pam2exu.backend.natural.reactions import _incidence_inverse
+    D = np.array([[d]])
+    assert np.array_equal(_incidence_inverse(D), np.linalg.pinv(D))
+    two = np.array([[1.0, -1.0]])
+    assert np.array_equal(_incidence_inverse(two), np.linalg.pinv(two))

@@ -45,8 +45,8 @@ class Bodies:
 
     def __post_init__(self):
         ns, _, nz = self.A.shape
-        self.flat = sparse.csr_matrix(self.A.reshape(4 * ns, nz))       # ζ = flat z + c
-        self.flat_t = sparse.csr_matrix(self.A.reshape(4 * ns, nz).T)
+        self.flat = csr(self.A.reshape(4 * ns, nz))                     # ζ = flat z + c
+        self.flat_t = csr(self.A.reshape(4 * ns, nz).T)
 
     @property
     def block(self) -> np.ndarray:
@@ -67,11 +67,20 @@ def times(x: np.ndarray, A) -> np.ndarray:
     return (A @ flat.T).T.reshape(x.shape[:-1] + (A.shape[0],))
 
 
+def csr(dense: np.ndarray) -> sparse.csr_matrix:
+    """A 2-D array's nonzeros as a CSR matrix, built from its arrays (row-major, columns
+    ascending: the matrix ``scipy.sparse.csr_matrix(dense)`` makes, without its COO pass)."""
+    rows, cols = np.nonzero(dense)
+    starts = np.searchsorted(rows, np.arange(dense.shape[0] + 1))
+    return sparse.csr_matrix((dense[rows, cols], cols.astype(np.int32),
+                              starts.astype(np.int32)), shape=dense.shape)
+
+
 def sparse_of(form, name: str, make):
     """The constant matrix ``make()`` of a formulation as a CSR matrix, made once."""
     kept = form.__dict__.setdefault("_kept", {})
     if name not in kept:
-        kept[name] = sparse.csr_matrix(make())
+        kept[name] = csr(make())
     return kept[name]
 
 
@@ -166,5 +175,5 @@ def multipliers(form, z, W, redundant: bool, jacobian: np.ndarray | None = None)
 
 
 __all__ = ["Bodies", "applied", "bodies", "body_coordinates", "body_mass_matrices",
-           "constraint_forces", "kinetic_energy", "multipliers", "on_coordinates", "on_pose",
+           "constraint_forces", "csr", "kinetic_energy", "multipliers", "on_coordinates", "on_pose",
            "sparse_of", "times"]

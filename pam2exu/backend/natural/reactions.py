@@ -33,7 +33,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy import sparse
 
 from ...kinematics import ANGLES, column, cross, pose
 from ..base import Reactions
@@ -114,6 +113,15 @@ class _Pin:
     at: list | None = None
 
 
+def _incidence_inverse(D: np.ndarray) -> np.ndarray:
+    """D⁺, the least-norm inverse of a pin's incidence; one revolute between one moving solid
+    and the ground, D = [[±1]], is its own inverse (what ``numpy.linalg.pinv`` gives, without
+    its SVD)."""
+    if D.shape == (1, 1):
+        return D.copy()
+    return np.linalg.pinv(D)
+
+
 class Plan:
     """What the natural reactions need of a formulation, made once (``plan``)."""
 
@@ -138,14 +146,17 @@ class Plan:
         self._pins(form, mech, index)
         self._fixed(form, mech)
         self._copied(form)
-        K = form.pose_forms()
+        # the backend's own (``_pose_forms``: the same key and value), made once
+        K = form.__dict__.setdefault("_kept", {}).get("pose_forms")
+        if K is None:
+            K = form._kept["pose_forms"] = form.pose_forms()
         angles = np.zeros((len(self.angle_cols), form.nz))
         for r, c in enumerate(self.angle_cols.values()):
             angles[r, c] = 1.0
         self.angle_solids = np.array(list(self.angle_cols), dtype=int)
         self.offsets = np.r_[K[:, -1], np.zeros(len(self.angle_cols))]
         Q, R = np.linalg.qr(np.vstack([K[:, :-1], angles]))       # full column rank
-        self.rates = sparse.csr_matrix(np.linalg.solve(R, Q.T))     # its left inverse
+        self.rates = inverse.csr(np.linalg.solve(R, Q.T))           # its left inverse
 
     def _pins(self, form, mech, index) -> None:
         groups: dict[int, list] = {}
@@ -171,7 +182,7 @@ class Plan:
                 for s in solids:
                     grounded[s] = grounded.get(s, 0) + 1
             self.pins.append(_Pin(cols, constant, solids, [index[el] for el in els],
-                                  np.linalg.pinv(D)))
+                                  _incidence_inverse(D)))
         self.ok &= all(k == 1 for k in grounded.values())
         # a column point's coordinates are exactly one z column each
         self.ok &= all(p.columns is None or len(p.columns) == 2 for p in self.pins)
