@@ -156,15 +156,15 @@ def checked_reactions(mech, wrenches) -> dict[str, np.ndarray]:
     """The reported components of every constraint element's wrench (n, 3) in its reporting
     frame (``wrenches`` in ``mech.constraints`` order), by column name; the components that
     are zero by construction are checked to be zero."""
-    out = {}
+    out, length = {}, mech.scale()
     for el, wrench in zip(mech.constraints, wrenches):
         scale = (np.max(np.abs(wrench[:, :2]), initial=0.0)
-                 + np.max(np.abs(wrench[:, 2]), initial=0.0) / mech.scale())
+                 + np.max(np.abs(wrench[:, 2]), initial=0.0) / length)
         for k, name in enumerate(el.wrench):
             if name is not None:
                 out[f"{el.name}.{name}"] = wrench[:, k]
                 continue
-            size = np.max(np.abs(wrench[:, k]), initial=0.0) / (mech.scale() if k == 2 else 1.0)
+            size = np.max(np.abs(wrench[:, k]), initial=0.0) / (length if k == 2 else 1.0)
             if size > ZERO_COMPONENT_TOLERANCE * scale + 1e-300:
                 what = ("moment" if k == 2 else
                         "force along x" if k == 0 else "force along y")
