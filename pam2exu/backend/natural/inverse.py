@@ -175,5 +175,5 @@ def multipliers(form, z, W, redundant: bool, jacobian: np.ndarray | None = None)
 
 
 __all__ = ["Bodies", "applied", "bodies", "body_coordinates", "body_mass_matrices",
-           "constraint_forces", "csr", "kinetic_energy", "multipliers", "on_coordinates", "on_pose",
-           "sparse_of", "times"]
+           "constraint_forces", "csr", "kinetic_energy", "multipliers", "on_coordinates",
+           "on_pose", "sparse_of", "times"]
