@@ -344,8 +344,12 @@ def _ext(zT: np.ndarray) -> np.ndarray:
 def _summing(K: np.ndarray) -> sparse.csr_matrix:
     """K as a sparse matrix: K @ z sums the same terms in the same order whatever the number
     of columns (a dense product's order depends on it, and chunked runs would differ in the
-    last bit)."""
-    return sparse.csr_matrix(K)
+    last bit). Built from its nonzero entries in row order (what scipy's conversion from a
+    dense matrix gives, at half its cost)."""
+    rows, cols = np.nonzero(K)
+    starts = np.zeros(K.shape[0] + 1, dtype=np.int32)
+    np.cumsum(np.bincount(rows, minlength=K.shape[0]), out=starts[1:])
+    return sparse.csr_matrix((K[rows, cols], cols.astype(np.int32), starts), shape=K.shape)
 
 
 def _chunks(n: int):

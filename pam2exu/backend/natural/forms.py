@@ -51,21 +51,34 @@ class Expr:
 
     def linear(self) -> dict:
         """{index (ONE for the constant): coefficient} of a linear form."""
-        if not self.is_linear:
+        if self.sines:
             raise ValueError("not a linear form")
-        return {(a if b == ONE else b): c for (a, b), c in self.products.items()}
+        out = {}
+        for (a, b), c in self.products.items():
+            if b == ONE:
+                out[a] = c
+            elif a == ONE:
+                out[b] = c
+            else:
+                raise ValueError("not a linear form")
+        return out
 
     def __add__(self, other: "Expr | float") -> "Expr":
         """e = a + b."""
         if not isinstance(other, Expr):
             other = Expr.constant(other)
-        products, sines = dict(self.products), dict(self.sines)
+        products = dict(self.products)
+        get = products.get
         for k, c in other.products.items():
-            products[k] = products.get(k, 0.0) + c
+            products[k] = get(k, 0.0) + c
+        if 0.0 in products.values():                 # (a sum that is 0 leaves the dict)
+            products = {k: c for k, c in products.items() if c}
+        if not (self.sines or other.sines):
+            return Expr(products, {})
+        sines = dict(self.sines)
         for k, c in other.sines.items():
             sines[k] = sines.get(k, 0.0) + c
-        return Expr({k: c for k, c in products.items() if c},
-                    {k: c for k, c in sines.items() if c})
+        return Expr(products, {k: c for k, c in sines.items() if c})
 
     __radd__ = __add__
 
@@ -86,8 +99,10 @@ class Expr:
             return Expr({key: c * k for key, c in self.products.items() if c * k},
                         {key: c * k for key, c in self.sines.items() if c * k})
         products: dict = {}
-        for a, ca in self.linear().items():
-            for b, cb in other.linear().items():
+        left = self.linear()
+        right = other.linear().items() if left else ()
+        for a, ca in left.items():
+            for b, cb in right:
                 # out + Expr({key: ca cb}) term after term: a sum that is 0 leaves the dict
                 # (and a later term enters at its end, as the sum's new dict would have it)
                 key = _key(a, b)
