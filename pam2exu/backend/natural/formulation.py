@@ -299,7 +299,13 @@ class Formulation:
 
     # ---- x, y, fi ---------------------------------------------------------------------------
     def pose_forms(self) -> np.ndarray:
-        """K (4·solids, nz + 1): (x, y, cos fi, sin fi) of every solid = K [z; 1]."""
+        """K (4·solids, nz + 1): (x, y, cos fi, sin fi) of every solid = K [z; 1] (a copy of
+        the one made on the first call: it depends only on the formulation)."""
+        if "_pose_forms" not in self.__dict__:
+            self._pose_forms = self._make_pose_forms()
+        return self._pose_forms.copy()
+
+    def _make_pose_forms(self) -> np.ndarray:
         rows = []
         for f in self.frames:
             c, s = f.cos_sin()
@@ -316,29 +322,49 @@ class Formulation:
         has it (exact where q satisfies the constraints)."""
         q = np.atleast_2d(q)
         z = np.zeros((q.shape[0], self.nz))
+        if "_placing" not in self.__dict__:
+            self._placing = self._make_placing()
+        for i, placed, angle in self._placing:
+            x, y, fi = (q[:, k] for k in range(pose(i).start, pose(i).stop))
+            c, s = np.cos(fi), np.sin(fi)
+            for k, what, loc in placed:
+                if what == "x":                     # a basic point's x, y
+                    z[:, k] = x + c * loc[0] - s * loc[1]
+                elif what == "y":
+                    z[:, k] = y + s * loc[0] + c * loc[1]
+                else:                               # the origin, a unit vector
+                    z[:, k] = {"ox": x, "oy": y, "c": c, "s": s}[what]
+            if angle is not None:
+                z[:, angle] = fi
+        return z
+
+    def _make_placing(self) -> list:
+        """What ``from_q`` writes, per moving solid: [(solid, [(coordinate, what, local)],
+        angle coordinate)], each coordinate from the first solid whose basic point, origin
+        or unit vector it is alone (coefficient 1)."""
         placed = np.zeros(self.nz, dtype=bool)
+        out = []
         for i, f in enumerate(self.frames):
             if i in self.grounds:
                 continue
-            x, y, fi = (q[:, k] for k in range(pose(i).start, pose(i).stop))
-            c, s = np.cos(fi), np.sin(fi)
+            writes = []
 
-            def place(vec: Vec, value):
-                for e, v in zip((vec.x, vec.y), value):
+            def place(vec: Vec, what, loc):
+                for e, name in zip((vec.x, vec.y), what):
                     lin = e.linear()
                     if len(lin) == 1 and next(iter(lin.values())) == 1.0:
                         k = next(iter(lin))
                         if not placed[k]:
-                            z[:, k], placed[k] = v, True
+                            writes.append((k, name, loc))
+                            placed[k] = True
 
             for loc, vec in self.own.get(i, []):
-                place(vec, (x + c * loc[0] - s * loc[1], y + s * loc[0] + c * loc[1]))
+                place(vec, ("x", "y"), loc)
             if not self.own.get(i):
-                place(f.p, (x, y))
-            place(f.v, (c, s))                 # a unit vector (does nothing for P₂ − P₁)
-            if f.angle is not None:
-                z[:, f.angle] = fi
-        return z
+                place(f.p, ("ox", "oy"), None)
+            place(f.v, ("c", "s"), None)       # a unit vector (does nothing for P₂ − P₁)
+            out.append((i, writes, f.angle))
+        return out
 
     # ---- the constant mass matrix -----------------------------------------------------------
     def mass_matrix(self, solids=None) -> np.ndarray:
