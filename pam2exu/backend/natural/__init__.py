@@ -296,13 +296,14 @@ class Natural(Backend):
         """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
         (in chunks of steps: bounded memory; one row per quantity inside)."""
         K = _kept(form, "pose_sum", lambda: _summing(_pose_forms(form)))
-        Kz = _kept(form, "pose_rate_sum", lambda: _summing(_pose_forms(form)[:, :form.nz]))
         kind = self._angle_kinds(form)
         qdT, qddT = np.empty((mech.nq, len(z))), np.empty((mech.nq, len(z)))
         f, c = kind.free, kind.coordinate
         for s in _chunks(len(z)):
             pose = K @ _ext(z[s].T)
-            d1, d2 = Kz @ zd[s].T, Kz @ zdd[s].T
+            # K [ż; 0]: a row's sum ends with + c·0 = ±0, which changes no sum (one matrix
+            # for x, y, cos, sin and their rates)
+            d1, d2 = K @ _ext(zd[s].T, 0.0), K @ _ext(zdd[s].T, 0.0)
             for out, d in ((qdT, d1), (qddT, d2)):
                 out[0::PER_SOLID, s], out[1::PER_SOLID, s] = d[0::4], d[1::4]
             w, a = qdT[2::PER_SOLID, s], qddT[2::PER_SOLID, s]
@@ -336,9 +337,12 @@ def _pose_forms(form: Formulation) -> np.ndarray:
     return _kept(form, "pose_forms", form.pose_forms)
 
 
-def _ext(zT: np.ndarray) -> np.ndarray:
-    """[z; 1] (nz + 1, n)."""
-    return np.vstack([zT, np.ones((1, zT.shape[1]))])
+def _ext(zT: np.ndarray, last: float = 1.0) -> np.ndarray:
+    """[z; 1] (nz + 1, n) (``last`` in place of the 1)."""
+    out = np.empty((zT.shape[0] + 1, zT.shape[1]))
+    out[:-1] = zT
+    out[-1] = last
+    return out
 
 
 def _summing(K: np.ndarray) -> sparse.csr_matrix:

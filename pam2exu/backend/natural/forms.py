@@ -86,8 +86,20 @@ class Expr:
         return self * -1.0
 
     def __sub__(self, other: "Expr | float") -> "Expr":
-        """e = a − b."""
-        return self + (-other)
+        """e = a − b: a + (−1 · b) term after term, in one pass (the same sums, the same
+        order of terms)."""
+        if not isinstance(other, Expr):
+            return self + (-other)
+        products = dict(self.products)
+        get = products.get
+        for k, c in other.products.items():
+            if c:                                    # (−b leaves out b's zero terms)
+                products[k] = get(k, 0.0) + c * -1.0
+        if 0.0 in products.values():
+            products = {k: c for k, c in products.items() if c}
+        if not (self.sines or other.sines):
+            return Expr(products, {})
+        return Expr(products, self.sines) + Expr({}, (-other).sines)
 
     def __rsub__(self, other: float) -> "Expr":
         return -self + other
@@ -96,8 +108,9 @@ class Expr:
         """e = k a for a number k, or a·b for two linear forms (a quadratic form)."""
         if not isinstance(other, Expr):
             k = float(other)
-            return Expr({key: c * k for key, c in self.products.items() if c * k},
-                        {key: c * k for key, c in self.sines.items() if c * k})
+            return Expr({key: v for key, c in self.products.items() if (v := c * k)},
+                        {key: v for key, c in self.sines.items() if (v := c * k)}
+                        if self.sines else {})
         products: dict = {}
         left = self.linear()
         right = other.linear().items() if left else ()
