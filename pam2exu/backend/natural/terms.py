@@ -61,66 +61,26 @@ class Terms:
                 prod.append((r, nz, nz, -float(target) ** power))
         p = np.array(prod, dtype=float).reshape(-1, 4)
         s = np.array(sine, dtype=float).reshape(-1, 5)
-        self.pr, self.pa, self.pb = (p[:, k].astype(int) for k in range(3))
+        self.__dict__.update(_indices(nz, self.m, p, s))
         self.pc = p[:, 3]
-        self.sr, self.sa, self.sb = (s[:, k].astype(int) for k in range(3))
         self.salpha, self.sc = s[:, 3], s[:, 4]
-        self.row_index = np.concatenate([self.pr, self.sr])
         self.law_rows = np.array([r for r, _, _ in self.laws], dtype=int)
         self._last_times, self._last_laws = None, []
         self._table = None                   # ``tabulate``
         # the terms' constants as columns, kept (evaluations broadcast them over the steps)
         self._pc, self._sc, self._alpha = self.pc[:, None], self.sc[:, None], self.salpha[:, None]
         self._apc, self._asc = np.abs(self._pc), np.abs(self._sc)
-
-        # Jacobian entries: (row, column) of each term's derivative, ONE columns left out
-        entries = [(self.pr, self.pa), (self.pr, self.pb), (self.sr, self.sa), (self.sr, self.sb)]
-        rr, cc = [], []
-        for rows_, cols in entries:
-            keep = cols != nz
-            rr.append(rows_[keep])
-            cc.append(cols[keep])
-        rr, cc = np.concatenate(rr), np.concatenate(cc)
-        flat = rr * max(nz, 1) + cc
-        pattern, where = np.unique(flat, return_inverse=True)
-        #: the Jacobian's nonzero pattern: Φ_z[:, rows[k], cols[k]] = data[:, k]
-        self.rows, self.cols = pattern // max(nz, 1), pattern % max(nz, 1)
-        self.entry_index = where
-        # the Jacobian's terms in the order of ``entries``: products c z_other (both
-        # derivatives in one gather), then c sin(z_b + α) and c z_a cos(z_b + α)
-        kb, ka = self.pa != nz, self.pb != nz
-        ks, kc = self.sa != nz, self.sb != nz
+        # the Jacobian's constants in the order of ``_indices``' entries: products c z_other
+        # (both derivatives in one gather), then c sin(z_b + α) and c z_a cos(z_b + α)
+        kb, ka, ks, kc = self._keeps
         self._jp_c = np.concatenate([self.pc[kb], self.pc[ka]])[:, None]
-        self._jp_i = np.concatenate([self.pb[kb], self.pa[ka]])
-        self._js_c, self._js_b, self._js_alpha = self._sc[ks], self.sb[ks], self._alpha[ks]
-        self._jc_c, self._jc_a, self._jc_b = self._sc[kc], self.sa[kc], self.sb[kc]
-        self._jc_alpha = self._alpha[kc]
-        self._keeps = (kb, ka, ks, kc)
+        self._js_c, self._js_alpha = self._sc[ks], self._alpha[ks]
+        self._jc_c, self._jc_alpha = self._sc[kc], self._alpha[kc]
         # the same constants 1-D, for the evaluations at one step (``*_one``)
         self._jp_c1, self._js_c1, self._js_alpha1, self._jc_c1, self._jc_alpha1 = (
             a[:, 0] for a in (self._jp_c, self._js_c, self._js_alpha, self._jc_c,
                               self._jc_alpha))
-        self._jp_keep = np.concatenate([kb, ka])
-        # ``residual_jacobian_one``: its values are [c z_a z_b, c z_a sin, c z_a, c z_b,
-        # c sin, c z_a cos] (products over all terms); the sums' weights pick, in the order of
-        # ``residual_jacobian_cols``, Φ's terms, then Φ_z's: c z_b, c z_a (kept), c sin (ks),
-        # c z_a cos (kc)
-        P, S = len(self.pa), len(self.sa)
         self._pc2 = np.concatenate([self.pc, self.pc])
-        jp = np.concatenate([P + S + P + np.arange(P), P + S + np.arange(P)])[self._jp_keep]
-        self._one_pick = np.concatenate([np.arange(P + S), jp, 3 * P + S + np.nonzero(ks)[0],
-                                         3 * P + 2 * S + np.nonzero(kc)[0]])
-        # ``residual_jacobian_cols``: the coordinates of every term in one gather, and the
-        # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
-        # adds the same terms in the same order as two calls)
-        self._gather = np.concatenate([self.pa, self.pb, self.sb, self.sa])
-        edges = np.cumsum([0, len(self.pa), len(self.pb), len(self.sb), len(self.sa)])
-        self._parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
-        self._both_index = np.concatenate([self.row_index, self.m + self.entry_index])
-        # the same sums straight into a dense Φ_z (m, nz), row by row (``*_one``): each
-        # position gets its entry's terms in the same order
-        self._dense_index = (self.rows * nz + self.cols)[self.entry_index]
-        self._both_dense = np.concatenate([self.row_index, self.m + self._dense_index])
 
     # ---- evaluation: one column per step --------------------------------------------------
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
@@ -411,3 +371,75 @@ class Terms:
         np.add.at(H, (self.sb, self.sa), w * np.cos(arg))
         np.add.at(H, (self.sb, self.sb), -w * x[self.sa] * np.sin(arg))
         return H[:self.nz, :self.nz]
+
+
+#: ``_indices`` of the structures met last (at most ``KEPT_STRUCTURES``): a study's variants
+#: share one structure, and a ``Terms``' index arrays depend on nothing else
+_STRUCTURES: dict = {}
+KEPT_STRUCTURES = 32
+
+
+def _indices(nz: int, m: int, p: np.ndarray, s: np.ndarray) -> dict:
+    """The index arrays of the terms p (row, a, b, c) and s (row, a, b, α, c): made once per
+    structure (the key is all of their rows and columns and the sizes), read-only, shared
+    by the ``Terms`` of that structure."""
+    key = (nz, m, p.shape, s.shape, p[:, :3].tobytes(), s[:, :3].tobytes())
+    if key not in _STRUCTURES:
+        if len(_STRUCTURES) >= KEPT_STRUCTURES:
+            _STRUCTURES.pop(next(iter(_STRUCTURES)))
+        made = _make_indices(nz, m, p, s)
+        for value in made.values():
+            for a in value if isinstance(value, (tuple, list)) else (value,):
+                if isinstance(a, np.ndarray):
+                    a.setflags(write=False)
+        _STRUCTURES[key] = made
+    return _STRUCTURES[key]
+
+
+def _make_indices(nz: int, m: int, p: np.ndarray, s: np.ndarray) -> dict:
+    """``_indices``, made: the terms' rows and coordinates, the Jacobian's pattern and where
+    each term's derivative goes in it."""
+    pr, pa, pb = (p[:, k].astype(int) for k in range(3))
+    sr, sa, sb = (s[:, k].astype(int) for k in range(3))
+    row_index = np.concatenate([pr, sr])
+    # Jacobian entries: (row, column) of each term's derivative, ONE columns left out
+    entries = [(pr, pa), (pr, pb), (sr, sa), (sr, sb)]
+    rr, cc = [], []
+    for rows_, cols in entries:
+        keep = cols != nz
+        rr.append(rows_[keep])
+        cc.append(cols[keep])
+    rr, cc = np.concatenate(rr), np.concatenate(cc)
+    flat = rr * max(nz, 1) + cc
+    pattern, where = np.unique(flat, return_inverse=True)
+    #: the Jacobian's nonzero pattern: Φ_z[:, rows[k], cols[k]] = data[:, k]
+    rows, cols = pattern // max(nz, 1), pattern % max(nz, 1)
+    # the Jacobian's terms in the order of ``entries``: products c z_other (both
+    # derivatives in one gather), then c sin(z_b + α) and c z_a cos(z_b + α)
+    kb, ka = pa != nz, pb != nz
+    ks, kc = sa != nz, sb != nz
+    jp_keep = np.concatenate([kb, ka])
+    # ``residual_jacobian_one``: its values are [c z_a z_b, c z_a sin, c z_a, c z_b,
+    # c sin, c z_a cos] (products over all terms); the sums' weights pick, in the order of
+    # ``residual_jacobian_cols``, Φ's terms, then Φ_z's: c z_b, c z_a (kept), c sin (ks),
+    # c z_a cos (kc)
+    P, S = len(pa), len(sa)
+    jp = np.concatenate([P + S + P + np.arange(P), P + S + np.arange(P)])[jp_keep]
+    # ``residual_jacobian_cols``: the coordinates of every term in one gather, and the
+    # rows' and the entries' sums in one ``numpy.bincount`` (disjoint bins: each sum
+    # adds the same terms in the same order as two calls)
+    edges = np.cumsum([0, len(pa), len(pb), len(sb), len(sa)])
+    # the same sums straight into a dense Φ_z (m, nz), row by row (``*_one``): each
+    # position gets its entry's terms in the same order
+    dense_index = (rows * nz + cols)[where]
+    return {"pr": pr, "pa": pa, "pb": pb, "sr": sr, "sa": sa, "sb": sb,
+            "row_index": row_index, "rows": rows, "cols": cols, "entry_index": where,
+            "_jp_i": np.concatenate([pb[kb], pa[ka]]), "_js_b": sb[ks], "_jc_a": sa[kc],
+            "_jc_b": sb[kc], "_keeps": (kb, ka, ks, kc), "_jp_keep": jp_keep,
+            "_one_pick": np.concatenate([np.arange(P + S), jp, 3 * P + S + np.nonzero(ks)[0],
+                                         3 * P + 2 * S + np.nonzero(kc)[0]]),
+            "_gather": np.concatenate([pa, pb, sb, sa]),
+            "_parts": tuple(slice(a, b) for a, b in zip(edges[:-1], edges[1:])),
+            "_both_index": np.concatenate([row_index, m + where]),
+            "_dense_index": dense_index,
+            "_both_dense": np.concatenate([row_index, m + dense_index])}
