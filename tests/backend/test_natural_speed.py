@@ -13,6 +13,8 @@ import pytest
 import pam2exu
 from benchmarks.cases import chain_model
 from pam2exu.backend.natural import Natural
+from pam2exu.backend.natural import terms as terms_module
+from pam2exu.backend.natural.formulation import Formulation
 from pam2exu.backend.natural.linear import SPARSE_FROM
 from pam2exu.backend.natural.solver import NaturalSettings, Solver
 from pam2exu.backend.natural.terms import BINCOUNT_STEPS
@@ -196,3 +198,28 @@ def test_a_run_asks_its_law_once(four_bar_mech):
         for order in range(3):
             assert terms.targets(t[rows], order).tobytes() == \
                 np.array([law(t[rows])[order]]).tobytes()
+
+
+def test_variants_of_one_structure_share_their_terms_indices(four_bar_mech):
+    """Equations scaled by 1.1 (other coefficients) have the same terms' rows and columns: their
+    ``Terms`` share the index arrays (made once, read-only), keep their own coefficients, and
+    evaluate exactly as a ``Terms`` made with no structure kept (the answer of a variant does
+    not depend on the variants made before it)."""
+    a = Formulation(four_bar_mech).terms
+    rows = [r[1:] for r in Formulation(four_bar_mech)._rows]
+    b = terms_module.Terms(a.nz, [(e * 1.1, g, p) for e, g, p in rows])
+    assert b.pa is a.pa and b.entry_index is a.entry_index and not a.pa.flags.writeable
+    assert not np.array_equal(b.pc, a.pc)
+    z = np.random.default_rng(3).standard_normal((2, a.nz))
+    t = np.array([0.1, 0.2])
+    kept = dict(terms_module._STRUCTURES)
+    terms_module._STRUCTURES.clear()
+    try:
+        fresh = terms_module.Terms(b.nz, [(e * 1.1, g, p) for e, g, p in rows])
+        assert fresh.pa is not b.pa
+    finally:
+        terms_module._STRUCTURES.clear()
+        terms_module._STRUCTURES.update(kept)
+    for got, want in ((b.residual(t, z), fresh.residual(t, z)),
+                      (b.jacobian(z), fresh.jacobian(z))):
+        assert got.tobytes() == want.tobytes()
