@@ -221,3 +221,26 @@ def test_chunked_solves_and_conversions_give_the_same_run(monkeypatch):
     chunked = pam2exu.run(path, analysis="kinematic", steps=5000, backend="natural")
     for c in whole.columns:
         np.testing.assert_array_equal(chunked[c], whole[c], err_msg=c)
+
+
+def test_from_q_of_an_assembled_pose_is_on_the_constraints_with_a_ground_point_at_1():
+    """``Formulation.from_q`` of a configuration that satisfies the constraints gives z with
+    Φ(z) = 0 (each coordinate a basic point's x, y, or an angle, of that configuration).
+    A ground point at x = 1.0 m is the constant 1.0, whose linear form {1: 1.0} looks like
+    a coordinate of coefficient 1: it was written into the last coordinate (the crank's
+    angle: 1.0 instead of 0.0). Reference: the four-bar moved 0.6 m to the right, its
+    assembled pose at t = 0 from the Exudyn backend."""
+    from pam2exu.backend.natural.formulation import Formulation
+    text = (ROOT / "examples" / "four_bar.toml").read_text()
+    text = (text.replace("O4 = [0.4, 0.0]", "O4 = [1.0, 0.0]")
+            .replace("x = 0.4\ny = 0.0\nfi = 1.85", "x = 1.0\ny = 0.0\nfi = 1.85")
+            .replace("B = [0.35, 0.0], P", "B = [0.95, 0.0], P"))
+    model = pam2exu.loads(text)
+    res = pam2exu.run(model, "assembly", backend="exudyn")
+    mech = model.mechanism()
+    q = np.array([[res[f"{s.name}.{k}"][0] for s in mech.solids for k in ("x", "y", "fi")]])
+    form = Formulation(mech)
+    z = form.from_q(q)
+    names = [c.name for c in form.coordinates]
+    assert z[0, names.index("crank.fi")] == q[0, column(1, 2)] == pytest.approx(0.0)
+    assert np.max(np.abs(form.terms.residual(np.zeros(1), z))) < 1e-12

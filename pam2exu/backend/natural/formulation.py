@@ -354,7 +354,7 @@ class Formulation:
                     lin = e.linear()
                     if len(lin) == 1 and next(iter(lin.values())) == 1.0:
                         k = next(iter(lin))
-                        if not placed[k]:
+                        if k != ONE and not placed[k]:     # (ONE: a ground point's 1.0)
                             writes.append((k, name, loc))
                             placed[k] = True
 
