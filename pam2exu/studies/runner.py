@@ -5,9 +5,9 @@ variant order, the result (``result.StudyResult``).
 A worker receives a payload of plain data (``payload``: the model's text, the analysis
 settings, the reductions, the requirements, the parameters' names), never solver objects,
 with its chunk's variants' values only, and runs rows ``start … stop − 1``
-(``run_variants``). A
-variant that fails is a row with status ``error``: a pam2exu error with its class and
-message, any other exception named as a fault of pam2exu. It never stops the study.
+(``run_variants``). A variant that fails is a row with status ``error``: a pam2exu error
+with its class and message, any other exception named as a fault of pam2exu. It never
+stops the study.
 """
 from __future__ import annotations
 

@@ -12,12 +12,12 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
-from scipy import sparse
 
 from ...errors import SolverError
 from ...kinematics import ANGLES, PER_SOLID, column
 from ..base import Backend, Integrator, Positions
 from .formulation import Coordinate, Formulation, Frame
+from .inverse import csr
 from .dynamics import motion
 from .loads import multipliers
 from .anchored import anchored
@@ -249,7 +249,9 @@ class Natural(Backend):
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
         value in the whole turn nearest ``start`` (in chunks of steps: bounded memory; one
         row per quantity inside, the step axis last)."""
-        K = _kept(form, "pose_sum", lambda: _summing(_pose_forms(form)))
+        # K sparse: K @ z sums the same terms in the same order whatever the number of
+        # columns (a dense product's order depends on it: chunked runs would differ)
+        K = _kept(form, "pose_sum", lambda: csr(form.pose_forms()))
         kind = self._angle_kinds(form)
         qT = np.empty((mech.nq, len(z)))             # one row per x, y, fi
         free, c = kind.free, kind.coordinate
@@ -295,7 +297,7 @@ class Natural(Backend):
     def to_rates(self, form: Formulation, mech, z, zd, zdd):
         """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
         (in chunks of steps: bounded memory; one row per quantity inside)."""
-        K = _kept(form, "pose_sum", lambda: _summing(_pose_forms(form)))
+        K = _kept(form, "pose_sum", lambda: csr(form.pose_forms()))
         kind = self._angle_kinds(form)
         qdT, qddT = np.empty((mech.nq, len(z))), np.empty((mech.nq, len(z)))
         f, c = kind.free, kind.coordinate
@@ -332,28 +334,12 @@ def _kept(form: Formulation, name: str, make):
     return kept[name]
 
 
-def _pose_forms(form: Formulation) -> np.ndarray:
-    """``form.pose_forms()``, made once per formulation (to_q and to_rates both sum it)."""
-    return _kept(form, "pose_forms", form.pose_forms)
-
-
 def _ext(zT: np.ndarray, last: float = 1.0) -> np.ndarray:
     """[z; 1] (nz + 1, n) (``last`` in place of the 1)."""
     out = np.empty((zT.shape[0] + 1, zT.shape[1]))
     out[:-1] = zT
     out[-1] = last
     return out
-
-
-def _summing(K: np.ndarray) -> sparse.csr_matrix:
-    """K as a sparse matrix: K @ z sums the same terms in the same order whatever the number
-    of columns (a dense product's order depends on it, and chunked runs would differ in the
-    last bit). Built from its nonzero entries in row order (what scipy's conversion from a
-    dense matrix gives, at half its cost)."""
-    rows, cols = np.nonzero(K)
-    starts = np.zeros(K.shape[0] + 1, dtype=np.int32)
-    np.cumsum(np.bincount(rows, minlength=K.shape[0]), out=starts[1:])
-    return sparse.csr_matrix((K[rows, cols], cols.astype(np.int32), starts), shape=K.shape)
 
 
 def _chunks(n: int):

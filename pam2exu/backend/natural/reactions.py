@@ -146,10 +146,7 @@ class Plan:
         self._pins(form, mech, index)
         self._fixed(form, mech)
         self._copied(form)
-        # the backend's own (``_pose_forms``: the same key and value), made once
-        K = form.__dict__.setdefault("_kept", {}).get("pose_forms")
-        if K is None:
-            K = form._kept["pose_forms"] = form.pose_forms()
+        K = form.pose_forms()
         angles = np.zeros((len(self.angle_cols), form.nz))
         for r, c in enumerate(self.angle_cols.values()):
             angles[r, c] = 1.0

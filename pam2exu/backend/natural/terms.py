@@ -87,8 +87,8 @@ class Terms:
     # step, so that every term is a contiguous row and the sums over terms are one product
     # with a small matrix. The methods without the suffix take and return one row per step.
     def _ext(self, z: np.ndarray) -> np.ndarray:
-        """[z; 1] (nz + 1, n)."""
-        out = np.empty((self.nz + 1, z.shape[1]))
+        """[z; 1] (nz + 1, n), or (nz + 1,) of one configuration z (nz,)."""
+        out = np.empty((self.nz + 1,) + z.shape[1:])
         out[:self.nz] = z
         out[self.nz] = 1.0
         return out
@@ -233,9 +233,7 @@ class Terms:
         rows). Every product is made once over all terms and the summed ones picked by one
         index (``_one_pick``)."""
         P, S = len(self.pa), len(self.sa)
-        x = np.empty(self.nz + 1)
-        x[:self.nz] = z
-        x[self.nz] = 1.0
+        x = self._ext(z)
         gathered = x[self._gather]                   # z_a, z_b of the products; z_b, z_a of sines
         ab = self._pc2 * gathered[:2 * P]            # c z_a, c z_b
         arg = gathered[2 * P:2 * P + S] + self.salpha
@@ -252,9 +250,7 @@ class Terms:
     def jacobian_one(self, z: np.ndarray) -> np.ndarray:
         """Φ_z (m, nz) dense at one configuration z (nz,): ``jacobian_cols``' column, on its
         pattern."""
-        x = np.empty(self.nz + 1)
-        x[:self.nz] = z
-        x[self.nz] = 1.0
+        x = self._ext(z)
         values = np.concatenate([
             self._jp_c1 * x[self._jp_i],
             self._js_c1 * np.sin(x[self._js_b] + self._js_alpha1),
@@ -265,9 +261,7 @@ class Terms:
     def gamma_one(self, z: np.ndarray, zd: np.ndarray, g2: np.ndarray | None) -> np.ndarray:
         """γ (m,) at one step: ``gamma_cols``' column; g2: ``targets(t, 2)[:, 0]``."""
         pc, sc, alpha = self.pc, self.sc, self.salpha
-        x = np.empty(self.nz + 1)
-        x[:self.nz] = z
-        x[self.nz] = 1.0
+        x = self._ext(z)
         v = np.zeros(self.nz + 1)
         v[:self.nz] = zd
         arg = x[self.sb] + alpha
