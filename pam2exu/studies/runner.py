@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import gc
 import os
 import tempfile
 import warnings
@@ -138,23 +139,57 @@ def run_variants(payload: dict, start: int, stop: int, values: np.ndarray
     """
     rows, warned_rows, kept = [], [], []
     made = solved = [None] * (stop - start)
-    if one_pass(payload):                  # the chunk's positions in one pass
-        made = [made_variant(payload, v) for v in values]
-        solved = answered(payload, [model for model, _ in made])
-    for i in range(start, stop):
-        row = values[i - start]
-        reduced, outcome, warned_text, series = run_variant(payload, row, made[i - start],
-                                                            solved[i - start])
-        rows.append(Variant(i, ERROR, outcome, tuple(row), None) if reduced is None
-                    else Variant(i, outcome, "", tuple(row), reduced))
-        warned_rows.append(warned_text)
-        kept.append(series)
+    frozen = False
+    try:
+        if one_pass(payload):              # the chunk's positions in one pass
+            (made, solved), frozen = set_apart(lambda: _one_pass(payload, values))
+        for i in range(start, stop):
+            row = values[i - start]
+            reduced, outcome, warned_text, series = run_variant(payload, row, made[i - start],
+                                                                solved[i - start])
+            made[i - start] = solved[i - start] = None       # its objects may go now
+            rows.append(Variant(i, ERROR, outcome, tuple(row), None) if reduced is None
+                        else Variant(i, outcome, "", tuple(row), reduced))
+            warned_rows.append(warned_text)
+            kept.append(series)
+    finally:
+        if frozen:
+            gc.unfreeze()
     table = variant_table(payload["names"], payload["reduced"], rows)
     table[WARNINGS] = np.array(warned_rows, dtype=str)
     if payload.get("series") is not None:
         table.update(chunk_series(kept, len(series_outputs(payload["reduced"])),
                                   payload.get("series")))
     return table
+
+
+def _one_pass(payload: dict, values: np.ndarray) -> tuple[list, list]:
+    """(made, solved) of a chunk's variants: each one's model (``made_variant``) and its
+    answers from the one pass (``batch.answered``)."""
+    made = [made_variant(payload, v) for v in values]
+    return made, answered(payload, [model for model, _ in made])
+
+
+def set_apart(make):
+    """(``make()``, frozen): ``make()`` run with Python's cyclic garbage collector paused,
+    and every object alive then set apart from the collector (``gc.freeze``: frozen True;
+    the caller's ``gc.unfreeze`` gives them back), unless objects were set apart already
+    (by the program that runs the study: its own are left as they are).
+
+    The one pass makes objects that all live until their variants have run: the
+    collector's passes over them would free nothing, and one full pass over the ~170,000
+    objects of 400 four-bars costs ~0.1–0.2 s (2–4 % of the chunk). Objects that go are
+    still freed by their reference counts."""
+    enabled, frozen = gc.isenabled(), gc.get_freeze_count() == 0
+    gc.disable()
+    try:
+        out = make()
+        if frozen:
+            gc.freeze()
+        return out, frozen
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def payload(study: Study, reduced: list[str]) -> dict:

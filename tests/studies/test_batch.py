@@ -206,3 +206,36 @@ def test_the_shipped_one_pass_study_runs_its_first_variants_as_their_own_runs():
     s = prepared(load_study(EXAMPLES / "studies" / "four_bar_tolerance.toml"), 6)
     assert s.backend == "natural" and s.batched
     _same(study(s, workers=1), study(dataclasses.replace(s, batched=False), workers=1))
+
+
+def test_a_chunk_gives_the_garbage_collector_back_as_it_found_it(monkeypatch):
+    """The one pass pauses Python's cyclic collector and sets its objects apart
+    (``runner.set_apart``): after the chunk, or when the pass raises, the collector is on
+    again with nothing set apart; a program's own frozen objects are left frozen."""
+    import gc
+    from pam2exu.studies import runner
+    s = loads_study(SLIDER, folder=EXAMPLES)
+    names, _ = nominal(s)
+    p = payload(s, names)
+    values = s.variants()[:2]
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    table = runner.run_variants(p, 0, 2, values)
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    assert list(table["status"]) == ["ok", "ok"]
+
+    def fails(*_):
+        raise RuntimeError("the pass failed")
+    monkeypatch.setattr(runner, "answered", fails)
+    with pytest.raises(RuntimeError):
+        runner.run_variants(p, 0, 2, values)
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+
+    monkeypatch.undo()
+    mine = [[]]                                    # a program's own object, frozen
+    gc.freeze()
+    try:
+        runner.run_variants(p, 0, 2, values)
+        assert gc.get_freeze_count() > 0 and gc.isenabled()     # not unfrozen by the chunk
+    finally:
+        gc.unfreeze()
+    assert mine
