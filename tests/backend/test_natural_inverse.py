@@ -228,3 +228,15 @@ def test_one_revolute_incidence_is_its_own_inverse(d):
     assert np.array_equal(_incidence_inverse(D), np.linalg.pinv(D))
     two = np.array([[1.0, -1.0]])
     assert np.array_equal(_incidence_inverse(two), np.linalg.pinv(two))
+
+
+def test_incidence_inverse_is_made_once_per_incidence_and_read_only():
+    """A pin's D⁺ depends on D alone: the same entries give the same read-only array
+    (numpy.linalg.pinv's), other entries another one."""
+    from pam2exu.backend.natural.reactions import _incidence_inverse
+    D = np.array([[1.0], [-1.0]])
+    first = _incidence_inverse(D)
+    assert _incidence_inverse(D.copy()) is first and not first.flags.writeable
+    assert np.array_equal(first, np.linalg.pinv(D))
+    other = _incidence_inverse(np.array([[-1.0], [1.0]]))
+    assert other is not first and np.array_equal(other, -first)

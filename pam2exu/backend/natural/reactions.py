@@ -113,13 +113,24 @@ class _Pin:
     at: list | None = None
 
 
+#: ``_incidence_inverse`` of the incidences met last (at most ``KEPT_INCIDENCES``): a study's
+#: variants share their pins' incidences (entries ±1 and 0, from which solids meet where)
+_INCIDENCES: dict = {}
+KEPT_INCIDENCES = 64
+
+
 def _incidence_inverse(D: np.ndarray) -> np.ndarray:
-    """D⁺, the least-norm inverse of a pin's incidence; one revolute between one moving solid
-    and the ground, D = [[±1]], is its own inverse (what ``numpy.linalg.pinv`` gives, without
-    its SVD)."""
-    if D.shape == (1, 1):
-        return D.copy()
-    return np.linalg.pinv(D)
+    """D⁺, the least-norm inverse of a pin's incidence (read-only, made once per D: the key
+    is D's shape and entries); one revolute between one moving solid and the ground,
+    D = [[±1]], is its own inverse (what ``numpy.linalg.pinv`` gives, without its SVD)."""
+    key = (D.shape, D.tobytes())
+    if key not in _INCIDENCES:
+        if len(_INCIDENCES) >= KEPT_INCIDENCES:
+            _INCIDENCES.pop(next(iter(_INCIDENCES)))
+        made = D.copy() if D.shape == (1, 1) else np.linalg.pinv(D)
+        made.setflags(write=False)
+        _INCIDENCES[key] = made
+    return _INCIDENCES[key]
 
 
 class Plan:
