@@ -90,11 +90,20 @@ class Loads:
             np.sum(v * v, axis=1, keepdims=True)
 
     def gravity(self, g: float) -> None:
-        """(0, −m g) at every solid's centre of mass."""
+        """(0, −m g) at every solid's centre of mass: on (p, v) the same (F, a F − b Ω F) at
+        every step (``force``'s sums), added for all solids in one operation."""
+        solids, on_p, on_v = [], [], []
         for i, s in enumerate(self.form.mech.solids):
             if float(s.mass) and g:
-                weight = np.broadcast_to([0.0, -float(s.mass) * g], (self.n, 2))
-                self.force(i, (float(s.cog[0]), float(s.cog[1])), weight)
+                f = self.form.frames[i]
+                a, b = f._ab((float(s.cog[0]) - f.sp[0], float(s.cog[1]) - f.sp[1]))
+                fx, fy = 0.0, -float(s.mass) * g
+                solids.append(i)
+                on_p.append((fx, fy))
+                on_v.append((a * fx - b * -fy, a * fy - b * fx))       # Ω F = (−Fy, Fx)
+        if solids:
+            self.Qp[:, solids] += np.array(on_p)
+            self.Qv[:, solids] += np.array(on_v)
 
     def on_coordinates(self) -> np.ndarray:
         """Q (n, nz) on the natural coordinates: Σ Pᵀ Q_p + Vᵀ Q_v over the solids."""

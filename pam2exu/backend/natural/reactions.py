@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...kinematics import ANGLES, column, cross, pose
+from ...kinematics import ANGLES, column, cross
 from ..base import Reactions
 from . import inverse
 from .forms import ONE, Expr, Vec
@@ -162,6 +162,17 @@ class Plan:
         for r, c in enumerate(self.angle_cols.values()):
             angles[r, c] = 1.0
         self.angle_solids = np.array(list(self.angle_cols), dtype=int)
+        # ``natural_rates``: the rows of y that are columns of q (x, y of every solid, the
+        # angle coordinates), those columns, and every solid's fi column
+        ns = len(form.frames)
+        self.y_rows = np.array([4 * i + k for i in range(ns) for k in (0, 1)] +
+                               [4 * ns + r for r in range(len(self.angle_solids))], dtype=int)
+        self.y_columns = np.array([column(i, k) for i in range(ns) for k in (0, 1)] +
+                                  [column(i, 2) for i in self.angle_solids], dtype=int)
+        self.fi_columns = np.array([column(i, 2) for i in range(ns)], dtype=int)
+        # ``_wrenches``: the columns of each constraint element's receiver's x and y
+        self.receiver_columns = np.array([[column(el.receiver, k) for el in mech.constraints]
+                                          for k in (0, 1)], dtype=int).reshape(2, -1)
         self.offsets = np.r_[K[:, -1], np.zeros(len(self.angle_cols))]
         Q, R = np.linalg.qr(np.vstack([K[:, :-1], angles]))       # full column rank
         self.rates = inverse.csr(np.linalg.solve(R, Q.T))           # its left inverse
@@ -234,32 +245,29 @@ def natural_rates(pl: Plan, q, qd, qdd):
     """(z, ż, z̈) of the motion q, q̇, q̈: the least-squares solutions of K z = y − k,
     K ż = ẏ, K z̈ = ÿ, y = (x, y, cos fi, sin fi) of every solid and the angle coordinates
     (exact: they are linear in z, ``Formulation.pose_forms``). y is built one row per
-    quantity with the steps along it (no operation along an axis of 4 solids)."""
+    quantity with the steps along it, all solids' rows of a kind in one operation."""
     ns, n = len(pl.form.frames), len(q)
     y = np.empty((3, 4 * ns + len(pl.angle_solids), n))
     for out, v in zip(y, (q, qd, qdd)):
-        for i in range(ns):
-            out[4 * i], out[4 * i + 1] = v[:, column(i, 0)], v[:, column(i, 1)]
-        for r, i in enumerate(pl.angle_solids):
-            out[4 * ns + r] = v[:, column(i, 2)]
-    for i in range(ns):
-        fi, w, a = q[:, column(i, 2)], qd[:, column(i, 2)], qdd[:, column(i, 2)]
-        c, s = np.cos(fi), np.sin(fi)
-        y[0, 4 * i + 2], y[0, 4 * i + 3] = c, s
-        y[1, 4 * i + 2], y[1, 4 * i + 3] = -s * w, c * w
-        y[2, 4 * i + 2], y[2, 4 * i + 3] = -s * a - c * w * w, c * a - s * w * w
+        out[pl.y_rows] = v[:, pl.y_columns].T                # x, y and the angle coordinates
+    f, w, a = (v[:, pl.fi_columns].T for v in (q, qd, qdd))   # (ns, n) each
+    c, s = np.cos(f), np.sin(f)
+    y[0, 2:4 * ns:4], y[0, 3:4 * ns:4] = c, s
+    y[1, 2:4 * ns:4], y[1, 3:4 * ns:4] = -s * w, c * w
+    y[2, 2:4 * ns:4], y[2, 3:4 * ns:4] = -s * a - c * w * w, c * a - s * w * w
     y[0] -= pl.offsets[:, None]
     return tuple((pl.rates @ v).T for v in y)      # (n, nz) views, as ``inverse.times``
 
 
 def _about_origin(zeta, force_p, force_v, moment=0.0):
-    """(3, n): forces (force_p, force_v) (2, n) on a frame's (p, v) (zeta (4, n)), and a
-    moment on its angle, as a force and a moment about the global origin:
-    (F, p × F + G_v·Ω v + M) (one row per quantity, the steps along it)."""
-    out = np.empty((3, zeta.shape[-1]))
-    out[0], out[1] = force_p
-    out[2] = (_cross(zeta[:2], force_p) + (force_v[0] * -zeta[3] + force_v[1] * zeta[2])
-              + moment)
+    """(…, 3, n): forces (force_p, force_v) (…, 2, n) on a frame's (p, v) (zeta (…, 4, n)),
+    and a moment on its angle, as a force and a moment about the global origin:
+    (F, p × F + G_v·Ω v + M) (one row per quantity, the steps along it; … the solids)."""
+    out = np.empty(force_p.shape[:-2] + (3, force_p.shape[-1]))
+    out[..., :2, :] = force_p
+    px, py, vx, vy = (zeta[..., k, :] for k in range(4))
+    fx, fy, gx, gy = force_p[..., 0, :], force_p[..., 1, :], force_v[..., 0, :], force_v[..., 1, :]
+    out[..., 2, :] = (px * fy - py * fx) + (gx * -vy + gy * vx) + moment
     return out
 
 
@@ -321,7 +329,7 @@ def _chunk(pl: Plan, t, q, qd, qdd, extra: int):
     for i, c in pl.angle_cols.items():
         hat[:, pl.frame_eq.frames[i].angle] = z[:, c]
     Jh = pl.terms.dense(pl.terms.jacobian(hat))                 # (n, rows, ζ̂)
-    origins = [q[:, pose(el.receiver)][:, :2] for el in pl.mech.constraints]
+    origins = (q[:, pl.receiver_columns[0]].T, q[:, pl.receiver_columns[1]].T)  # (nc, n)
     wrench = _wrenches(pl, z, zeta, J, Jh, W, mu, origins)
     modes = None
     if extra:                                                  # the null space of Φ_zᵀ
@@ -369,8 +377,7 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
         for i in el.solids:
             if i in form.grounds:
                 on[(k, i)] = on.get((k, i), 0.0) - total
-    balance = np.stack([_about_origin(Zt[i], Wt[i, :2], Wt[i, 2:])
-                        for i in range(len(form.frames))])
+    balance = _about_origin(Zt, Wt[:, :2], Wt[:, 2:])          # (ns, 3, n)
     left = balance.copy()                                      # what the pins must give
     for (k, i), w in on.items():
         left[i] -= w
@@ -401,12 +408,9 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
                 if i == g and kk != k:
                     w -= other
             wrench[k] = w
-    out = np.empty((n, nc, 3))
-    for k, origin in enumerate(origins):                       # about the receiver's origin
-        wrench[k, 2] -= origin[:, 0] * wrench[k, 1] - origin[:, 1] * wrench[k, 0]
-        for d in range(3):
-            out[:, k, d] = wrench[k, d]
-    return out
+    ox, oy = origins                                           # about the receiver's origin
+    wrench[:, 2] -= ox * wrench[:, 1] - oy * wrench[:, 0]
+    return wrench.transpose(2, 0, 1)
 
 
 def _summed(weights, rows) -> np.ndarray:
