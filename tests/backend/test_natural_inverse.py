@@ -240,3 +240,38 @@ def test_incidence_inverse_is_made_once_per_incidence_and_read_only():
     assert np.array_equal(first, np.linalg.pinv(D))
     other = _incidence_inverse(np.array([[-1.0], [1.0]]))
     assert other is not first and np.array_equal(other, -first)
+
+
+def _rigid_rows_made(form):
+    """Each moving solid's rigid-body rows made by ``Formulation._rigid_equations`` alone
+    (every other solid taken as ground), their solid for each: the reference."""
+    from pam2exu.backend.natural.formulation import Formulation
+    owners = []
+    for i in range(len(form.frames)):
+        if i in form.grounds:
+            continue
+        alone = object.__new__(Formulation)
+        alone.mech, alone.frames, alone.own = form.mech, form.frames, form.own
+        alone.grounds = {j: None for j in range(len(form.frames)) if j != i}
+        alone._rows = []
+        alone._rigid_equations()
+        owners += [i] * len(alone._rows)
+    return owners
+
+
+def test_rigid_rows_counted_are_the_rows_made_solid_by_solid():
+    """The reaction plan counts each solid's rigid-body rows (|v|², further basic points, its
+    angle) without making them: the same owners as the rows made solid by solid, on models
+    with a ternary solid, unit vectors, angle coordinates (an actuator, every solid's) and a
+    solid held by two ground pins."""
+    from pam2exu.backend.natural.formulation import Formulation
+    from pam2exu.backend.natural.reactions import _rigid_owners
+    models = [_six_bar()[0], _redundant()[0]] + [pam2exu.load(ROOT / p) for p in (
+        "examples/all_elements.toml", "examples/slider_crank.toml", "examples/scotch_yoke.toml",
+        "tests/data/every_element.toml")]
+    for model in models:
+        mech = model.mechanism()
+        for all_angles in (False, True):
+            form = Formulation(mech, all_angles=all_angles)
+            made = _rigid_rows_made(form)
+            assert _rigid_owners(form) == made and len(made) > 0, model.name

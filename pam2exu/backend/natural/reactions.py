@@ -84,17 +84,18 @@ class _FrameEquations(Formulation):
 
 
 def _rigid_owners(form: Formulation) -> list[int]:
-    """The solid of each rigid-body row (the formulation's first rows), in order."""
+    """The solid of each rigid-body row (the formulation's first rows), in order: each moving
+    solid's rows of ``Formulation._rigid_equations`` counted, not made: |v|² = |d|² where v
+    is not constant, two for each further basic point (not at the base point or at the end
+    of the base vector), one for its angle coordinate."""
     owners = []
-    for i in range(len(form.frames)):
+    for i, f in enumerate(form.frames):
         if i in form.grounds:
             continue
-        alone = object.__new__(Formulation)        # the formulation's own rows, one solid
-        alone.mech, alone.frames, alone.own = form.mech, form.frames, form.own
-        alone.grounds = {j: None for j in range(len(form.frames)) if j != i}
-        alone._rows = []
-        alone._rigid_equations()
-        owners += [i] * len(alone._rows)
+        base = {f.sp, (f.sp[0] + f.d[0], f.sp[1] + f.d[1])}
+        count = (not f.v.x.is_constant or not f.v.y.is_constant) + (f.angle is not None) + \
+            2 * sum(loc not in base for loc, _ in form.own.get(i, []))
+        owners += [i] * count
     return owners
 
 
