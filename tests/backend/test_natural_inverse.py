@@ -275,3 +275,17 @@ def test_rigid_rows_counted_are_the_rows_made_solid_by_solid():
             form = Formulation(mech, all_angles=all_angles)
             made = _rigid_rows_made(form)
             assert _rigid_owners(form) == made and len(made) > 0, model.name
+
+
+def test_solids_matrices_are_shared_between_formulations_of_one_structure():
+    """Two formulations of one mechanism (a study's variants) share the CSR matrices of
+    their solids' A (made once per exact matrix); another A gets its own, scipy's."""
+    from scipy import sparse
+    from pam2exu.backend.natural.formulation import Formulation
+    mech = pam2exu.load(ROOT / "examples/four_bar.toml").mechanism()
+    one, two = (inverse.bodies(Formulation(mech)) for _ in range(2))
+    assert one.flat is two.flat and one.flat_t is two.flat_t
+    assert (one.flat != sparse.csr_matrix(one.A.reshape(len(one.A) * 4, -1))).nnz == 0
+    other = one.A.reshape(len(one.A) * 4, -1).copy()
+    other[0, 0] += 1.0
+    assert inverse.shared_csr(other) is not one.flat

@@ -45,8 +45,8 @@ class Bodies:
 
     def __post_init__(self):
         ns, _, nz = self.A.shape
-        self.flat = csr(self.A.reshape(4 * ns, nz))                     # ζ = flat z + c
-        self.flat_t = csr(self.A.reshape(4 * ns, nz).T)
+        self.flat = shared_csr(self.A.reshape(4 * ns, nz))              # ζ = flat z + c
+        self.flat_t = shared_csr(self.A.reshape(4 * ns, nz).T)
 
     @property
     def block(self) -> np.ndarray:
@@ -74,6 +74,23 @@ def csr(dense: np.ndarray) -> sparse.csr_matrix:
     starts = np.searchsorted(rows, np.arange(dense.shape[0] + 1))
     return sparse.csr_matrix((dense[rows, cols], cols.astype(np.int32),
                               starts.astype(np.int32)), shape=dense.shape)
+
+
+#: ``shared_csr`` of the matrices met last (at most ``KEPT_MATRICES``): a study's variants
+#: share their solids' A (which coordinates each base point and base vector are: entries ±1)
+_SHARED: dict = {}
+KEPT_MATRICES = 32
+
+
+def shared_csr(dense: np.ndarray) -> sparse.csr_matrix:
+    """``csr(dense)``, made once per matrix (the key is its shape and entries) and shared:
+    never to be changed."""
+    key = (dense.shape, dense.tobytes())
+    if key not in _SHARED:
+        if len(_SHARED) >= KEPT_MATRICES:
+            _SHARED.pop(next(iter(_SHARED)))
+        _SHARED[key] = csr(dense)
+    return _SHARED[key]
 
 
 def sparse_of(form, name: str, make):
@@ -176,4 +193,4 @@ def multipliers(form, z, W, redundant: bool, jacobian: np.ndarray | None = None)
 
 __all__ = ["Bodies", "applied", "bodies", "body_coordinates", "body_mass_matrices",
            "constraint_forces", "csr", "kinetic_energy", "multipliers", "on_coordinates",
-           "on_pose", "sparse_of", "times"]
+           "on_pose", "shared_csr", "sparse_of", "times"]
