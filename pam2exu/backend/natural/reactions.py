@@ -110,7 +110,7 @@ class _Pin:
     solids: list
     revolutes: list               # indices into mech.constraints
     inverse: np.ndarray           # (revolutes, solids)
-    #: where the point's columns are in each solid's ``Plan.copied`` columns
+    #: the rows of the point's columns in ``_wrenches``' copy, for each of its solids
     at: list | None = None
 
 
@@ -155,6 +155,12 @@ class Plan:
         for r, el in enumerate(eq.owners):
             self.rows_of.setdefault(index[el], []).append(r)
         self.rows_of = {k: np.array(v) for k, v in self.rows_of.items()}
+        self.solids_of = [el.solids for el in mech.constraints]
+        self.receivers = [el.receiver for el in mech.constraints]
+        # ``_wrenches``: each moving solid's columns of ζ̂ (p, v and its angle if it has one)
+        self.frame_columns = {i: np.r_[k:k + 4, [eq.frames[i].angle] if eq.frames[i].angle
+                                       is not None else []].astype(int)
+                              for i, k in eq.start.items()}
         self._pins(form, mech, index)
         self._fixed(form, mech)
         self._copied(form)
@@ -209,9 +215,13 @@ class Plan:
 
     def _copied(self, form) -> None:
         """The columns of each solid's copy of its basic points that the reactions read (its
-        column pins'), with A_s's nonzero entries there: ``copied`` {solid: (columns, [[(k,
-        A_s[k, c])] per column c])}; the pins, column points first (``ordered_pins``), each with where its
-        columns are in its solids' (``_Pin.at``)."""
+        column pins'), stacked solid after solid (``_wrenches``' copy, rows ``copy_rows``
+        {solid: slice}), with A_s's nonzero entries there: ``copied`` {solid: (columns,
+        [[(k, A_s[k, c])] per column c])}, and as rounds of one operation each: A_sᵀ W_s
+        (``copy_terms``: the k-th nonzero of every column in round k, as ``_combined``) and
+        the rigid-body rows' Φ_zᵀ μ (``copy_rigid``: the j-th rigid row of every solid in
+        round j); the pins, column points first (``ordered_pins``), each with the copy's rows
+        of its columns for each of its solids (``_Pin.at``)."""
         bd = inverse.bodies(form)
         wanted: dict[int, list] = {}
         for pin in self.pins:
@@ -221,9 +231,32 @@ class Plan:
         self.copied = {i: (np.array(cols), [[(k, bd.A[i][k, c]) for k in range(4)
                                               if bd.A[i][k, c]] for c in cols])
                        for i, cols in wanted.items()}
+        self.copy_rows, size = {}, 0
+        for i, cols in wanted.items():
+            self.copy_rows[i], size = slice(size, size + len(cols)), size + len(cols)
+        self.copy_size = size
+        terms, rigid = [], []                  # per round: (rows, sources, numbers)
+        for i, (cols, per_column) in self.copied.items():
+            first = self.copy_rows[i].start
+            for a, pairs in enumerate(per_column):
+                for number, (k, c) in enumerate(pairs):
+                    if number == len(terms):
+                        terms.append(([], [], []))
+                    for part, value in zip(terms[number], (first + a, 4 * i + k, c)):
+                        part.append(value)
+            own = [r for r, o in enumerate(self.rigid) if o == i]
+            for j, r in enumerate(own):
+                if j == len(rigid):
+                    rigid.append(([], [], []))
+                for a, c in enumerate(cols):
+                    for part, value in zip(rigid[j], (first + a, r, c)):
+                        part.append(value)
+        self.copy_terms = [(np.array(a), np.array(b), np.array(c)[:, None]) for a, b, c in terms]
+        self.copy_rigid = [tuple(np.array(x) for x in round_) for round_ in rigid]
         for pin in self.pins:
             if pin.columns is not None:
-                pin.at = [[wanted[i].index(c) for c in pin.columns] for i in pin.solids]
+                pin.at = [np.array([self.copy_rows[i].start + wanted[i].index(c)
+                                    for c in pin.columns]) for i in pin.solids]
         self.ordered_pins = sorted(self.pins, key=lambda p: p.columns is None)
 
     def _fixed(self, form, mech) -> None:
@@ -351,31 +384,35 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
     mut, zt = np.ascontiguousarray(mu.T), z.T
     wrench = np.zeros((nc, 3, n))                              # about O, on the receiver
     on = {}                                                    # (element, solid) -> about O
-    # A_sᵀ W_s per solid, on the columns of its column pins only (``Plan.copied``)
-    copies = {i: _combined(Wt[i], terms) for i, (_, terms) in pl.copied.items()}
-    for r, i in enumerate(pl.rigid):                           # s's rigid rows on its copy
-        if i in copies:
-            for a, c in enumerate(pl.copied[i][0]):
-                copies[i][a] += J[:, r, c] * mut[r]
+    # A_sᵀ W_s per solid, on the columns of its column pins only (``Plan.copied``), then
+    # s's rigid rows on its copy, in rounds (``Plan._copied``): each entry's terms in order
+    copy = np.zeros((pl.copy_size, n))
+    flat = Wt.reshape(-1, n)
+    for number, (rows, sources, numbers) in enumerate(pl.copy_terms):
+        if number:
+            copy[rows] += flat[sources] * numbers
+        else:
+            copy[rows] = flat[sources] * numbers
+    for rows, r, c in pl.copy_rigid:
+        copy[rows] += J[:, r, c].T * mut[r]
     if pl.rows_of:
         Jht = np.ascontiguousarray(np.moveaxis(Jh, 0, -1))     # (rows, ζ̂, n)
     for k, rows in pl.rows_of.items():
-        el = mech.constraints[k]
         total = np.zeros((3, n))
-        for i in el.solids:
+        weights, el_rows = mut[pl.first + rows], Jht[rows]
+        for i in pl.solids_of[k]:
             if i in form.grounds or (k, i) in on:
                 continue
-            j = pl.frame_eq.start[i]
-            f = pl.frame_eq.frames[i]
-            wanted = list(range(j, j + 4)) + ([f.angle] if f.angle is not None else [])
-            g = _summed(mut[pl.first + rows], Jht[rows][:, wanted])   # (Φ_ζ̂ᵀ μ) there
-            moment = -g[4] if f.angle is not None else 0.0
+            wanted = pl.frame_columns[i]
+            g = _summed(weights, el_rows[:, wanted])                   # (Φ_ζ̂ᵀ μ) there
+            moment = -g[4] if len(wanted) == 5 else 0.0
             on[(k, i)] = w = _about_origin(Zt[i], -g[0:2], -g[2:4], moment)
             total += w
-            if i in copies:                # (its angle column is no pin's)
-                copies[i] += _combined(g, pl.copied[i][1])
-        wrench[k] = -total if el.receiver in form.grounds else on[(k, el.receiver)]
-        for i in el.solids:
+            if i in pl.copy_rows:          # (its angle column is no pin's)
+                copy[pl.copy_rows[i]] += _combined(g, pl.copied[i][1])
+        receiver = pl.receivers[k]
+        wrench[k] = -total if receiver in form.grounds else on[(k, receiver)]
+        for i in pl.solids_of[k]:
             if i in form.grounds:
                 on[(k, i)] = on.get((k, i), 0.0) - total
     balance = _about_origin(Zt, Wt[:, :2], Wt[:, 2:])          # (ns, 3, n)
@@ -385,7 +422,7 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
     for pin in pl.ordered_pins:                                # column points first
         if pin.columns is not None:
             point = zt[pin.columns]
-            force = [copies[i][at] for i, at in zip(pin.solids, pin.at)]
+            force = [copy[at] for at in pin.at]
             for r, i in enumerate(pin.solids):
                 left[i, :2] -= force[r]
                 left[i, 2] -= _cross(point, force[r])
@@ -393,13 +430,12 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
             point = pin.constant
             force = [left[i, :2].copy() for i in pin.solids]
         for e, k in enumerate(pin.revolutes):                  # on each receiver
-            el = mech.constraints[k]
             w = wrench[k]
             w[:2] = _mixed(pin.inverse[e], force)
             w[2] = _cross(point, w[:2])
-            for i in el.solids:
+            for i in pl.solids_of[k]:
                 if i in form.grounds:
-                    sign = 1.0 if i == el.receiver else -1.0
+                    sign = 1.0 if i == pl.receivers[k] else -1.0
                     on[(k, i)] = on.get((k, i), 0.0) + sign * w
     for k, el in enumerate(mech.constraints):
         if el.grounds:                                         # the held solid's balance
