@@ -157,6 +157,12 @@ class Plan:
         self.rows_of = {k: np.array(v) for k, v in self.rows_of.items()}
         self.solids_of = [el.solids for el in mech.constraints]
         self.receivers = [el.receiver for el in mech.constraints]
+        # ``_chunk``: ζ̂'s columns of every moving solid's p, v (from ζ's) and angle (from z's)
+        self.hat_frames = (np.array([k + d for k in eq.start.values() for d in range(4)],
+                                    dtype=int),
+                           np.array([4 * i + d for i in eq.start for d in range(4)], dtype=int))
+        self.hat_angles = (np.array([eq.frames[i].angle for i in self.angle_cols], dtype=int),
+                           np.array(list(self.angle_cols.values()), dtype=int))
         # ``_wrenches``: each moving solid's columns of ζ̂ (p, v and its angle if it has one)
         self.frame_columns = {i: np.r_[k:k + 4, [eq.frames[i].angle] if eq.frames[i].angle
                                        is not None else []].astype(int)
@@ -357,11 +363,9 @@ def _chunk(pl: Plan, t, q, qd, qdd, extra: int):
     mu = inverse.multipliers(form, z, W, extra > 0, jacobian=J)
     zeta = inverse.body_coordinates(bd, z)                     # (n, ns, 4): p, v
     n = len(t)
-    hat = np.empty((n, pl.terms.nz))
-    for i, k in pl.frame_eq.start.items():
-        hat[:, k:k + 4] = zeta[:, i]
-    for i, c in pl.angle_cols.items():
-        hat[:, pl.frame_eq.frames[i].angle] = z[:, c]
+    hat = np.empty((n, pl.terms.nz))                           # ζ̂: (p, v, fi) per solid
+    hat[:, pl.hat_frames[0]] = zeta.reshape(n, -1)[:, pl.hat_frames[1]]
+    hat[:, pl.hat_angles[0]] = z[:, pl.hat_angles[1]]
     Jh = pl.terms.dense(pl.terms.jacobian(hat))                 # (n, rows, ζ̂)
     origins = (q[:, pl.receiver_columns[0]].T, q[:, pl.receiver_columns[1]].T)  # (nc, n)
     wrench = _wrenches(pl, z, zeta, J, Jh, W, mu, origins)
