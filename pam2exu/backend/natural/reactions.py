@@ -164,9 +164,10 @@ class Plan:
         self.hat_angles = (np.array([eq.frames[i].angle for i in self.angle_cols], dtype=int),
                            np.array(list(self.angle_cols.values()), dtype=int))
         # ``_wrenches``: each moving solid's columns of ζ̂ (p, v and its angle if it has one)
-        self.frame_columns = {i: np.r_[k:k + 4, [eq.frames[i].angle] if eq.frames[i].angle
-                                       is not None else []].astype(int)
-                              for i, k in eq.start.items()}
+        self.frame_columns = {
+            i: np.array([k, k + 1, k + 2, k + 3] + (
+                [] if eq.frames[i].angle is None else [eq.frames[i].angle]))
+            for i, k in eq.start.items()}
         self._pins(form, mech, index)
         self._fixed(form, mech)
         self._copied(form)
@@ -186,7 +187,7 @@ class Plan:
         # ``_wrenches``: the columns of each constraint element's receiver's x and y
         self.receiver_columns = np.array([[column(el.receiver, k) for el in mech.constraints]
                                           for k in (0, 1)], dtype=int).reshape(2, -1)
-        self.offsets = np.r_[K[:, -1], np.zeros(len(self.angle_cols))]
+        self.offsets = np.concatenate([K[:, -1], np.zeros(len(self.angle_cols))])
         Q, R = np.linalg.qr(np.vstack([K[:, :-1], angles]))       # full column rank
         self.rates = inverse.csr(np.linalg.solve(R, Q.T))           # its left inverse
 
