@@ -155,7 +155,7 @@ def applied(form, t, z, q, zd) -> np.ndarray:
     loads.gravity(form.mech.gravity)
     for el in form.mech.elements:
         el.natural_loads(loads)
-    return np.concatenate([loads.Qp, loads.Qv], axis=2)
+    return loads.Q
 
 
 def constraint_forces(form, t, z, zd, zdd, q) -> np.ndarray:

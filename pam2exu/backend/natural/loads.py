@@ -43,7 +43,9 @@ class Loads:
         self.z = np.asarray(z, dtype=float)
         self.zd = zd
         ns = len(form.frames)
-        self.Qp, self.Qv = np.zeros((self.n, ns, 2)), np.zeros((self.n, ns, 2))
+        #: Q (n, ns, 4) on every solid's (p, v); Qp, Qv its views on p and on v
+        self.Q = np.zeros((self.n, ns, 4))
+        self.Qp, self.Qv = self.Q[:, :, :2], self.Q[:, :, 2:]
 
     def _value(self, solid: int, local, kind: str) -> np.ndarray:
         """A point or vector of a solid (``Formulation.affine``) at the configurations, (n, 2)."""
@@ -101,9 +103,10 @@ class Loads:
                 solids.append(i)
                 on_p.append((fx, fy))
                 on_v.append((a * fx - b * -fy, a * fy - b * fx))       # Ω F = (−Fy, Fx)
-        if solids:
-            self.Qp[:, solids] += np.array(on_p)
-            self.Qv[:, solids] += np.array(on_v)
+        if solids:                 # consecutive solids: a slice (no per-element indexing)
+            at = slice(solids[0], solids[-1] + 1) if solids[-1] - solids[0] == len(solids) - 1 \
+                else solids
+            self.Q[:, at] += np.array([p + v for p, v in zip(on_p, on_v)])     # (p, v) rows
 
     def on_coordinates(self) -> np.ndarray:
         """Q (n, nz) on the natural coordinates: Σ Pᵀ Q_p + Vᵀ Q_v over the solids."""
