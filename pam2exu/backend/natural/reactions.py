@@ -400,16 +400,15 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
             copy[rows] = flat[sources] * numbers
     for rows, r, c in pl.copy_rigid:
         copy[rows] += J[:, r, c].T * mut[r]
-    if pl.rows_of:
-        Jht = np.ascontiguousarray(np.moveaxis(Jh, 0, -1))     # (rows, ζ̂, n)
     for k, rows in pl.rows_of.items():
         total = np.zeros((3, n))
-        weights, el_rows = mut[pl.first + rows], Jht[rows]
+        weights = mut[pl.first + rows]
         for i in pl.solids_of[k]:
             if i in form.grounds or (k, i) in on:
                 continue
             wanted = pl.frame_columns[i]
-            g = _summed(weights, el_rows[:, wanted])                   # (Φ_ζ̂ᵀ μ) there
+            part = np.ascontiguousarray(Jh[:, rows[:, None], wanted].transpose(1, 2, 0))
+            g = _summed(weights, part)                                  # (Φ_ζ̂ᵀ μ) there
             moment = -g[4] if len(wanted) == 5 else 0.0
             on[(k, i)] = w = _about_origin(Zt[i], -g[0:2], -g[2:4], moment)
             total += w
