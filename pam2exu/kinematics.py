@@ -50,9 +50,11 @@ def rotate(fi, v):
 
 def _rotate(c, s, v):
     """A v with A = [[c, −s], [s, c]]: ``rotate`` with cos fi and sin fi given."""
-    x, y = c * v[0] - s * v[1], s * v[0] + c * v[1]
+    vx, vy = v[0], v[1]
+    x = c * vx
     out = np.empty(x.shape + (2,), x.dtype)     # np.stack's values, without its checks
-    out[..., 0], out[..., 1] = x, y
+    np.subtract(x, s * vy, out=out[..., 0])
+    np.add(s * vx, c * vy, out=out[..., 1])
     return out
 
 
@@ -288,27 +290,37 @@ class State:
         return self._rotated_memo[key]
 
     def _build_rotated(self, solid: int, local: np.ndarray, translate: bool) -> Quantity:
-        x, y, fi = (column(solid, k) for k in range(PER_SOLID))
+        x = PER_SOLID * solid
         As = _rotate(*self.trig(solid), local)
         jac = {}
+        turned = None
         if self.jacobians:
             block = jac[solid] = np.zeros((self.n, 2, 3), dtype=As.dtype)
             if translate:
                 block[:, 0, 0] = block[:, 1, 1] = 1.0
-            block[:, :, 2] = perp(As)
-        value = As + self.q[:, x:y + 1] if translate else As
+            turned = block[:, :, 2]
+            np.negative(As[:, 1], out=turned[:, 0])          # perp(As), written in place
+            turned[:, 1] = As[:, 0]
+        value = As + self.q[:, x:x + 2] if translate else As
         rate = conv = None
         if self.qd is not None:
-            w = self.qd[:, fi:fi + 1]
-            rate = w * perp(As)
+            w = self.qd[:, x + 2:x + 3]
+            rate = w * (perp(As) if turned is None else turned)
             if translate:
-                rate = rate + self.qd[:, x:y + 1]
+                rate += self.qd[:, x:x + 2]
             conv = -(w * w) * As
         hess = None
         if self.hessians:                      # ∂²(A s)/∂fi² = −A s, the rest 0
             hess = {(solid, solid): np.zeros((self.n, 2, 3, 3), dtype=As.dtype)}
             hess[solid, solid][:, :, 2, 2] = -As
         return Quantity(value, jac, rate, conv, hess)
+
+    def values_only(self) -> "State":
+        """The same states for values alone: the points and directions built from it carry
+        no velocities and no dv/dq (``jacobians=False``); (cos fi, sin fi) are shared."""
+        light = State(self.t, self.q, jacobians=False)
+        light._trig = self._trig              # the same q: the same cos fi, sin fi
+        return light
 
     def prepare(self, points: "PointSet") -> None:
         """Build the points and directions of ``points`` at once, in one vectorised pass,
@@ -369,17 +381,19 @@ def torque(solid: int, moment) -> dict[int, np.ndarray]:
 
 
 def move_wrench(wrench, origin, point):
-    """(F, M_p) with M_p = M_O − (p − O) × F: a wrench (n, 3) about O moved to the point p."""
+    """(F, M_p) with M_p = M_O − (p − O) × F: a wrench (..., 3) about O moved to the point p."""
     out = np.array(wrench, dtype=np.result_type(float, wrench, origin, point), copy=True)
-    out[:, 2] -= cross(point - origin, wrench[:, :2])
+    out[..., 2] -= cross(point - origin, wrench[..., :2])
     return out
 
 
 def to_basis(wrench, direction):
-    """The wrench (n, 3) with its force in the basis whose x axis is the unit vector ``direction``."""
-    ex, ey = direction[:, 0], direction[:, 1]
+    """The wrench (..., 3) with its force in the basis whose x axis is the unit vector
+    ``direction`` (..., 2)."""
+    ex, ey = direction[..., 0], direction[..., 1]
+    fx, fy = wrench[..., 0], wrench[..., 1]
     out = np.empty_like(wrench, dtype=np.result_type(wrench, direction))
-    out[:, 0] = ex * wrench[:, 0] + ey * wrench[:, 1]
-    out[:, 1] = -ey * wrench[:, 0] + ex * wrench[:, 1]
-    out[:, 2] = wrench[:, 2]
+    np.add(ex * fx, ey * fy, out=out[..., 0])
+    np.add(-ey * fx, ex * fy, out=out[..., 1])
+    out[..., 2] = wrench[..., 2]
     return out

@@ -34,15 +34,18 @@ CHUNK_STEPS = 4096
 
 # ---- applied forces ----------------------------------------------------------------------
 
-def gravity(mech, st: State) -> Load:
-    """Weight (0, −m g) at each solid's G; V = Σ m g y_G."""
+def gravity(mech, st: State, forces: bool = True) -> Load:
+    """Weight (0, −m g) at each solid's G; V = Σ m g y_G (``forces=False``: V alone, the
+    generalized forces left empty)."""
     force, potential = {}, np.zeros(st.n, st.q.dtype)     # complex in the complex step
+    at = st if forces else st.values_only()
     for i, s in enumerate(mech.solids):
         m = scalar(s.mass)
         if m.real > 0 and mech.gravity:
-            G = st.point(i, [scalar(c) for c in s.cog])
-            weight = np.broadcast_to([0.0, -m * mech.gravity], (st.n, 2))
-            force.update(generalized_force(G, weight))
+            G = at.point(i, [scalar(c) for c in s.cog])
+            if forces:
+                weight = np.broadcast_to([0.0, -m * mech.gravity], (st.n, 2))
+                force.update(generalized_force(G, weight))
             potential += m * mech.gravity * G.value[:, 1]
     return Load(force, {}, potential)
 
@@ -51,7 +54,8 @@ def gravity(mech, st: State) -> Load:
 class Applied:
     """The applied forces of a mechanism at its states (rows).
 
-    force:       Q_applied (n, nq): gravity, torsors, springs (and dampers)
+    force:       Q_applied (n, nq): gravity, torsors, springs (and dampers); None when
+                 not asked (``applied_forces(forces=False)``)
     outputs:     the force elements' outputs, by column name (``spring1.Força``)
     potential:   V (n,), gravity and springs
     dissipation: power removed by the dampers (n,)
@@ -65,24 +69,27 @@ class Applied:
     external: np.ndarray
 
 
-def applied_forces(mech, st: State, damping: bool) -> Applied:
-    """Sum the loads of gravity and of every force element (dampers only if ``damping``)."""
+def applied_forces(mech, st: State, damping: bool, forces: bool = True) -> Applied:
+    """Sum the loads of gravity and of every force element (dampers only if ``damping``;
+    ``forces=False``: without Q_applied, only the outputs, energies and torsors' forces)."""
     n, dtype = st.n, st.q.dtype                              # complex in the complex step
-    out = Applied(np.zeros((n, mech.nq), dtype), {}, np.zeros(n, dtype), np.zeros(n, dtype),
-                  np.zeros((n, mech.nq), dtype))
-    loads = [(None, gravity(mech, st))] + [(el, el.loads(st, damping)) for el in mech.elements]
+    out = Applied(np.zeros((n, mech.nq), dtype) if forces else None, {}, np.zeros(n, dtype),
+                  np.zeros(n, dtype), np.zeros((n, mech.nq), dtype))
+    loads = [(None, gravity(mech, st, forces))] + [(el, el.loads(st, damping))
+                                                   for el in mech.elements]
     for el, load in loads:
         if load is None:
             continue
         target = out.force if load.potential is not None else out.external
-        for solid, q in load.force.items():
+        for solid, q in load.force.items() if target is not None else ():
             target[:, pose(solid)] += q
         if load.potential is not None:
             out.potential += load.potential
         if load.dissipation is not None:
             out.dissipation += load.dissipation
         out.outputs.update({f"{el.name}.{k}": v for k, v in load.outputs.items()})
-    out.force += out.external
+    if forces:
+        out.force += out.external
     return out
 
 
@@ -148,23 +155,28 @@ def reactions(mech, st: State, lam: np.ndarray, parts=None) -> dict[str, np.ndar
     """
     if parts is None:
         parts = [el.constraint(st)[0] for el in mech.constraints]
-    return checked_reactions(mech, (element_wrench(el, st, lam[:, rows], v.jac)
-                                    for el, rows, v in zip(mech.constraints, mech.rows, parts)))
+    if not mech.constraints:
+        return {}
+    return checked_reactions(mech, np.stack([element_wrench(el, st, lam[:, rows], v.jac)
+                                             for el, rows, v in zip(mech.constraints,
+                                                                    mech.rows, parts)], axis=1))
 
 
-def checked_reactions(mech, wrenches) -> dict[str, np.ndarray]:
-    """The reported components of every constraint element's wrench (n, 3) in its reporting
-    frame (``wrenches`` in ``mech.constraints`` order), by column name; the components that
-    are zero by construction are checked to be zero."""
+def checked_reactions(mech, wrenches: np.ndarray) -> dict[str, np.ndarray]:
+    """The reported components of every constraint element's wrench in its reporting frame
+    (``wrenches`` (n, constraints, 3), in ``mech.constraints`` order), by column name; the
+    components that are zero by construction are checked to be zero."""
     out, length = {}, mech.scale()
-    for el, wrench in zip(mech.constraints, wrenches):
-        scale = (np.max(np.abs(wrench[:, :2]), initial=0.0)
-                 + np.max(np.abs(wrench[:, 2]), initial=0.0) / length)
+    if not mech.constraints:
+        return out
+    largest = np.max(np.abs(wrenches), axis=0, initial=0.0)         # (constraints, 3)
+    scales = (np.maximum(largest[:, 0], largest[:, 1]) + largest[:, 2] / length).tolist()
+    for e, (el, top, scale) in enumerate(zip(mech.constraints, largest.tolist(), scales)):
         for k, name in enumerate(el.wrench):
             if name is not None:
-                out[f"{el.name}.{name}"] = wrench[:, k]
+                out[f"{el.name}.{name}"] = wrenches[:, e, k]
                 continue
-            size = np.max(np.abs(wrench[:, k]), initial=0.0) / (length if k == 2 else 1.0)
+            size = top[k] / (length if k == 2 else 1.0)
             if size > ZERO_COMPONENT_TOLERANCE * scale + 1e-300:
                 what = ("moment" if k == 2 else
                         "force along x" if k == 0 else "force along y")
@@ -298,33 +310,51 @@ def over_time_given(mech, t, q, qd, given):
     energies = Energies(*(np.zeros(n) for _ in range(3)))
     for s in native.chunks(mech, n, most=CHUNK_STEPS):
         st = State(t[s], q[s], qd[s])
-        applied = applied_forces(mech, st, damping=True)
+        applied = applied_forces(mech, st, damping=True, forces=False)
         energies.energy[s] = given.kinetic[s] + applied.potential
         energies.dissipation[s] = applied.dissipation
         energies.external[s] = np.sum(applied.external * qd[s], axis=1)
-        wrenches = [reported_wrench(el, st, given.wrenches[s, k])
-                    for k, el in enumerate(mech.constraints)]
+        wrenches = reported_wrenches(mech, st, given.wrenches[s])
         if given.modes is not None:
             wrenches = _least_reported(mech, st, wrenches, given.modes[s])
         found = checked_reactions(mech, wrenches)
+        whole = s.start == 0 and s.stop == n          # one chunk: its arrays are the columns
         for name, v in {**found, **applied.outputs}.items():
-            out.setdefault(name, np.empty(n))[s] = v
+            if whole and isinstance(v, np.ndarray) and v.shape == (n,) and v.dtype == float:
+                out[name] = v
+            else:
+                out.setdefault(name, np.empty(n))[s] = v
     return out, energies
 
 
-def _least_reported(mech, st: State, wrenches: list, modes: np.ndarray) -> list:
-    """The reported wrenches plus the self-stresses' combination (``modes`` (n, r,
-    constraints, 3), about the receivers' origins) that makes the reported components
-    least in sum of squares: the native pass's least norm (``multipliers``)."""
+def reported_wrenches(mech, st: State, wrenches: np.ndarray) -> np.ndarray:
+    """``reported_wrench`` of every constraint element at once: ``wrenches`` (n,
+    constraints, 3) on their receivers about the receivers' origins, in ``mech.constraints``
+    order, moved to the reporting points and turned into the reporting bases."""
+    if not mech.constraints:
+        return np.array(wrenches, dtype=float)
+    at = st.values_only()
+    frames = [el.report_frame(at) for el in mech.constraints]
+    point = np.stack([f[0] for f in frames], axis=1)                     # (n, constraints, 2)
+    direction = np.stack([f[1] for f in frames], axis=1)
+    origin = st.q[:, [[column(el.receiver, 0), column(el.receiver, 1)]
+                      for el in mech.constraints]]
+    return to_basis(move_wrench(wrenches, origin, point), direction)
+
+
+def _least_reported(mech, st: State, wrenches: np.ndarray, modes: np.ndarray) -> np.ndarray:
+    """The reported wrenches (n, constraints, 3) plus the self-stresses' combination
+    (``modes`` (n, r, constraints, 3), about the receivers' origins) that makes the reported
+    components least in sum of squares: the native pass's least norm (``multipliers``)."""
     shown = [reported(el) for el in mech.constraints]
-    moved = [[reported_wrench(el, st, modes[:, j, k]) for k, el in enumerate(mech.constraints)]
-             for j in range(modes.shape[1])]
-    R0 = np.concatenate([w[:, keep] for w, keep in zip(wrenches, shown)], axis=1)
-    S = np.stack([np.concatenate([w[:, keep] for w, keep in zip(mode, shown)], axis=1)
+    moved = [reported_wrenches(mech, st, modes[:, j]) for j in range(modes.shape[1])]
+    R0 = np.concatenate([wrenches[:, k, keep] for k, keep in enumerate(shown)], axis=1)
+    S = np.stack([np.concatenate([mode[:, k, keep] for k, keep in enumerate(shown)], axis=1)
                   for mode in moved], axis=1)                              # (n, r, K)
     c = -np.einsum("njk,nk->nj", least_norm_inverse(np.swapaxes(S, 1, 2), 1e-10), R0)
-    return [w + np.einsum("nj,njd->nd", c, np.stack([mode[k] for mode in moved], axis=1))
-            for k, w in enumerate(wrenches)]
+    return np.stack([wrenches[:, k] + np.einsum("nj,njd->nd", c,
+                                                np.stack([mode[:, k] for mode in moved], axis=1))
+                     for k in range(len(shown))], axis=1)
 
 
 def _sparse_multipliers(mech, st: State, rhs: np.ndarray):
@@ -368,9 +398,12 @@ class PowerBalance:
         return self.error <= self.tolerance
 
 
-def derivative(f: np.ndarray, k: np.ndarray, h: int, dt: float) -> np.ndarray:
-    """f'(t_k) ≈ (−f[k+2h] + 8 f[k+h] − 8 f[k−h] + f[k−2h]) / (12 h dt), error O((h dt)⁴)."""
-    return (-f[k + 2 * h] + 8 * f[k + h] - 8 * f[k - h] + f[k - 2 * h]) / (12 * h * dt)
+def derivative(f: np.ndarray, k: slice, h: int, dt: float) -> np.ndarray:
+    """f'(t_k) ≈ (−f[k+2h] + 8 f[k+h] − 8 f[k−h] + f[k−2h]) / (12 h dt), error O((h dt)⁴),
+    at the steps k of a slice (step 1)."""
+    def at(j):
+        return f[k.start + j:k.stop + j]
+    return (-at(2 * h) + 8 * at(h) - 8 * at(-h) + at(-2 * h)) / (12 * h * dt)
 
 
 def power_balance(mech, t: np.ndarray, actuator_power: np.ndarray, energy: np.ndarray,
@@ -380,22 +413,24 @@ def power_balance(mech, t: np.ndarray, actuator_power: np.ndarray, energy: np.nd
     if n < 9:
         return None
     dt = float(t[1] - t[0])
-    k = np.arange(4, n - 4)
+    k = slice(4, n - 4)
     d1, d2 = derivative(energy, k, 1, dt), derivative(energy, k, 2, dt)
-    keep = np.ones(len(k), dtype=bool)
-    for el in mech.drivers:
-        for b in el.time_law().breakpoints():
-            keep &= ~((t[k - 4] < b) & (b <= t[k + 4]))
-    if not keep.any():
-        return PowerBalance(0.0, 0.0, 0)
     residual = actuator_power[k] - (d1 + dissipation[k] - external_power[k])
-    residual, d1, d2 = residual[keep], d1[keep], d2[keep]
+    breakpoints = [b for el in mech.drivers for b in el.time_law().breakpoints()]
+    if breakpoints:
+        keep = np.ones(n - 8, dtype=bool)
+        for b in breakpoints:
+            keep &= ~((t[:n - 8] < b) & (b <= t[8:]))
+        if not keep.any():
+            return PowerBalance(0.0, 0.0, 0)
+        residual, d1, d2 = residual[keep], d1[keep], d2[keep]
+    checked = len(residual)
     truncation = np.max(np.abs(d2 - d1)) / 15.0
     size = max(np.max(np.abs(actuator_power)), np.max(np.abs(d1)),
                np.max(np.abs(dissipation)), np.max(np.abs(external_power)))
     roundoff = 1e3 * np.finfo(float).eps * np.max(np.abs(energy)) / dt
     tolerance = 10.0 * truncation + 1e-9 * size + roundoff
-    return PowerBalance(float(np.max(np.abs(residual))), float(tolerance), int(keep.sum()))
+    return PowerBalance(float(np.max(np.abs(residual))), float(tolerance), checked)
 
 
 def actuator_power(mech, st: State, outputs: dict[str, np.ndarray]) -> np.ndarray:
@@ -410,4 +445,4 @@ def actuator_power(mech, st: State, outputs: dict[str, np.ndarray]) -> np.ndarra
 __all__ = ["Applied", "PowerBalance", "applied_forces", "actuator_power",
            "checked_reactions", "element_wrench", "equilibrium_residual", "gravity",
            "inertia_forces", "multipliers", "over_time_given", "power_balance", "reactions",
-           "reported_wrench"]
+           "reported_wrench", "reported_wrenches"]
