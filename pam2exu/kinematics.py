@@ -235,6 +235,13 @@ class PointSet:
                    [(a[0], local.tobytes(), a[2]) for a, local in zip(asked, locals_)])
 
 
+def _rows(a: np.ndarray, ndim: int) -> np.ndarray:
+    """``np.atleast_1d`` (ndim 1) or ``np.atleast_2d`` (ndim 2) of an array."""
+    if a.ndim >= ndim:
+        return a
+    return np.atleast_1d(a) if ndim == 1 else np.atleast_2d(a)
+
+
 class State:
     """Coordinates q (n, 3·solids) at times t (n,), and optionally velocities qd.
 
@@ -244,9 +251,9 @@ class State:
     """
 
     def __init__(self, t, q, qd=None, jacobians: bool = True, hessians: bool = False):
-        self.t = np.atleast_1d(np.asarray(t, dtype=float))
-        self.q = np.atleast_2d(as_array(q))
-        self.qd = None if qd is None else np.atleast_2d(as_array(qd))
+        self.t = _rows(np.asarray(t, dtype=float), 1)
+        self.q = _rows(as_array(q), 2)
+        self.qd = None if qd is None else _rows(as_array(qd), 2)
         self.n = self.q.shape[0]
         self.jacobians = jacobians or hessians
         self.hessians = hessians

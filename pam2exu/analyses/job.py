@@ -213,12 +213,19 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
     table = res.to_numpy()[:, 1:]        # a view of the table's storage: no copies
     np.add(table, 0.0, out=table)        # no negative zeros in tables
     wanted = set(job.columns)
-    if not (np.isfinite(table).all()
-            and all(np.isfinite(v).all() for k, v in values.items() if k not in wanted)):
+    if not (np.isfinite(table).all() and _finite([v for k, v in values.items()
+                                                  if k not in wanted])):
         # an instantaneous centre is NaN by definition where the solid translates
         check_finite(job, t, {k: v for k, v in values.items()
                               if k.rpartition(".")[2] not in ("ICx", "ICy")})
     return res
+
+
+def _finite(arrays: list) -> bool:
+    """Every value of every array is finite (one test of them joined when all are 1-D)."""
+    if all(isinstance(a, np.ndarray) and a.ndim == 1 for a in arrays):
+        return bool(np.isfinite(np.concatenate(arrays)).all()) if arrays else True
+    return all(np.isfinite(a).all() for a in arrays)
 
 
 def column_values(job: Job, t, q, qd=None, qdd=None, extra: dict | None = None):
@@ -227,6 +234,7 @@ def column_values(job: Job, t, q, qd=None, qdd=None, extra: dict | None = None):
     from the solids' coordinates and rates and the analysis' own columns ``extra``.
     Complex in, complex out: the complex step of ``sensitivity``."""
     mech, wanted = job.mech, set(job.columns)
+    extra = extra or {}
     values: dict[str, np.ndarray] = {}
     for i, s in enumerate(mech.solids):
         for k, var in enumerate(SOLID_OUTPUTS):
@@ -234,16 +242,19 @@ def column_values(job: Job, t, q, qd=None, qdd=None, extra: dict | None = None):
             if name in wanted:
                 source = (q, qd, qdd)[k // 3]
                 values[name] = source[:, column(i, k % 3)]
-    st = State(t, q, qd if VELOCITY in job.levels else None)
+    st = None
     for el in mech.elements:
-        names = {v.name for v in el.outputs if f"{el.name}.{v.name}" in wanted}
-        if names:
+        names = {v.name for v in el.outputs
+                 if (c := f"{el.name}.{v.name}") in wanted and c not in extra}
+        if names:                           # (the analysis' own columns replace these)
+            if st is None:
+                st = State(t, q, qd if VELOCITY in job.levels else None)
             for var, v in el.compute(st, names).items():
                 if var in names:
                     values[f"{el.name}.{var}"] = v
     derived, notes = points.columns(mech, t, q, qd, qdd, wanted)
     values.update(derived)
-    values.update(extra or {})
+    values.update(extra)
     return values, notes
 
 
