@@ -55,20 +55,19 @@ class Job:
 
 def available_columns(mech, kind: registry.AnalysisType) -> dict[str, Var]:
     """Every column the analysis ``kind`` can produce, in order: solids, then elements."""
-    out, derived = {}, {}
-    for c, var in derived_columns(mech) if kind.element_outputs else ():
-        if var.level in kind.levels:             # opt-in: points, centres, couplers
-            derived.setdefault(c.partition(".")[0], []).append((c, var))
-    for s in mech.solids:
-        for var in SOLID_OUTPUTS:
-            if var.level in kind.levels:
-                out[f"{s.name}.{var.name}"] = var
-        out.update(derived.get(s.name, ()))
+    out, levels = {}, kind.levels
+    own = [var for var in SOLID_OUTPUTS if var.level in levels]
+    derived = _derived(mech, levels) if kind.element_outputs else None
+    for i, s in enumerate(mech.solids):
+        for var in own:
+            out[f"{s.name}.{var.name}"] = var
+        if derived:                              # opt-in: points, centres, couplers
+            out.update(derived[i])
     for el in mech.elements if kind.element_outputs else ():
         for var in el.outputs:
-            if var.level in kind.levels:
+            if var.level in levels:
                 out[f"{el.name}.{var.name}"] = var
-    if CLEARANCE in kind.levels:                 # the joints with clearance = true
+    if CLEARANCE in levels:                      # the joints with clearance = true
         for el in mech.elements:
             if el.clearance:
                 for var in el.clearance_parameters + el.clearance_derived:
@@ -79,15 +78,25 @@ def available_columns(mech, kind: registry.AnalysisType) -> dict[str, Var]:
 def derived_columns(mech) -> list[tuple[str, Var]]:
     """The opt-in columns (``points``), in order: per solid its instantaneous centre (if it
     is not fixed), its transmission angle (if it is a coupler), then its points' motion."""
+    return [c for columns in _derived(mech) for c in columns]
+
+
+def _derived(mech, levels=None) -> list[list[tuple[str, Var]]]:
+    """``derived_columns`` of each solid, those of the ``levels`` given (default all)."""
+    def kept(variables):
+        return [var for var in variables if levels is None or var.level in levels]
+    centre, coupler, point = (kept(points.CENTRE_OUTPUTS), kept(points.COUPLER_OUTPUTS),
+                              kept(points.POINT_OUTPUTS))
     ground, coupled = mech.held, {c.solid for c in points.couplers(mech)}
     out = []
     for i, s in enumerate(mech.solids):
+        columns = []
         if i not in ground:
-            out += [(f"{s.name}.{var.name}", var) for var in points.CENTRE_OUTPUTS]
+            columns += [(f"{s.name}.{var.name}", var) for var in centre]
         if i in coupled:
-            out += [(f"{s.name}.{var.name}", var) for var in points.COUPLER_OUTPUTS]
-        out += [(f"{s.name}.{p}.{var.name}", var) for p in s.points
-                for var in points.POINT_OUTPUTS]
+            columns += [(f"{s.name}.{var.name}", var) for var in coupler]
+        columns += [(f"{s.name}.{p}.{var.name}", var) for p in s.points for var in point]
+        out.append(columns)
     return out
 
 
