@@ -33,6 +33,10 @@ PER_SOLID = 3
 ANGLES = slice(2, None, PER_SOLID)
 
 
+#: d(x, y)/d(x, y) of a point of a solid
+_IDENTITY = np.eye(2)
+
+
 def pose(solid: int) -> slice:
     """q[pose(i)] = (x, y, fi) of solid i."""
     return slice(PER_SOLID * solid, PER_SOLID * solid + PER_SOLID)
@@ -226,6 +230,15 @@ class PointSet:
     translate: np.ndarray       # (K,) bool: a point (True) or a direction
     keys: list                  # the State's keys of them
 
+    def __post_init__(self):
+        #: the columns of q of each one's solid: fi (K,) and x, y (K, 2)
+        self.angles = PER_SOLID * self.solids + 2
+        self.origins = PER_SOLID * self.solids[:, None] + np.arange(2)
+        #: dv/d(x, y) of each (K, 2, 3): the identity for a point, zero for a direction
+        self.frame = np.zeros((len(self.solids), 2, 3))
+        self.frame[self.translate, 0, 0] = self.frame[self.translate, 1, 1] = 1.0
+        self.points_only = bool(self.translate.all())
+
     @classmethod
     def of(cls, asked: list[tuple]) -> "PointSet":
         locals_ = [as_array(a[1]) for a in asked]      # complex at p + ih (complex step)
@@ -302,9 +315,8 @@ class State:
         jac = {}
         turned = None
         if self.jacobians:
-            block = jac[solid] = np.zeros((self.n, 2, 3), dtype=As.dtype)
-            if translate:
-                block[:, 0, 0] = block[:, 1, 1] = 1.0
+            block = jac[solid] = np.empty((self.n, 2, 3), dtype=As.dtype)
+            block[:, :, :2] = _IDENTITY if translate else 0.0
             turned = block[:, :, 2]
             np.negative(As[:, 1], out=turned[:, 0])          # perp(As), written in place
             turned[:, 1] = As[:, 0]
@@ -335,20 +347,22 @@ class State:
         velocities: otherwise they are left to those)."""
         if self.qd is not None or np.iscomplexobj(self.q):
             return
-        solids, local, translate = points.solids, points.local, points.translate
-        fi = self.q[:, PER_SOLID * solids + 2]                        # (n, K)
+        local, translate, K = points.local, points.translate, len(points.solids)
+        fi = self.q[:, points.angles]                                 # (n, K)
         c, s = np.cos(fi), np.sin(fi)
-        As = np.stack([c * local[:, 0] - s * local[:, 1], s * local[:, 0] + c * local[:, 1]],
-                      axis=-1)                                        # (n, K, 2)
-        origin = np.stack([self.q[:, PER_SOLID * solids], self.q[:, PER_SOLID * solids + 1]],
-                          axis=-1)
-        value = np.where(translate[None, :, None], As + origin, As)
-        jac = np.zeros((self.n, len(solids), 2, 3))
-        jac[:, translate, 0, 0] = jac[:, translate, 1, 1] = 1.0
+        x = c * local[:, 0]
+        As = np.empty(x.shape + (2,), x.dtype)                        # (n, K, 2)
+        np.subtract(x, s * local[:, 1], out=As[..., 0])
+        np.add(s * local[:, 0], c * local[:, 1], out=As[..., 1])
+        origin = self.q[:, points.origins]                            # (n, K, 2)
+        value = (As + origin if points.points_only
+                 else np.where(translate[None, :, None], As + origin, As))
+        jac = np.empty((self.n, K, 2, 3))
+        jac[...] = points.frame
         jac[..., 2] = perp(As)
         hess = None
         if self.hessians:                      # ∂²(A s)/∂fi² = −A s, the rest 0
-            hess = np.zeros((self.n, len(solids), 2, 3, 3))
+            hess = np.zeros((self.n, K, 2, 3, 3))
             hess[..., 2, 2] = -As
         for k, key in enumerate(points.keys):
             solid = key[0]
