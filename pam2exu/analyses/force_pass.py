@@ -171,10 +171,11 @@ def checked_reactions(mech, wrenches: np.ndarray) -> dict[str, np.ndarray]:
         return out
     largest = np.max(np.abs(wrenches), axis=0, initial=0.0)         # (constraints, 3)
     scales = (np.maximum(largest[:, 0], largest[:, 1]) + largest[:, 2] / length).tolist()
+    columns = np.ascontiguousarray(np.moveaxis(wrenches, 0, -1))    # (constraints, 3, n)
     for e, (el, top, scale) in enumerate(zip(mech.constraints, largest.tolist(), scales)):
         for k, name in enumerate(el.wrench):
             if name is not None:
-                out[f"{el.name}.{name}"] = wrenches[:, e, k]
+                out[f"{el.name}.{name}"] = columns[e, k]
                 continue
             size = top[k] / (length if k == 2 else 1.0)
             if size > ZERO_COMPONENT_TOLERANCE * scale + 1e-300:
