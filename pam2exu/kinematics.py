@@ -236,7 +236,7 @@ class PointSet:
         self.origins = PER_SOLID * self.solids[:, None] + np.arange(2)
         #: dv/d(x, y) of each (K, 2, 3): the identity for a point, zero for a direction
         self.frame = np.zeros((len(self.solids), 2, 3))
-        self.frame[self.translate, 0, 0] = self.frame[self.translate, 1, 1] = 1.0
+        self.frame[:, 0, 0] = self.frame[:, 1, 1] = self.translate
         self.points_only = bool(self.translate.all())
 
     @classmethod
