@@ -311,7 +311,11 @@ class State:
 
     def _build_rotated(self, solid: int, local: np.ndarray, translate: bool) -> Quantity:
         x = PER_SOLID * solid
-        As = _rotate(*self.trig(solid), local)
+        c, s = self.trig(solid)
+        if (self.n == 1 and self.qd is None and not self.hessians and c.dtype == np.float64
+                and local.dtype == np.float64):
+            return self._one_rotated(x, c.item(), s.item(), local, translate)
+        As = _rotate(c, s, local)
         jac = {}
         turned = None
         if self.jacobians:
@@ -333,6 +337,20 @@ class State:
             hess = {(solid, solid): np.zeros((self.n, 2, 3, 3), dtype=As.dtype)}
             hess[solid, solid][:, :, 2, 2] = -As
         return Quantity(value, jac, rate, conv, hess)
+
+    def _one_rotated(self, x: int, c: float, s: float, local: np.ndarray,
+                     translate: bool) -> Quantity:
+        """``_build_rotated`` at one real state without velocities: the same products and
+        sums in floats, each array made at once (a rank test's point)."""
+        vx, vy = local.tolist()
+        ax, ay = c * vx - s * vy, s * vx + c * vy
+        value = ([[ax + self.q[0, x].item(), ay + self.q[0, x + 1].item()]] if translate
+                 else [[ax, ay]])
+        jac = {}
+        if self.jacobians:
+            e = 1.0 if translate else 0.0
+            jac[x // PER_SOLID] = np.array([[[e, 0.0, -ay], [0.0, e, ax]]])
+        return Quantity(np.array(value), jac)
 
     def values_only(self) -> "State":
         """The same states for values alone: the points and directions built from it carry
