@@ -53,17 +53,20 @@ class Job:
                                                     for o in registry.OPTIONS.values()})
 
 
-def available_columns(mech, kind: registry.AnalysisType) -> dict[str, Var]:
-    """Every column the analysis ``kind`` can produce, in order: solids, then elements."""
-    out, derived = {}, {}
-    for c, var in derived_columns(mech) if kind.element_outputs else ():
+def available_columns(mech, kind: registry.AnalysisType,
+                      derived: bool = True) -> dict[str, Var]:
+    """Every column the analysis ``kind`` can produce, in order: solids, then elements;
+    without ``derived``, not the opt-in columns of ``derived_columns`` (the default outputs
+    leave them out)."""
+    out, derived_of = {}, {}
+    for c, var in derived_columns(mech) if kind.element_outputs and derived else ():
         if var.level in kind.levels:             # opt-in: points, centres, couplers
-            derived.setdefault(c.partition(".")[0], []).append((c, var))
+            derived_of.setdefault(c.partition(".")[0], []).append((c, var))
     for s in mech.solids:
         for var in SOLID_OUTPUTS:
             if var.level in kind.levels:
                 out[f"{s.name}.{var.name}"] = var
-        out.update(derived.get(s.name, ()))
+        out.update(derived_of.get(s.name, ()))
     for el in mech.elements if kind.element_outputs else ():
         for var in el.outputs:
             if var.level in kind.levels:
@@ -122,7 +125,8 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
         too_fast = pace_problems(mech.variations, settings.t_end, settings.steps)
         if too_fast:
             raise ModelError([Problem(*p) for p in too_fast], model.source)
-    available = available_columns(mech, kind)
+    # the default outputs leave the derived columns out: they are not made then
+    available = available_columns(mech, kind, derived=settings.outputs is not None)
     try:
         if settings.outputs is None:             # the default: every column not opt-in
             columns = [c for c in available if not points.is_opt_in(c)]

@@ -184,6 +184,8 @@ def require_defined(mech, t: float, q: np.ndarray, eq=None) -> None:
     equations there when already evaluated (``at_guess``)."""
     if eq is None:
         eq = at_guess(mech, t, q)
+    if np.isfinite(eq.residual).all() and np.isfinite(eq.jacobian).all():
+        return                                   # (the elements' rows one by one: not)
     bad = [el for el, rows in zip(mech.constraints, mech.rows)
            if not (np.isfinite(eq.residual[0, rows]).all()
                    and np.isfinite(eq.jacobian[0, rows]).all())]
