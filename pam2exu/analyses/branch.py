@@ -104,7 +104,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
         qd, qdd, residual, *kept = rates(job, tk, qk, redundant, own, with_jacobian=keep)
         jacobian = kept[0] if kept else None
         check_residual(mech, tk, qk, job, residual)
-        singular = ~(np.isfinite(qd).all(axis=1) & np.isfinite(qdd).all(axis=1))
+        singular = ~continuity.finite_rows(qd, qdd)
         unwrapped = _unwrap(mech, tk, q, qd, solved)
         if unwrapped is not q:       # whole turns taken out: Cq at qk is not Cq at q
             q, jacobian = unwrapped, None
