@@ -59,3 +59,61 @@ def test_steps_ruled_out_by_a_probed_neighbour_are_below_the_largest(steps, peak
     if steps > 5:
         assert sum(sizes) < steps
     assert k in rank._candidates(rank._equilibrated(A))
+
+
+def test_the_continuity_defect_is_the_plain_expressions_bits():
+    """``continuity_defect`` (buffers reused over its blocks, the rows' largest column by
+    column) gives max |q̇_k − q̇_j − dt (q̈_k + q̈_j)/2| / scale bit for bit, over a block
+    boundary, with NaN and infinite rates and a breakpoint; ``finite_rows`` and
+    ``branch._scales`` are the plain expressions' too."""
+    from pam2exu.analyses import branch, continuity
+    rng = np.random.default_rng(5)
+    n = continuity.RESIDUAL_CHUNK + 300
+    t = np.cumsum(rng.random(n))
+    qd, qdd = rng.standard_normal((2, n, 12))
+    qd[17, 4], qdd[8200, 0], qd[40, 2] = np.nan, np.inf, -np.inf
+    scale = rng.random(12) + 0.1
+    dt = np.diff(t)[:, None]
+    with np.errstate(invalid="ignore"):
+        plain = np.max(np.abs(qd[1:] - qd[:-1] - dt * (qdd[1:] + qdd[:-1]) / 2) / scale, axis=1)
+    plain = np.r_[0.0, np.where(np.isnan(plain), np.inf, plain)]
+    plain[1:][(t[:-1] < t[500] - 1e-9) & (t[500] - 1e-9 <= t[1:])] = 0.0
+    with np.errstate(invalid="ignore"):
+        found = continuity.continuity_defect(t, qd, qdd, scale, [t[500] - 1e-9])
+    assert found.tobytes() == plain.tobytes()
+    rows = np.isfinite(qd).all(axis=1) & np.isfinite(qdd).all(axis=1)
+    assert (continuity.finite_rows(qd, qdd) == rows).all()
+    assert continuity.finite_rows(qd[:10], qdd[:10]).all()
+
+    class Mech:
+        solids = [None] * 4
+
+        @staticmethod
+        def scale():
+            return 0.35
+
+    weights = np.tile([1.0, 1.0, 0.35], 4)
+    speed = np.max(np.abs(np.where(np.isfinite(qd), qd, 0.0) * weights), initial=0.0)
+    assert branch._scales(Mech, qd).tobytes() == (speed / weights).tobytes()
+    assert branch._scales(Mech, qd[50:60]).tobytes() == \
+        (np.max(np.abs(qd[50:60] * weights)) / weights).tobytes()
+
+
+def test_the_default_outputs_do_not_make_the_derived_columns(monkeypatch):
+    """A run with the default outputs (which leave the points, centres and transmission
+    angles out) does not list those columns at all; its columns are those of the full list
+    without the opt-in ones, and asking for one still makes them."""
+    from pam2exu.analyses import job as job_module
+    from pam2exu import load
+    from pathlib import Path
+    model = load(Path(__file__).resolve().parents[2] / "examples" / "four_bar.toml")
+    made, derived = [], job_module.derived_columns
+    monkeypatch.setattr(job_module, "derived_columns", lambda m: made.append(1) or derived(m))
+    job = job_module.prepare(model, "kinetostatic", steps=10)
+    assert made == []
+    every = job_module.available_columns(job.mech, job.analysis_type)
+    from pam2exu.points import is_opt_in
+    assert job.columns == [c for c in every if not is_opt_in(c)]
+    made.clear()
+    asked = job_module.prepare(model, "kinetostatic", steps=10, outputs=["coupler.P.x"])
+    assert made == [1] and asked.columns == ["coupler.P.x"]
