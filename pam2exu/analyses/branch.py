@@ -53,11 +53,16 @@ SINGULAR = 1e4
 
 
 def _scales(mech, qd) -> np.ndarray:
-    """Per-coordinate scale of the velocities: the largest speed, angles × the length scale."""
-    finite = np.where(np.isfinite(qd), qd, 0.0)
+    """Per-coordinate scale of the velocities: the largest speed, angles × the length scale
+    (of the finite velocities)."""
     L = mech.scale()
     weights = np.tile([1.0, 1.0, L], len(mech.solids))
-    speed = max(float(np.max(np.abs(finite * weights), initial=0.0)), 1e-12 * L)
+    # max_k |q̇_k w| = w max_k |q̇_k| for w > 0 (rounding is monotone): each column's
+    # largest first, one pass over the run when every velocity is finite
+    largest = np.max(np.abs(qd), axis=0, initial=0.0)
+    if not np.isfinite(largest).all():
+        largest = np.max(np.abs(qd), axis=0, initial=0.0, where=np.isfinite(qd))
+    speed = max(float(np.max(largest * weights, initial=0.0)), 1e-12 * L)
     return speed / weights
 
 
@@ -99,7 +104,7 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
         qd, qdd, residual, *kept = rates(job, tk, qk, redundant, own, with_jacobian=keep)
         jacobian = kept[0] if kept else None
         check_residual(mech, tk, qk, job, residual)
-        singular = ~(np.isfinite(qd).all(axis=1) & np.isfinite(qdd).all(axis=1))
+        singular = ~continuity.finite_rows(qd, qdd)
         unwrapped = _unwrap(mech, tk, q, qd, solved)
         if unwrapped is not q:       # whole turns taken out: Cq at qk is not Cq at q
             q, jacobian = unwrapped, None
@@ -313,11 +318,15 @@ def _warn_ill_conditioned(job: Job, q, singular, near=(), jacobian=None) -> None
     if mech.n_equations == 0:
         return
     samples = condition_samples(mech)
-    steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), samples)).astype(int),
-                            np.asarray(near, dtype=int)[:samples]])
-    steps = steps[~singular[steps]]
-    i, worst = rank.largest_condition(mech, t[steps], q[steps],
-                                      None if jacobian is None else jacobian[steps])
+    if len(t) <= samples and not singular.any():     # every step: no copies of them
+        i, worst = rank.largest_condition(mech, t, q, jacobian)
+        steps = np.arange(len(t))
+    else:
+        steps = np.unique(np.r_[np.linspace(0, len(t) - 1, min(len(t), samples)).astype(int),
+                                np.asarray(near, dtype=int)[:samples]])
+        steps = steps[~singular[steps]]
+        i, worst = rank.largest_condition(mech, t[steps], q[steps],
+                                          None if jacobian is None else jacobian[steps])
     job.info["max_condition_number"] = worst
     # well-conditioned large mechanisms (long chains) still have condition numbers that
     # grow with their size: the threshold grows as √(coordinates / 12)

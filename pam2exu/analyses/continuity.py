@@ -17,7 +17,7 @@ def turns_jumped(t, q, qd, solids: int) -> np.ndarray:
     position can land on the same configuration with an angle off by whole turns.
     """
     fi, w = q[:, ANGLES][:, :solids], qd[:, ANGLES][:, :solids]
-    valid = np.isfinite(w).all(axis=1)
+    valid = finite_rows(w)
     valid[0] = True
     if valid.all():                  # j = k − 1 at every step: slices, not gathers
         j, k = slice(None, -1), slice(1, None)
@@ -73,13 +73,46 @@ def continuity_defect(t, qd, qdd, scale, breakpoints=()) -> np.ndarray:
     """
     dt = np.diff(t)[:, None]
     d = np.zeros(len(t))
-    for a in range(1, len(t), RESIDUAL_CHUNK):      # in blocks that stay in the cache
+    # in blocks that stay in the cache, the same operations into two buffers (no new
+    # arrays per block: a block's temporaries cost more than their arithmetic)
+    size = max(1, min(len(t) - 1, RESIDUAL_CHUNK))
+    jump, mean = np.empty((size, qd.shape[1])), np.empty((size, qd.shape[1]))
+    for a in range(1, len(t), RESIDUAL_CHUNK):
         k = slice(a, min(len(t), a + RESIDUAL_CHUNK))
         j = slice(a - 1, k.stop - 1)
-        jump = qd[k] - qd[j] - dt[j] * (qdd[k] + qdd[j]) / 2
+        J, M = jump[:k.stop - a], mean[:k.stop - a]
+        # qd_k − qd_j − dt (qdd_k + qdd_j) / 2, in that order
+        np.subtract(qd[k], qd[j], out=J)
+        np.add(qdd[k], qdd[j], out=M)
+        np.multiply(dt[j], M, out=M)
+        np.divide(M, 2, out=M)
+        np.subtract(J, M, out=J)
         with np.errstate(invalid="ignore"):
-            d[k] = np.max(np.abs(jump) / scale, axis=1)
+            np.divide(np.abs(J, out=J), scale, out=J)
+            d[k] = row_max(J)
     d[np.isnan(d)] = np.inf
     for b in breakpoints:
         d[1:][(t[:-1] < b) & (b <= t[1:])] = 0.0
     return d
+
+
+def finite_rows(*arrays) -> np.ndarray:
+    """Per row (step), whether every value of every array there is finite (the whole arrays
+    checked first: one pass each when they are, the usual case)."""
+    if all(np.isfinite(a).all() for a in arrays):
+        return np.ones(len(arrays[0]), dtype=bool)
+    out = np.isfinite(arrays[0]).all(axis=1)
+    for a in arrays[1:]:
+        out &= np.isfinite(a).all(axis=1)
+    return out
+
+
+def row_max(X: np.ndarray) -> np.ndarray:
+    """np.max(X, axis=1), NaN where a row has one: column by column when there are few (a
+    maximum is exact in any order; numpy's reduction over short rows is slow)."""
+    if X.shape[1] == 0 or X.shape[1] > 32:
+        return np.max(X, axis=1)
+    out = X[:, 0].copy()
+    for c in range(1, X.shape[1]):
+        np.maximum(out, X[:, c], out=out)
+    return out

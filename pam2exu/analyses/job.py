@@ -53,16 +53,19 @@ class Job:
                                                     for o in registry.OPTIONS.values()})
 
 
-def available_columns(mech, kind: registry.AnalysisType) -> dict[str, Var]:
-    """Every column the analysis ``kind`` can produce, in order: solids, then elements."""
+def available_columns(mech, kind: registry.AnalysisType,
+                      derived: bool = True) -> dict[str, Var]:
+    """Every column the analysis ``kind`` can produce, in order: solids, then elements;
+    without ``derived``, not the opt-in columns of ``derived_columns`` (the default outputs
+    leave them out)."""
     out, levels = {}, kind.levels
     own = [var for var in SOLID_OUTPUTS if var.level in levels]
-    derived = _derived(mech, levels) if kind.element_outputs else None
+    extra = _derived(mech, levels) if kind.element_outputs and derived else None
     for i, s in enumerate(mech.solids):
         for var in own:
             out[f"{s.name}.{var.name}"] = var
-        if derived:                              # opt-in: points, centres, couplers
-            out.update(derived[i])
+        if extra:                                # opt-in: points, centres, couplers
+            out.update(extra[i])
     for el in mech.elements if kind.element_outputs else ():
         for var in el.outputs:
             if var.level in levels:
@@ -131,7 +134,8 @@ def prepare(model, analysis=None, t_end=None, steps=None, outputs=None, solver=N
         too_fast = pace_problems(mech.variations, settings.t_end, settings.steps)
         if too_fast:
             raise ModelError([Problem(*p) for p in too_fast], model.source)
-    available = available_columns(mech, kind)
+    # the default outputs leave the derived columns out: they are not made then
+    available = available_columns(mech, kind, derived=settings.outputs is not None)
     try:
         if settings.outputs is None:             # the default: every column not opt-in
             columns = [c for c in available if not points.is_opt_in(c)]

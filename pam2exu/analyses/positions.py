@@ -140,9 +140,7 @@ def velocities(job: Job, q: np.ndarray, redundant: bool):
     job.stage = "computing velocities and accelerations"
     qd, qdd, residual = rates(job, t, q, redundant, accelerations=accelerations)
     check_residual(mech, t, q, job, residual)
-    bad = ~np.isfinite(qd).all(axis=1)
-    if qdd is not None:
-        bad |= ~np.isfinite(qdd).all(axis=1)
+    bad = ~continuity.finite_rows(qd, *(() if qdd is None else (qdd,)))
     if bad.any():
         raise singular_error(job, min(int(np.argmax(bad)), rank.first_singular(mech, t, q)))
     return qd, qdd

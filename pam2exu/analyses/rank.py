@@ -51,35 +51,84 @@ def largest_condition(mech, t, q, jacobian: np.ndarray | None = None) -> tuple[i
 GRAM_ERROR, SVD_ERROR = 1e-10, 1e-8
 #: ``_candidates`` bounds condition numbers up to about this; beyond, every step's SVD
 BOUNDED = 1e3
+#: ``_candidates`` takes the eigenvalues of every PROBE-th step (and the last) first
+PROBE = 4
 
 
 def _candidates(A: np.ndarray) -> np.ndarray | None:
     """The steps whose κ(A) can be the largest (None: every step), from the eigenvalues λ
     of A Aᵀ or Aᵀ A (the smaller: λ = σ², λ_min = σ_r²) within ±GRAM_ERROR ‖A‖_F²; a step
-    whose κ may exceed about BOUNDED is one of them (its bounds are not tight)."""
+    whose κ may exceed about BOUNDED is one of them (its bounds are not tight).
+
+    The eigenvalues are taken at every PROBE-th step first; a step between them whose κ
+    is below their largest lower bound for certain, from its nearest probed step's σ and
+    Weyl's |σ_i(A_k) − σ_i(A_j)| ≤ ‖A_k − A_j‖_F (``_ruled_out``), needs none."""
     n, m, nq = A.shape
     if n == 0 or np.iscomplexobj(A) or not np.isfinite(A).all():
         return None
-    lam = np.linalg.eigvalsh(A @ A.transpose(0, 2, 1) if m < nq else A.transpose(0, 2, 1) @ A)
+    G = A @ A.transpose(0, 2, 1) if m < nq else A.transpose(0, 2, 1) @ A
     size = np.einsum("nij,nij->n", A, A)             # ‖A‖_F² ≥ λ_max
-    error = GRAM_ERROR * size
-    low, high = lam[:, 0], lam[:, -1]
-    bounded = low > size / BOUNDED ** 2                # then low − error > 0
+    error, low, high = GRAM_ERROR * size, np.zeros(n), np.zeros(n)
+    known = np.zeros(n, dtype=bool)
+    known[::PROBE] = known[-1] = True
+    bounded = _bound(G, known, low, high, size)
+    rest = ~known
+    if rest.any() and bounded[known].all():
+        rest[rest] = ~_ruled_out(A, known, rest, low, high, error)
+    if rest.any():
+        bounded = _bound(G, rest, low, high, size)
+        known |= rest
     if not bounded.any():
         return None
     with np.errstate(divide="ignore", invalid="ignore"):     # (steps not bounded)
         upper = np.sqrt((high + error) / (low - error))
         lower = np.sqrt(np.maximum(high - error, 0.0) / (low + error))
     reach = np.max(lower[bounded]) * (1 - SVD_ERROR)
-    return np.nonzero(~bounded | (upper * (1 + SVD_ERROR) >= reach))[0]
+    return np.nonzero(known & (~bounded | (upper * (1 + SVD_ERROR) >= reach)))[0]
+
+
+def _bound(G, steps, low, high, size) -> np.ndarray:
+    """λ_min, λ_max of the Gram matrices G at ``steps`` (a mask) into ``low``, ``high``;
+    the steps whose bounds are tight: λ_min > ‖A‖_F² / BOUNDED² (then λ_min − error > 0)."""
+    lam = np.linalg.eigvalsh(G[steps])
+    low[steps], high[steps] = lam[:, 0], lam[:, -1]
+    return low > size / BOUNDED ** 2
+
+
+def _ruled_out(A, known, rest, low, high, error) -> np.ndarray:
+    """Of the steps ``rest`` (a mask), those whose κ is below the largest lower bound of
+    the ``known`` steps' for certain: σ_1(A_k) ≤ σ_1(A_j) + d, σ_r(A_k) ≥ σ_r(A_j) − d
+    (Weyl) for d ≥ ‖A_k − A_j‖_2, j a probed step next to k (its bounds all tight); d is
+    the sum of the steps' ‖A_{i+1} − A_i‖_F from j to k (one difference of the stack)."""
+    steps = np.flatnonzero(rest)
+    j = np.minimum((steps + PROBE // 2) // PROBE * PROBE, len(A) - 1)
+    D = np.diff(A, axis=0)
+    walked = np.zeros(len(A))
+    np.cumsum(np.sqrt(np.einsum("nij,nij->n", D, D)), out=walked[1:])
+    # (the sums' round-off: below 1e-12 of the whole walk)
+    d = np.abs(walked[steps] - walked[j]) * (1 + SVD_ERROR) + 1e-12 * walked[-1]
+    smallest, largest = np.sqrt(low[j] - error[j]) - d, np.sqrt(high[j] + error[j]) + d
+    lower = np.sqrt(np.maximum(high[known] - error[known], 0.0) / (low[known] + error[known]))
+    return largest * (1 + 2 * SVD_ERROR) < np.max(lower) * (1 - SVD_ERROR) * smallest
 
 
 def _equilibrated(J: np.ndarray) -> np.ndarray:
     """J with its rows and columns scaled to unit length, three passes (a copy)."""
-    for _ in range(3):
-        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
-        J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
-    return J
+    if np.iscomplexobj(J):
+        for _ in range(3):
+            J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+            J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
+        return J
+    # the same operations as np.linalg.norm's (√ of the sums of squares, in its order), in
+    # place: a third fewer passes over the arrays
+    squares, A = J * J, None
+    for axis in (2, 1, 2, 1, 2, 1):
+        if A is not None:
+            np.multiply(A, A, out=squares)
+        norm = np.sqrt(np.add.reduce(squares, axis=axis, keepdims=True))
+        np.maximum(norm, 1e-300, out=norm)
+        A = J / norm if A is None else np.divide(A, norm, out=A)
+    return A
 
 
 def _kappa(A: np.ndarray, rank: int) -> np.ndarray:
@@ -135,6 +184,8 @@ def require_defined(mech, t: float, q: np.ndarray, eq=None) -> None:
     equations there when already evaluated (``at_guess``)."""
     if eq is None:
         eq = at_guess(mech, t, q)
+    if np.isfinite(eq.residual).all() and np.isfinite(eq.jacobian).all():
+        return                                   # (the elements' rows one by one: not)
     bad = [el for el, rows in zip(mech.constraints, mech.rows)
            if not (np.isfinite(eq.residual[0, rows]).all()
                    and np.isfinite(eq.jacobian[0, rows]).all())]

@@ -149,10 +149,12 @@ class Natural(Backend):
         fi, with ``rates`` their rates from ż, z̈, with ``forces`` the multipliers."""
         n, solved = len(times), len(z)
         q = np.full((n, mech.nq), np.nan)
-        q[:solved] = self.to_q(form, mech, z, start)
+        with_rates = rates and solved
+        converted = self._converted(form, mech, z, start, zd if with_rates else None, zdd)
+        q[:solved] = converted[0]
         found = Positions(q, solved, error, q[solved - 1], iterations=iterations)
-        if rates and solved:
-            qd, qdd = self.to_rates(form, mech, z, zd, zdd)
+        if with_rates:
+            qd, qdd = converted[1:]
             if solved < n:                     # NaN after the last solved step, as q
                 qd, qdd = (np.r_[x, np.full((n - solved, mech.nq), np.nan)] for x in (qd, qdd))
             found.qd, found.qdd = qd, qdd
@@ -249,33 +251,76 @@ class Natural(Backend):
         """x, y, fi (n, nq) of configurations z; fi continuous over the steps, its first
         value in the whole turn nearest ``start`` (in chunks of steps: bounded memory; one
         row per quantity inside, the step axis last)."""
+        return self._converted(form, mech, z, start)[0]
+
+    def to_rates(self, form: Formulation, mech, z, zd, zdd):
+        """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
+        (in chunks of steps: bounded memory; one row per quantity inside)."""
+        return self._converted(form, mech, z, None, zd, zdd)[1:]
+
+    def _converted(self, form: Formulation, mech, z, start=None, zd=None, zdd=None):
+        """(q, q̇, q̈) of ``to_q`` (None without ``start``) and ``to_rates`` (None without
+        ``zd``) from one product K [z; 1] per chunk (the pose x, y, cos, sin of each solid)."""
         # K sparse: K @ z sums the same terms in the same order whatever the number of
         # columns (a dense product's order depends on it: chunked runs would differ)
         K = _kept(form, "pose_sum", lambda: csr(form.pose_forms()))
         kind = self._angle_kinds(form)
-        qT = np.empty((mech.nq, len(z)))             # one row per x, y, fi
-        free, c = kind.free, kind.coordinate
-        raw = np.empty((free.size, len(z)))
-        for s in _chunks(len(z)):
+        n = len(z)
+        qT = None if start is None else np.empty((mech.nq, n))    # one row per x, y, fi
+        rates = None if zd is None else (np.empty((mech.nq, n)), np.empty((mech.nq, n)))
+        raw = np.empty((kind.free.size, n))
+        for s in _chunks(n):
             zT = z[s].T
             pose = K @ _ext(zT)                             # x, y, cos, sin per solid
-            qT[0::PER_SOLID, s], qT[1::PER_SOLID, s] = pose[0::4], pose[1::4]
-            fi = qT[2::PER_SOLID, s]
-            fi[kind.fixed] = kind.fixed_values[:, None]
-            # fi is the angle coordinate where the solid's vector points that way (to
-            # round-off), else the vector's direction: the tie v × e(fi) = 0 also holds π
-            # away, and the residual check then sees the actuator violated instead
-            theta = zT[kind.columns]
-            gap = np.arctan2(pose[4 * c + 3], pose[4 * c + 2]) - theta
-            gap -= 2 * np.pi * np.rint(gap / (2 * np.pi))
-            fi[c] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
-            raw[:, s] = np.arctan2(pose[4 * free + 3], pose[4 * free + 2])
-        if free.size:
-            if len(z) > 1:                               # (one step: nothing to unwrap)
+            if qT is not None:
+                raw[:, s] = self._chunk_q(kind, zT, pose, qT[:, s])
+            if rates is not None:
+                self._chunk_rates(kind, K, pose, zd[s].T, zdd[s].T, rates[0][:, s],
+                                  rates[1][:, s])
+        if qT is not None and kind.free.size:
+            if n > 1:                                    # (one step: nothing to unwrap)
                 raw = np.unwrap(raw, axis=1)
-            raw += 2 * np.pi * np.rint((start[ANGLES][free] - raw[:, 0]) / (2 * np.pi))[:, None]
-            qT[column(free, 2)] = raw
-        return qT.T
+            raw += 2 * np.pi * np.rint((start[kind.free_fi] - raw[:, 0]) / (2 * np.pi))[:, None]
+            qT[kind.free_fi] = raw
+        return (None if qT is None else qT.T,
+                *((None, None) if rates is None else (rates[0].T, rates[1].T)))
+
+    @staticmethod
+    def _chunk_q(kind, zT, pose, qT) -> np.ndarray:
+        """x, y, fi of a chunk into qT (a view), but the free solids' fi: their atan2 (the
+        unwrapping is over the whole run), returned."""
+        qT[0::PER_SOLID], qT[1::PER_SOLID] = pose[0::4], pose[1::4]
+        fi = qT[2::PER_SOLID]
+        fi[kind.fixed] = kind.fixed_values[:, None]
+        # fi is the angle coordinate where the solid's vector points that way (to
+        # round-off), else the vector's direction: the tie v × e(fi) = 0 also holds π
+        # away, and the residual check then sees the actuator violated instead
+        angle = np.arctan2(pose[kind.sines], pose[kind.cosines])    # coordinate, then free
+        theta = zT[kind.columns]
+        gap = angle[:kind.coordinate.size] - theta
+        gap -= 2 * np.pi * np.rint(gap / (2 * np.pi))
+        fi[kind.coordinate] = theta + np.where(np.abs(gap) > 1e-6, gap, 0.0)
+        return angle[kind.coordinate.size:]
+
+    @staticmethod
+    def _chunk_rates(kind, K, pose, zdT, zddT, qdT, qddT) -> None:
+        """q̇, q̈ of a chunk into qdT, qddT (views) from its pose and ż, z̈."""
+        f = kind.free
+        # K [ż; 0]: a row's sum ends with + c·0 = ±0, which changes no sum (one matrix
+        # for x, y, cos, sin and their rates)
+        d1, d2 = K @ _ext(zdT, 0.0), K @ _ext(zddT, 0.0)
+        for out, d in ((qdT, d1), (qddT, d2)):
+            out[0::PER_SOLID], out[1::PER_SOLID] = d[0::4], d[1::4]
+        w, a = qdT[2::PER_SOLID], qddT[2::PER_SOLID]
+        w[kind.fixed] = a[kind.fixed] = 0.0
+        w[kind.coordinate], a[kind.coordinate] = zdT[kind.columns], zddT[kind.columns]
+        if f.size:
+            cs, sn = pose[4 * f + 2], pose[4 * f + 3]
+            dc, ds = d1[4 * f + 2], d1[4 * f + 3]
+            ddc, dds = d2[4 * f + 2], d2[4 * f + 3]
+            r2 = cs * cs + sn * sn
+            w[f] = (cs * ds - sn * dc) / r2
+            a[f] = (cs * dds - sn * ddc) / r2 - 2 * (cs * dc + sn * ds) * w[f] / r2
 
     def _angle_kinds(self, form: Formulation):
         """Which solids' fi are constant (ground), an angle coordinate, or atan2 of the vector."""
@@ -287,38 +332,17 @@ class Natural(Backend):
         coordinate = [i for i, f in enumerate(form.frames)
                       if f.fixed_angle is None and f.angle is not None]
         free = [i for i, f in enumerate(form.frames) if f.fixed_angle is None and f.angle is None]
+        both = np.array(coordinate + free, dtype=int)
         return SimpleNamespace(
             fixed=np.array(fixed, dtype=int),
             fixed_values=np.array([form.frames[i].fixed_angle for i in fixed]),
             coordinate=np.array(coordinate, dtype=int),
             columns=np.array([form.frames[i].angle for i in coordinate], dtype=int),
-            free=np.array(free, dtype=int))
-
-    def to_rates(self, form: Formulation, mech, z, zd, zdd):
-        """(q̇, q̈) from (z, ż, z̈): x, y, cos, sin are linear in z; fi = atan2(sin, cos)
-        (in chunks of steps: bounded memory; one row per quantity inside)."""
-        K = _kept(form, "pose_sum", lambda: csr(form.pose_forms()))
-        kind = self._angle_kinds(form)
-        qdT, qddT = np.empty((mech.nq, len(z))), np.empty((mech.nq, len(z)))
-        f, c = kind.free, kind.coordinate
-        for s in _chunks(len(z)):
-            pose = K @ _ext(z[s].T)
-            # K [ż; 0]: a row's sum ends with + c·0 = ±0, which changes no sum (one matrix
-            # for x, y, cos, sin and their rates)
-            d1, d2 = K @ _ext(zd[s].T, 0.0), K @ _ext(zdd[s].T, 0.0)
-            for out, d in ((qdT, d1), (qddT, d2)):
-                out[0::PER_SOLID, s], out[1::PER_SOLID, s] = d[0::4], d[1::4]
-            w, a = qdT[2::PER_SOLID, s], qddT[2::PER_SOLID, s]
-            w[kind.fixed] = a[kind.fixed] = 0.0
-            w[c], a[c] = zd[s].T[kind.columns], zdd[s].T[kind.columns]
-            if f.size:
-                cs, sn = pose[4 * f + 2], pose[4 * f + 3]
-                dc, ds = d1[4 * f + 2], d1[4 * f + 3]
-                ddc, dds = d2[4 * f + 2], d2[4 * f + 3]
-                r2 = cs * cs + sn * sn
-                w[f] = (cs * ds - sn * dc) / r2
-                a[f] = (cs * dds - sn * ddc) / r2 - 2 * (cs * dc + sn * ds) * w[f] / r2
-        return qdT.T, qddT.T
+            free=np.array(free, dtype=int),
+            # rows of the pose: sin and cos of the coordinate solids, then of the free ones
+            sines=4 * both + 3, cosines=4 * both + 2,
+            # the free solids' fi in q
+            free_fi=column(np.array(free, dtype=int), 2))
 
 
 #: steps converted to x, y, fi at a time

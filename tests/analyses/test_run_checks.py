@@ -1,0 +1,119 @@
+"""The checks of every run done with less work (issue 25, the per-run costs), checked by
+comparing bits with the plain computations, never by time: the equilibration of Cq in place,
+the condition check's eigenvalues at the steps that can be the worst only."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pam2exu.analyses import rank
+
+
+def _norm_equilibrated(J):
+    """Rows and columns of J scaled to unit length, three passes, by np.linalg.norm."""
+    for _ in range(3):
+        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+        J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
+    return J
+
+
+@pytest.mark.parametrize("m, nq", [(1, 3), (5, 6), (12, 12), (9, 12), (14, 12), (40, 45)])
+def test_the_equilibration_is_the_norms_bits(m, nq):
+    """``_equilibrated`` (squares summed in place) gives np.linalg.norm's passes bit for bit,
+    zero rows and columns and scales from 1e-6 to 1e6 included, complex too."""
+    rng = np.random.default_rng(m * 100 + nq)
+    J = rng.standard_normal((7, m, nq)) * rng.choice([1e-6, 1.0, 1e6], size=nq)
+    J[2, 0] = 0.0
+    J[3, :, -1] = 0.0
+    assert rank._equilibrated(J).tobytes() == _norm_equilibrated(J).tobytes()
+    Z = J + 1e-20j * rng.standard_normal(J.shape)
+    assert rank._equilibrated(Z).tobytes() == _norm_equilibrated(Z).tobytes()
+
+
+def _smooth(rng, steps, m, nq, peak):
+    """Equilibrated Cq along a smooth closed path whose κ peaks near step ``peak``."""
+    a, b, c = (0.1 * rng.standard_normal((m, nq)) for _ in range(3))
+    s = np.linspace(0.0, 2 * np.pi, steps)[:, None, None]
+    J = np.eye(m, nq) + a + np.cos(s) * b + np.sin(s) * c
+    J[:, :, 0] += 0.5 * np.exp(-((s[:, :, 0] - s[peak, 0, 0]) ** 2)) * J[:, :, 1]
+    return rank._equilibrated(J)
+
+
+@pytest.mark.parametrize("steps, peak", [(101, 50), (101, 3), (102, 101), (5, 2), (400, 217)])
+def test_steps_ruled_out_by_a_probed_neighbour_are_below_the_largest(steps, peak, monkeypatch):
+    """On a smooth motion the Gram eigenvalues are taken at fewer steps than the run's
+    (every PROBE-th step, then those Weyl's bound from a probed neighbour cannot rule out),
+    and the largest condition number and its step are still every step's SVD's."""
+    rng = np.random.default_rng(steps + peak)
+    A = _smooth(rng, steps, 12, 12, peak)
+    sizes, eigvalsh = [], np.linalg.eigvalsh
+    monkeypatch.setattr(np.linalg, "eigvalsh", lambda G: sizes.append(len(G)) or eigvalsh(G))
+
+    class Mech:
+        nq = 12
+
+    every = rank.condition_numbers(Mech, None, None, A)
+    k = int(np.argmax(every))
+    sizes.clear()
+    assert rank.largest_condition(Mech, None, None, A) == (k, float(every[k]))
+    if steps > 5:
+        assert sum(sizes) < steps
+    assert k in rank._candidates(rank._equilibrated(A))
+
+
+def test_the_continuity_defect_is_the_plain_expressions_bits():
+    """``continuity_defect`` (buffers reused over its blocks, the rows' largest column by
+    column) gives max |q̇_k − q̇_j − dt (q̈_k + q̈_j)/2| / scale bit for bit, over a block
+    boundary, with NaN and infinite rates and a breakpoint; ``finite_rows`` and
+    ``branch._scales`` are the plain expressions' too."""
+    from pam2exu.analyses import branch, continuity
+    rng = np.random.default_rng(5)
+    n = continuity.RESIDUAL_CHUNK + 300
+    t = np.cumsum(rng.random(n))
+    qd, qdd = rng.standard_normal((2, n, 12))
+    qd[17, 4], qdd[8200, 0], qd[40, 2] = np.nan, np.inf, -np.inf
+    scale = rng.random(12) + 0.1
+    dt = np.diff(t)[:, None]
+    with np.errstate(invalid="ignore"):
+        plain = np.max(np.abs(qd[1:] - qd[:-1] - dt * (qdd[1:] + qdd[:-1]) / 2) / scale, axis=1)
+    plain = np.r_[0.0, np.where(np.isnan(plain), np.inf, plain)]
+    plain[1:][(t[:-1] < t[500] - 1e-9) & (t[500] - 1e-9 <= t[1:])] = 0.0
+    with np.errstate(invalid="ignore"):
+        found = continuity.continuity_defect(t, qd, qdd, scale, [t[500] - 1e-9])
+    assert found.tobytes() == plain.tobytes()
+    rows = np.isfinite(qd).all(axis=1) & np.isfinite(qdd).all(axis=1)
+    assert (continuity.finite_rows(qd, qdd) == rows).all()
+    assert continuity.finite_rows(qd[:10], qdd[:10]).all()
+
+    class Mech:
+        solids = [None] * 4
+
+        @staticmethod
+        def scale():
+            return 0.35
+
+    weights = np.tile([1.0, 1.0, 0.35], 4)
+    speed = np.max(np.abs(np.where(np.isfinite(qd), qd, 0.0) * weights), initial=0.0)
+    assert branch._scales(Mech, qd).tobytes() == (speed / weights).tobytes()
+    assert branch._scales(Mech, qd[50:60]).tobytes() == \
+        (np.max(np.abs(qd[50:60] * weights)) / weights).tobytes()
+
+
+def test_the_default_outputs_do_not_make_the_derived_columns(monkeypatch):
+    """A run with the default outputs (which leave the points, centres and transmission
+    angles out) does not list those columns at all; its columns are those of the full list
+    without the opt-in ones, and asking for one still makes them."""
+    from pam2exu.analyses import job as job_module
+    from pam2exu import load
+    from pathlib import Path
+    model = load(Path(__file__).resolve().parents[2] / "examples" / "four_bar.toml")
+    made, derived = [], job_module.derived_columns
+    monkeypatch.setattr(job_module, "derived_columns", lambda m: made.append(1) or derived(m))
+    job = job_module.prepare(model, "kinetostatic", steps=10)
+    assert made == []
+    every = job_module.available_columns(job.mech, job.analysis_type)
+    from pam2exu.points import is_opt_in
+    assert job.columns == [c for c in every if not is_opt_in(c)]
+    made.clear()
+    asked = job_module.prepare(model, "kinetostatic", steps=10, outputs=["coupler.P.x"])
+    assert made == [1] and asked.columns == ["coupler.P.x"]
