@@ -22,30 +22,38 @@ def lu_factor(A: np.ndarray, threshold: float = 1.0):
     swaps = np.empty((m, n), dtype=np.intp)
     ok = np.ones(n, dtype=bool)
     for k in range(m):
-        best = np.full(n, k)                          # argmax |A[k:, k]| (np.argmax along
-        largest = np.abs(A[k, k])                     # the first axis is slow)
-        for r in range(k + 1, m):
-            size = np.abs(A[r, k])
-            larger = size > largest
-            best += larger * (r - best)               # (faster than best[larger] = r)
-            np.maximum(largest, size, out=largest)
+        size = np.abs(A[k:, k])                       # (m - k, n)
+        largest = size.max(axis=0)                    # exact: NaN where any is NaN
         swaps[k] = k
-        moved = np.nonzero(np.abs(A[k, k]) < threshold * largest)[0]
+        moved = np.nonzero(size[0] < threshold * largest)[0]
         if moved.size:
-            p = swaps[k][moved] = best[moved]
+            few = 4 * moved.size < n                  # else all columns (no copy)
+            best = _first_largest(size[:, moved] if few else size)
+            p = swaps[k][moved] = k + (best if few else best[moved])
             row = A[k][:, moved]                      # a copy: (m, moved)
             A[k][:, moved] = A[p, :, moved].T
             A[p, :, moved] = row.T
         pivot = A[k, k]
-        bad = ~np.isfinite(pivot) | (pivot == 0.0)
-        if bad.any():
+        if not (np.isfinite(pivot).all() and pivot.all()):
+            bad = ~np.isfinite(pivot) | (pivot == 0.0)
             ok &= ~bad
             pivot = np.where(bad, 1.0, pivot)
         if k + 1 < m:
-            L = A[k + 1:, k] / pivot
-            A[k + 1:, k] = L
+            L = np.divide(A[k + 1:, k], pivot, out=A[k + 1:, k])
             A[k + 1:, k + 1:] -= L[:, None, :] * A[k, k + 1:][None]
     return swaps, ok
+
+
+def _first_largest(size: np.ndarray) -> np.ndarray:
+    """The row of the first largest of each column of size (r, n) (``numpy.argmax`` along
+    the first axis, which is slow): NaN is never larger."""
+    best = np.zeros(size.shape[1], dtype=np.intp)
+    largest = size[0].copy()
+    for r in range(1, len(size)):
+        larger = size[r] > largest
+        best += larger * (r - best)                   # (faster than best[larger] = r)
+        np.maximum(largest, size[r], out=largest)
+    return best
 
 
 def lu_solve(A: np.ndarray, swaps: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -53,16 +61,16 @@ def lu_solve(A: np.ndarray, swaps: np.ndarray, b: np.ndarray) -> np.ndarray:
     m, n = A.shape[0], A.shape[2]
     x = np.array(b, dtype=float)
     extra = (1,) * (x.ndim - 2)
-    for k in range(m):                                # P b
-        moved = np.nonzero(swaps[k] != k)[0]
-        if moved.size:
-            p = swaps[k][moved]
-            row = x[k][..., moved]
-            x[k][..., moved] = x[p, ..., moved].T if x.ndim == 3 else x[p, moved]
-            if x.ndim == 3:
-                x[p, ..., moved] = row.T
-            else:
-                x[p, moved] = row
+    exchanged = swaps != np.arange(m)[:, None]
+    for k in np.nonzero(exchanged.any(axis=1))[0]:    # P b, the steps that exchanged rows
+        moved = np.nonzero(exchanged[k])[0]
+        p = swaps[k][moved]
+        row = x[k][..., moved]
+        x[k][..., moved] = x[p, ..., moved].T if x.ndim == 3 else x[p, moved]
+        if x.ndim == 3:
+            x[p, ..., moved] = row.T
+        else:
+            x[p, moved] = row
     for k in range(m - 1):                            # L y = P b
         x[k + 1:] -= A[k + 1:, k].reshape((m - k - 1,) + extra + (n,)) * x[k][None]
     with np.errstate(divide="ignore", invalid="ignore"):   # singular systems: NaN, inf
