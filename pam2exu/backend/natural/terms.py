@@ -97,11 +97,12 @@ class Terms:
         """The terms' values (k, n) summed per row (``per`` 'row') or per Jacobian entry
         ('entry'): out[index[k]] += values[k], term after term (``numpy.bincount`` for a
         few steps, else the sparse summing matrix of ``_summer``, made on first use)."""
-        index, size = (self.row_index, self.m) if per == "row" else \
-            (self.entry_index, len(self.rows))
+        index, size = {"row": (self.row_index, self.m),
+                       "entry": (self.entry_index, len(self.rows)),
+                       "both": (self._both_index, self.m + len(self.rows))}[per]
         n = values.shape[1]
         if n > BINCOUNT_STEPS:
-            summers = self.__dict__.setdefault("_summers", {})
+            summers = self._summers              # shared by the structure's ``Terms``
             if per not in summers:
                 summers[per] = _summer(index, size)
             return np.asarray(summers[per] @ values)
@@ -275,20 +276,34 @@ class Terms:
         return out
 
     def _residual_jacobian_many(self, t, z, g=None):
-        """``residual_jacobian_cols`` for many steps (each sum by its sparse summing matrix)."""
+        """``residual_jacobian_cols`` for many steps: Φ's and Φ_z's terms written into one
+        array, each product c z_a made once (for Φ and ∂/∂z_b), and summed by one sparse
+        summing matrix of both (``_both_index``: disjoint rows, each the same terms in the
+        same order as its own matrix)."""
         x = self._ext(z)
-        xa, xb = x[self.pa], x[self.pb]
-        arg = x[self.sb] + self._alpha
-        sin, xs = np.sin(arg), x[self.sa]
-        out = self._sum(np.concatenate([self._pc * xa * xb, self._sc * xs * sin]), "row")
+        P, S, n = len(self.pa), len(self.sa), x.shape[1]
+        kb, ka, ks, kc = self._keeps
+        B, A = self._jp_counts
+        values = np.empty((len(self._both_index), n))
+        ca = self._pc * x[self.pa]
+        arg = x[self.sb]
+        arg += self._alpha
+        sin = np.sin(arg)
+        cs = np.multiply(self._sc, x[self.sa], out=values[P:P + S])
+        e = P + S                                  # Φ_z's terms: c z_b, c z_a, c sin, c z_a cos
+        np.multiply(self._jp_c[:B], x[self._jp_i[:B]], out=values[e:e + B])
+        values[e + B:e + B + A] = ca[ka]
+        e += B + A
+        np.multiply(self._js_c, sin[ks], out=values[e:e + len(self._js_c)])
+        e += len(self._js_c)
+        np.multiply(cs[kc], np.cos(arg[kc]), out=values[e:])
+        np.multiply(ca, x[self.pb], out=values[:P])
+        cs *= sin
+        both = self._sum(values, "both")
+        out, data = both[:self.m], both[self.m:]
         if self.laws:
             out[self.law_rows] -= self.targets(t, 0) if g is None else g
-        kb, ka, ks, kc = self._keeps
-        values = np.concatenate([
-            np.concatenate([self._pc * xb, self._pc * xa])[self._jp_keep],
-            self._js_c * sin[ks],
-            self._jc_c * xs[kc] * np.cos(arg[kc])])
-        return out, self._sum(values, "entry")
+        return out, data
 
     def dense_cols(self, data: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
         """Φ_z (m, nz, n) from its data (nnz, n); with ``order`` (m,), its rows in that
@@ -435,5 +450,8 @@ def _make_indices(nz: int, m: int, p: np.ndarray, s: np.ndarray) -> dict:
             "_gather": np.concatenate([pa, pb, sb, sa]),
             "_parts": tuple(slice(a, b) for a, b in zip(edges[:-1], edges[1:])),
             "_both_index": np.concatenate([row_index, m + where]),
-            "_dense_index": dense_index,
+            "_dense_index": dense_index, "_jp_counts": (int(kb.sum()), int(ka.sum())),
+            # the sparse summing matrices (``_sum``), made on first use: one structure's
+            # ``Terms`` share them
+            "_summers": {},
             "_both_dense": np.concatenate([row_index, m + dense_index])}
