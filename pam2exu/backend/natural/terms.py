@@ -326,14 +326,24 @@ class Terms:
 
     def gamma_cols(self, t: np.ndarray, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
         """γ (m, n): Φ_z z̈ = γ = g'' − (d/dt Φ_z) ż."""
-        x, v = self._ext(z), np.zeros((self.nz + 1, z.shape[1]))
+        x, v = self._ext(z), np.empty((self.nz + 1, z.shape[1]))
         v[:self.nz] = zd
-        arg = x[self.sb] + self._alpha
+        v[self.nz] = 0.0                         # ONE's rate
+        arg = x[self.sb]
+        arg += self._alpha
         wb = v[self.sb]
-        values = np.concatenate([
-            2.0 * self._pc * v[self.pa] * v[self.pb],
-            self._sc * wb * (2.0 * v[self.sa] * np.cos(arg) - x[self.sa] * wb * np.sin(arg))])
-        out = -self._sum(values, "row")
+        P = len(self.pa)
+        values = np.empty((P + len(self.sa), z.shape[1]))     # the terms, written in place
+        np.multiply(2.0 * self._pc, v[self.pa], out=values[:P])
+        values[:P] *= v[self.pb]
+        cos = np.cos(arg)
+        cos *= 2.0 * v[self.sa]
+        sin = np.sin(arg)
+        sin *= x[self.sa] * wb
+        np.subtract(cos, sin, out=cos)
+        np.multiply(self._sc * wb, cos, out=values[P:])
+        out = self._sum(values, "row")
+        np.negative(out, out=out)
         if self.laws:
             out[self.law_rows] += self.targets(t, 2)
         return out

@@ -216,12 +216,13 @@ def _fill(stack: Stack, z, zd, zdd, coarse: list[int], alive: np.ndarray, tolera
         block = np.array(inner[lo:lo + per])                      # (a, b, k) per step
         cols = np.tile(alive, len(block))                          # variant of each column
         a, b, k = (np.repeat(block[:, i], alive.size) for i in range(3))
-        h = t[b] - t[a]
-        s = (t[k] - t[a]) / h
-        guess = ((2 * s**3 - 3 * s**2 + 1) * z[a, :, cols].T
-                 + (s**3 - 2 * s**2 + s) * h * zd[a, :, cols].T
-                 + (-2 * s**3 + 3 * s**2) * z[b, :, cols].T
-                 + (s**3 - s**2) * h * zd[b, :, cols].T)
+        h = t[block[:, 1]] - t[block[:, 0]]                        # the Hermite weights
+        s = (t[block[:, 2]] - t[block[:, 0]]) / h                  # per step, then each
+        s2, s3 = s**2, s**3                                        # variant's column
+        weights = np.repeat(np.array([2 * s3 - 3 * s2 + 1, (s3 - 2 * s2 + s) * h,
+                                      -2 * s3 + 3 * s2, (s3 - s2) * h]), alive.size, axis=1)
+        guess = (weights[0] * z[a, :, cols].T + weights[1] * zd[a, :, cols].T
+                 + weights[2] * z[b, :, cols].T + weights[3] * zd[b, :, cols].T)
         found, ok, rates, used = solved_steps(stack, k, cols, guess, tolerance,
                                               max_iterations, far=COARSE_MISS)
         spent += used
