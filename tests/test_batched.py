@@ -56,3 +56,20 @@ def test_singular_and_non_finite_systems_are_flagged_alone():
     assert ok.tolist() == [True, False, False, True]
     x = lu_solve(A, swaps, np.ones((3, 4)))
     np.testing.assert_array_equal(x[:, [0, 3]], 1.0)
+
+
+@pytest.mark.parametrize("exchanging", [3, 40])
+def test_tied_pivots_take_the_first_row_as_getrf(exchanging):
+    """Rows exchanged in a few systems of a batch or in all: each takes the first of its
+    largest |entries| (LAPACK getrf's idamax), the same rows either way (a check of the
+    search's two paths, both already right before they were split)."""
+    from scipy.linalg import lu_factor as getrf
+    rng = np.random.default_rng(3)
+    A = rng.integers(-3, 4, size=(40, 4, 4)).astype(float)   # ties among the integers
+    A[:, 0, 0] = 0.5
+    A[exchanging:, 0, 0] = 9.0                    # these keep their rows at the first step
+    A[:, [1, 3], 0] = -4.0                        # two largest: rows 1 and 3
+    swaps, ok = lu_factor(np.ascontiguousarray(A.transpose(1, 2, 0)), 1.0)
+    for k in range(40):                           # the first step's pivot (exact data)
+        assert swaps[0, k] == getrf(A[k])[1][0]
+    assert (swaps[0, :exchanging] == 1).all() and (swaps[0, exchanging:] == 0).all()
