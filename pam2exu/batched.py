@@ -30,9 +30,17 @@ def lu_factor(A: np.ndarray, threshold: float = 1.0):
             few = 4 * moved.size < n                  # else all columns (no copy)
             best = _first_largest(size[:, moved] if few else size)
             p = swaps[k][moved] = k + (best if few else best[moved])
-            row = A[k][:, moved]                      # a copy: (m, moved)
-            A[k][:, moved] = A[p, :, moved].T
-            A[p, :, moved] = row.T
+            rows = [] if few else np.nonzero(np.bincount(p, minlength=m))[0]
+            if few or len(rows) * n > 2 * moved.size:
+                row = A[k][:, moved]                  # a copy: (m, moved)
+                A[k][:, moved] = A[p, :, moved].T
+                A[p, :, moved] = row.T
+            else:                                     # most systems exchange rows k and r:
+                for r in rows:                        # whole rows (no gathers)
+                    there = swaps[k] == r
+                    row = np.where(there, A[r], A[k])
+                    A[r] = np.where(there, A[k], A[r])
+                    A[k] = row
         pivot = A[k, k]
         if not (np.isfinite(pivot).all() and pivot.all()):
             bad = ~np.isfinite(pivot) | (pivot == 0.0)
