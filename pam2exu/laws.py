@@ -177,6 +177,24 @@ def law_names() -> list[str]:
     return [*LAWS, *LAW_ALIASES]
 
 
+_FLOAT = np.dtype(float)
+
+
+def _own(value, shape: tuple) -> np.ndarray:
+    """A law's f, f' or f'' as an array of its own of the times' shape: a fresh float array
+    of that shape as it is (``* 1.0`` would copy it bit for bit), anything else broadcast
+    and copied: a complex one (``* 1.0`` turns its NaN and signed zeros as before), one
+    time (a NumPy scalar, as before)."""
+    if shape and type(value) is np.ndarray and value.shape == shape and value.dtype == _FLOAT:
+        return value
+    return np.broadcast_to(value, shape) * 1.0
+
+
+def _plain(C) -> bool:
+    """C is already what ``Law`` keeps: a tuple of four Python floats or complex numbers."""
+    return type(C) is tuple and len(C) == 4 and all(type(c) in (float, complex) for c in C)
+
+
 @dataclass(frozen=True)
 class Law:
     """A time law ``name`` with constants ``C = (C1, C2, C3, C4)``.
@@ -224,9 +242,12 @@ class Law:
     C: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        object.__setattr__(self, "name", LAW_ALIASES.get(self.name, self.name))
+        if self.name not in LAWS:
+            object.__setattr__(self, "name", LAW_ALIASES.get(self.name, self.name))
         if self.name not in LAWS:
             raise ValueError(f"unknown law '{self.name}'; known laws: {', '.join(law_names())}")
+        if _plain(self.C):
+            return                                      # four floats (or complex) already
         C = tuple(scalar(c) for c in (self.C if np.ndim(self.C) else [self.C]))
         if len(C) > 4:
             raise ValueError(f"a law has at most four constants C1 … C4, got {len(C)}")
@@ -258,10 +279,8 @@ class Law:
         """
         if xp is np:
             t = np.asarray(t, dtype=float)
-            f, df, ddf = LAWS[self.name].function(t, self.C, xp)
-            shape = np.shape(t)
-            return (np.broadcast_to(f, shape) * 1.0, np.broadcast_to(df, shape) * 1.0,
-                    np.broadcast_to(ddf, shape) * 1.0)
+            shape = t.shape
+            return tuple(_own(v, shape) for v in LAWS[self.name].function(t, self.C, xp))
         return LAWS[self.name].function(t, self.C, xp)
 
     def value(self, t: float) -> float:

@@ -266,6 +266,29 @@ def test_constant_results_broadcast_to_the_time_array(name):
         assert values.shape == (2, 5)
 
 
+@pytest.mark.parametrize("name", list(REFERENCE))
+def test_results_are_arrays_of_their_own(name):
+    """f, f', f'' are three separate writable arrays: writing into one changes neither the
+    times, nor the others, nor a later call; complex constants (a complex step) give the
+    same values as the law's function copied by ``* 1.0``."""
+    law = Law(name, (0.1, 0.9, -1.0, 2.0))
+    t = np.linspace(-0.5, 1.5, 9)
+    kept = t.copy()
+    out = law(t)
+    again = [v.copy() for v in law(t)]
+    assert len({id(v) for v in out}) == 3
+    for v in out:
+        assert v.flags.writeable and not np.shares_memory(v, t)
+        assert not any(np.shares_memory(v, w) for w in out if w is not v)
+        v[:] = 7.0
+    assert np.array_equal(t, kept)
+    assert all(np.array_equal(a, b) for a, b in zip(law(t), again))
+    stepped = Law(name, (0.1, 0.9, complex(-1.0, 1e-20), 2.0))
+    direct = LAWS[name].function(t, stepped.C)
+    for a, b in zip(stepped(t), direct):
+        assert a.dtype == complex and np.array_equal(a, np.broadcast_to(b, t.shape) * 1.0)
+
+
 @pytest.mark.parametrize("name", ALL_NAMES)
 def test_value_returns_python_float(name):
     law = Law(name[0], (0.2, 0.7, 0.45, 1.3))
