@@ -122,6 +122,16 @@ class Param:
         return None
 
 
+_X_AXIS = np.array([1.0, 0.0])
+_X_AXIS.flags.writeable = False
+
+
+def global_x(n: int) -> np.ndarray:
+    """The global x axis (1, 0) for each of n states, (n, 2): a read-only view of one row
+    (what ``np.broadcast_to([1.0, 0.0], (n, 2))`` gives, made without its checks)."""
+    return np.ndarray((n, 2), float, _X_AXIS, 0, (0, _X_AXIS.itemsize))
+
+
 def constants(value, size: int = 4) -> tuple[float, ...]:
     """C as a tuple of floats, missing entries 0."""
     values = list(value) if isinstance(value, (list, tuple, np.ndarray)) else [value]
@@ -360,7 +370,7 @@ class Element:
         is reported (the first docstring line says it in words, for the reference pages).
         """
         s = self.receiver
-        return st.q[:, pose(s)][:, :2], np.broadcast_to([1.0, 0.0], (st.n, 2))
+        return st.q[:, pose(s)][:, :2], global_x(st.n)
 
     def loads(self, st: State, damping: bool) -> Load | None:
         """A force element's action at the states ``st`` (None for constraint elements).

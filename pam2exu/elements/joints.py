@@ -9,7 +9,7 @@ import numpy as np
 
 from ..kinematics import column, stack
 from ..limits import ANGLE
-from .base import CLEARANCE, FORCE, Element, Param, Var, number
+from .base import CLEARANCE, FORCE, Element, Param, Var, global_x, number
 
 #: ``clearance = true``: the joint gets clearance parameters (shared/spec/clearance.md)
 _CLEARANCE = Param("boolean", "true: the joint has clearance parameters, which the clearance "
@@ -102,7 +102,7 @@ class Revolute(Element):
 
     def report_frame(self, st):
         """At the joint, global basis."""
-        return st.point(self.ref2.solid, self.ref2.local).value, super().report_frame(st)[1]
+        return st.point(self.ref2.solid, self.ref2.local).value, global_x(st.n)
 
     def constraint(self, st):
         """r2 − r1 = 0 (Exudyn's ObjectJointRevolute2D: p(marker1) − p(marker0))."""
