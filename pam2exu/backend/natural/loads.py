@@ -18,6 +18,16 @@ import numpy as np
 from ...kinematics import State, column, pose, perp
 
 
+def _lever(frame, local) -> tuple[float, float]:
+    """(a, b) of the point ``local`` of a solid: r = p + a v + b Ω v (``Frame.point``)."""
+    return frame._ab((local[0] - frame.sp[0], local[1] - frame.sp[1]))
+
+
+def _on_v(a: float, b: float, force: np.ndarray) -> np.ndarray:
+    """a F − b Ω F: the share on the base vector v of a force F at p + a v + b Ω v."""
+    return a * force - b * perp(force)
+
+
 class Loads:
     """The generalized forces of gravity and of the force elements at configurations z.
 
@@ -79,11 +89,10 @@ class Loads:
 
     def force(self, solid: int, local, force) -> None:
         """A force (n, 2) at the point ``local`` of the solid: (F, a F − b Ω F) on (p, v)."""
-        f = self.form.frames[solid]
-        a, b = f._ab((local[0] - f.sp[0], local[1] - f.sp[1]))
+        a, b = _lever(self.form.frames[solid], local)
         force = np.asarray(force, dtype=float)
         self.Qp[:, solid] += force
-        self.Qv[:, solid] += a * force - b * perp(force)
+        self.Qv[:, solid] += _on_v(a, b, force)
 
     def moment(self, solid: int, moment) -> None:
         """A moment (n,) on the solid: M Ω v / |v|² on v."""
@@ -94,19 +103,17 @@ class Loads:
     def gravity(self, g: float) -> None:
         """(0, −m g) at every solid's centre of mass: on (p, v) the same (F, a F − b Ω F) at
         every step (``force``'s sums), added for all solids in one operation."""
-        solids, on_p, on_v = [], [], []
+        solids, rows = [], []
         for i, s in enumerate(self.form.mech.solids):
             if float(s.mass) and g:
-                f = self.form.frames[i]
-                a, b = f._ab((float(s.cog[0]) - f.sp[0], float(s.cog[1]) - f.sp[1]))
-                fx, fy = 0.0, -float(s.mass) * g
+                a, b = _lever(self.form.frames[i], (float(s.cog[0]), float(s.cog[1])))
+                weight = np.array([0.0, -float(s.mass) * g])
                 solids.append(i)
-                on_p.append((fx, fy))
-                on_v.append((a * fx - b * -fy, a * fy - b * fx))       # Ω F = (−Fy, Fx)
+                rows.append(np.concatenate([weight, _on_v(a, b, weight)]))   # (p, v)
         if solids:                 # consecutive solids: a slice (no per-element indexing)
             at = slice(solids[0], solids[-1] + 1) if solids[-1] - solids[0] == len(solids) - 1 \
                 else solids
-            self.Q[:, at] += np.array([p + v for p, v in zip(on_p, on_v)])     # (p, v) rows
+            self.Q[:, at] += np.array(rows)
 
     def on_coordinates(self) -> np.ndarray:
         """Q (n, nz) on the natural coordinates: Σ Pᵀ Q_p + Vᵀ Q_v over the solids."""
