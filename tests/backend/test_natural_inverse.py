@@ -260,12 +260,11 @@ def _rigid_rows_made(form):
 
 
 def test_rigid_rows_counted_are_the_rows_made_solid_by_solid():
-    """The reaction plan counts each solid's rigid-body rows (|v|², further basic points, its
-    angle) without making them: the same owners as the rows made solid by solid, on models
-    with a ternary solid, unit vectors, angle coordinates (an actuator, every solid's) and a
-    solid held by two ground pins."""
+    """The owners the formulation records for its rigid-body rows (|v|², further basic
+    points, its angle; what the reaction plan reads) are those of the rows made solid by
+    solid, on models with a ternary solid, unit vectors, angle coordinates (an actuator,
+    every solid's) and a solid held by two ground pins."""
     from pam2exu.backend.natural.formulation import Formulation
-    from pam2exu.backend.natural.reactions import _rigid_owners
     models = [_six_bar()[0], _redundant()[0]] + [pam2exu.load(ROOT / p) for p in (
         "examples/all_elements.toml", "examples/slider_crank.toml", "examples/scotch_yoke.toml",
         "tests/data/every_element.toml")]
@@ -274,7 +273,7 @@ def test_rigid_rows_counted_are_the_rows_made_solid_by_solid():
         for all_angles in (False, True):
             form = Formulation(mech, all_angles=all_angles)
             made = _rigid_rows_made(form)
-            assert _rigid_owners(form) == made and len(made) > 0, model.name
+            assert form.rigid_owners == made and len(made) > 0, model.name
 
 
 def test_solids_matrices_are_shared_between_formulations_of_one_structure():

@@ -245,10 +245,13 @@ class Formulation:
         return Frame(i, p1, self._new_point(f"{name}.u", "vector"), s1, (1.0, 0.0))
 
     def _rigid_equations(self) -> None:
-        """|v|² = |d|² for each moving solid, P_k = r(s_k) for its further basic points."""
+        """|v|² = |d|² for each moving solid, P_k = r(s_k) for its further basic points;
+        ``rigid_owners``: the solid of each of these rows, in order."""
+        self.rigid_owners: list[int] = []
         for i, f in enumerate(self.frames):
             if i in self.grounds:
                 continue
+            before = len(self._rows)
             label = f"rigid '{self.mech.solids[i].name}'"
             if not f.v.x.is_constant or not f.v.y.is_constant:   # else held by two ground pins
                 self._rows.append((label, f.v.dot(f.v), f.d[0] ** 2 + f.d[1] ** 2, 1))
@@ -262,6 +265,7 @@ class Formulation:
                 size = math.hypot(*f.d)
                 self._rows.append((f"angle of '{self.mech.solids[i].name}'",
                                    f.v.aligned(f.angle, alpha) * (1.0 / size), 0.0, 1))
+            self.rigid_owners += [i] * (len(self._rows) - before)
 
     # ---- what the elements' ``natural`` declarations call -----------------------------------
     def ground(self, solid, pose_) -> None:

@@ -83,22 +83,6 @@ class _FrameEquations(Formulation):
         self.owners += [element] * (len(self._rows) - before)
 
 
-def _rigid_owners(form: Formulation) -> list[int]:
-    """The solid of each rigid-body row (the formulation's first rows), in order: each moving
-    solid's rows of ``Formulation._rigid_equations`` counted, not made: |v|² = |d|² where v
-    is not constant, two for each further basic point (not at the base point or at the end
-    of the base vector), one for its angle coordinate."""
-    owners = []
-    for i, f in enumerate(form.frames):
-        if i in form.grounds:
-            continue
-        base = {f.sp, (f.sp[0] + f.d[0], f.sp[1] + f.d[1])}
-        count = (not f.v.x.is_constant or not f.v.y.is_constant) + (f.angle is not None) + \
-            2 * sum(loc not in base for loc, _ in form.own.get(i, []))
-        owners += [i] * count
-    return owners
-
-
 @dataclass
 class _Pin:
     """The revolutes at one shared basic point: its columns (None: a ground point), the
@@ -145,7 +129,7 @@ class Plan:
         self.first = form.m - len(eq._rows)            # the element rows' first row
         self.ok = (form.nz > 0 and not eq.unshared       # nz = 0: every solid held
                    and form.labels[self.first:] == [r[0] for r in eq._rows])
-        self.rigid = np.array(_rigid_owners(form), dtype=int)
+        self.rigid = np.array(form.rigid_owners, dtype=int)
         self.ok &= len(self.rigid) == self.first
         self.moving = [i for i in range(len(form.frames)) if i not in form.grounds]
         self.angle_cols = {i: form.frames[i].angle for i in self.moving
