@@ -18,6 +18,7 @@ from ...kinematics import ANGLES, PER_SOLID, column
 from ..base import Backend, Integrator, Positions
 from .formulation import Coordinate, Formulation, Frame
 from .inverse import csr
+from .terms import extended
 from .dynamics import motion
 from .loads import multipliers
 from .anchored import anchored
@@ -271,7 +272,7 @@ class Natural(Backend):
         raw = np.empty((kind.free.size, n))
         for s in _chunks(n):
             zT = z[s].T
-            pose = K @ _ext(zT)                             # x, y, cos, sin per solid
+            pose = K @ extended(zT)                             # x, y, cos, sin per solid
             if qT is not None:
                 raw[:, s] = self._chunk_q(kind, zT, pose, qT[:, s])
             if rates is not None:
@@ -308,7 +309,7 @@ class Natural(Backend):
         f = kind.free
         # K [ż; 0]: a row's sum ends with + c·0 = ±0, which changes no sum (one matrix
         # for x, y, cos, sin and their rates)
-        d1, d2 = K @ _ext(zdT, 0.0), K @ _ext(zddT, 0.0)
+        d1, d2 = K @ extended(zdT, 0.0), K @ extended(zddT, 0.0)
         for out, d in ((qdT, d1), (qddT, d2)):
             out[0::PER_SOLID], out[1::PER_SOLID] = d[0::4], d[1::4]
         w, a = qdT[2::PER_SOLID], qddT[2::PER_SOLID]
@@ -356,14 +357,6 @@ def _kept(form: Formulation, name: str, make):
     if name not in kept:
         kept[name] = make()
     return kept[name]
-
-
-def _ext(zT: np.ndarray, last: float = 1.0) -> np.ndarray:
-    """[z; 1] (nz + 1, n) (``last`` in place of the 1)."""
-    out = np.empty((zT.shape[0] + 1, zT.shape[1]))
-    out[:-1] = zT
-    out[-1] = last
-    return out
 
 
 def _chunks(n: int):

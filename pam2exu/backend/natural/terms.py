@@ -34,6 +34,15 @@ def _summer(index: np.ndarray, size: int) -> sparse.csr_matrix:
                              shape=(size, len(index)))
 
 
+def extended(z: np.ndarray, last: float = 1.0) -> np.ndarray:
+    """[z; last] along the first axis: (nz + 1, n) of one column per step, or (nz + 1,) of
+    one configuration (last = 1: the ``ONE`` coordinate; 0: its rate)."""
+    out = np.empty((z.shape[0] + 1,) + z.shape[1:])
+    out[:-1] = z
+    out[-1] = last
+    return out
+
+
 class Terms:
     """The equations of a ``Formulation``, compiled.
 
@@ -86,13 +95,6 @@ class Terms:
     # The ``*_cols`` methods take z as (nz, n) and return (m, n) or (nnz, n): one column per
     # step, so that every term is a contiguous row and the sums over terms are one product
     # with a small matrix. The methods without the suffix take and return one row per step.
-    def _ext(self, z: np.ndarray) -> np.ndarray:
-        """[z; 1] (nz + 1, n), or (nz + 1,) of one configuration z (nz,)."""
-        out = np.empty((self.nz + 1,) + z.shape[1:])
-        out[:self.nz] = z
-        out[self.nz] = 1.0
-        return out
-
     def _sum(self, values: np.ndarray, per: str) -> np.ndarray:
         """The terms' values (k, n) summed per row (``per`` 'row') or per Jacobian entry
         ('entry'): out[index[k]] += values[k], term after term (``numpy.bincount`` for a
@@ -157,7 +159,7 @@ class Terms:
     def residual_cols(self, t: np.ndarray, z: np.ndarray, g: np.ndarray | None = None
                       ) -> np.ndarray:
         """Φ(z, t) (m, n); g: ``targets(t, 0)`` when already known."""
-        x = self._ext(z)
+        x = extended(z)
         values = np.concatenate([self._pc * x[self.pa] * x[self.pb],
                                  self._sc * x[self.sa] * np.sin(x[self.sb] + self._alpha)])
         out = self._sum(values, "row")
@@ -169,7 +171,7 @@ class Terms:
                        ) -> np.ndarray:
         """Σ |terms| per row (m, n): the size round-off errors of Φ scale with; g:
         ``targets(t, 0)`` when already known."""
-        x = np.abs(self._ext(z))
+        x = np.abs(extended(z))
         values = np.concatenate([self._apc * x[self.pa] * x[self.pb], self._asc * x[self.sa]])
         out = self._sum(values, "row")
         if self.laws:
@@ -190,7 +192,7 @@ class Terms:
 
     def jacobian_cols(self, z: np.ndarray) -> np.ndarray:
         """Φ_z as data (nnz, n) on the pattern (``rows``, ``cols``)."""
-        x = self._ext(z)
+        x = extended(z)
         values = np.concatenate([
             self._jp_c * x[self._jp_i],
             self._js_c * np.sin(x[self._js_b] + self._js_alpha),
@@ -205,7 +207,7 @@ class Terms:
         bincount for both sums (disjoint bins: the same additions in the same order)."""
         if z.shape[1] > BINCOUNT_STEPS:
             return self._residual_jacobian_many(t, z, g)
-        x = self._ext(z)
+        x = extended(z)
         gathered = x[self._gather]
         xa, xb, arg, xs = (gathered[part] for part in self._parts)
         arg += self._alpha
@@ -234,7 +236,7 @@ class Terms:
         rows). Every product is made once over all terms and the summed ones picked by one
         index (``_one_pick``)."""
         P, S = len(self.pa), len(self.sa)
-        x = self._ext(z)
+        x = extended(z)
         gathered = x[self._gather]                   # z_a, z_b of the products; z_b, z_a of sines
         ab = self._pc2 * gathered[:2 * P]            # c z_a, c z_b
         arg = gathered[2 * P:2 * P + S] + self.salpha
@@ -251,7 +253,7 @@ class Terms:
     def jacobian_one(self, z: np.ndarray) -> np.ndarray:
         """Φ_z (m, nz) dense at one configuration z (nz,): ``jacobian_cols``' column, on its
         pattern."""
-        x = self._ext(z)
+        x = extended(z)
         values = np.concatenate([
             self._jp_c1 * x[self._jp_i],
             self._js_c1 * np.sin(x[self._js_b] + self._js_alpha1),
@@ -262,9 +264,8 @@ class Terms:
     def gamma_one(self, z: np.ndarray, zd: np.ndarray, g2: np.ndarray | None) -> np.ndarray:
         """γ (m,) at one step: ``gamma_cols``' column; g2: ``targets(t, 2)[:, 0]``."""
         pc, sc, alpha = self.pc, self.sc, self.salpha
-        x = self._ext(z)
-        v = np.zeros(self.nz + 1)
-        v[:self.nz] = zd
+        x = extended(z)
+        v = extended(zd, 0.0)                        # ONE's rate: 0
         arg = x[self.sb] + alpha
         wb = v[self.sb]
         values = np.concatenate([
@@ -280,7 +281,7 @@ class Terms:
         array, each product c z_a made once (for Φ and ∂/∂z_b), and summed by one sparse
         summing matrix of both (``_both_index``: disjoint rows, each the same terms in the
         same order as its own matrix)."""
-        x = self._ext(z)
+        x = extended(z)
         P, S, n = len(self.pa), len(self.sa), x.shape[1]
         kb, ka, ks, kc = self._keeps
         B, A = self._jp_counts
@@ -326,9 +327,7 @@ class Terms:
 
     def gamma_cols(self, t: np.ndarray, z: np.ndarray, zd: np.ndarray) -> np.ndarray:
         """γ (m, n): Φ_z z̈ = γ = g'' − (d/dt Φ_z) ż."""
-        x, v = self._ext(z), np.empty((self.nz + 1, z.shape[1]))
-        v[:self.nz] = zd
-        v[self.nz] = 0.0                         # ONE's rate
+        x, v = extended(z), extended(zd, 0.0)     # ONE's rate: 0
         arg = x[self.sb]
         arg += self._alpha
         wb = v[self.sb]
