@@ -10,8 +10,8 @@ A run is solved in two passes (vectorised over steps, sequential only where it m
    is cut shorter, down to step by step. Its steps stay close enough that Newton does not
    jump to a nearby branch (a pass with intervals ten times longer, tried, did so next to
    a change point: tests/analyses/test_hard_cases.py);
-2. every step in between at once: Newton started from the cubic Hermite interpolation of
-   z and ż at the ends of its interval (error O(h⁴)), Jacobians and solves batched over the
+2. every step in between at once: Newton started from the quintic Hermite interpolation
+   of z, ż and z̈ at the ends of its interval (``hermite``: error O(h⁶)), Jacobians and solves batched over the
    steps (``batched``: blocks of BLOCK steps, the equations ordered as the pivots at the
    start of their interval, so that rows are seldom exchanged; a large system: one sparse
    block-diagonal LU per iteration, ``linear``). A step that does not
@@ -38,10 +38,10 @@ COARSE = 100
 #: and COARSE_LONGEST_STEPS steps: the run's own motion sets the coarse pass's size (a short
 #: run of a slow mechanism takes fewer sequential steps), within bounds that keep the
 #: intervals short enough to stay on the branch (4 times, tried, lost it next to a change
-#: point: tests/analyses/test_hard_cases.py); a long run's intervals do not grow (the
-#: fill's Newton iterations grow with the interval: 2.32 per step against 2.00 for the
-#: four-bar at 100,000 steps with intervals of 2,000 steps against 500, while its coarse
-#: pass is a small share of the run)
+#: point: tests/analyses/test_hard_cases.py); a long run's intervals do not grow (its
+#: coarse pass is a small share of the run; with the cubic guess the fill had before, its
+#: Newton iterations grew with the interval: 2.32 per step against 2.00 for the four-bar
+#: at 100,000 steps with intervals of 2,000 steps against 500)
 COARSE_GROW = 16
 COARSE_LONGEST = 2
 COARSE_LONGEST_STEPS = 64
@@ -65,6 +65,20 @@ COARSE_GAP = 64
 CONVERGED = 1e-3
 #: the machine epsilon (the size of round-off relative to a value)
 EPS = float(np.finfo(float).eps)
+
+
+def hermite(u, h):
+    """The weights of z(0), ż(0), z̈(0), z(h), ż(h), z̈(h) in z(u h) on the quintic through
+    them (error O(h⁶): a Newton step less than the cubic's O(h⁴) where the fill's steps are
+    far apart), u in [0, 1]: H₀ = 1 − 10u³ + 15u⁴ − 6u⁵, H₁ = h (u − 6u³ + 8u⁴ − 3u⁵),
+    H₂ = h² (u² − 3u³ + 3u⁴ − u⁵)/2, and at the far end H₃ = 1 − H₀, H₄ = h (−4u³ + 7u⁴ −
+    3u⁵), H₅ = h² (u³ − 2u⁴ + u⁵)/2."""
+    u2 = u * u
+    u3 = u2 * u
+    u4, u5 = u3 * u, u3 * u2
+    far = 10 * u3 - 15 * u4 + 6 * u5
+    return (1 - far, h * (u - 6 * u3 + 8 * u4 - 3 * u5), 0.5 * h * h * (u2 - 3 * u3 + 3 * u4 - u5),
+            far, h * (-4 * u3 + 7 * u4 - 3 * u5), 0.5 * h * h * (u3 - 2 * u4 + u5))
 
 
 @dataclass
@@ -320,7 +334,7 @@ class Solver(LinearSolves):
         self.own_rates[j] = True
 
     def _fill(self, t, z, intervals) -> list[int]:
-        """Solve the steps inside every interval at once from cubic Hermite guesses; the
+        """Solve the steps inside every interval at once from quintic Hermite guesses; the
         numbers of the intervals where some step failed or left its guess far behind (more
         than 10 times its interval's miss)."""
         if not intervals:
@@ -371,13 +385,12 @@ class Solver(LinearSolves):
                 yield c, min(b, c + BLOCK), orders[c]
 
     def _hermite(self, t, z, steps, k, j):
-        """z at the steps (nz, n) on the cubic through z and ż at the ends k, j of their
-        intervals (error O(h⁴))."""
+        """z at the steps (nz, n) on the quintic through z, ż and z̈ at the ends k, j of
+        their intervals (``hermite``)."""
         h = t[j] - t[k]
-        u = (t[steps] - t[k]) / h
-        u2, u3 = u * u, u * u * u
-        return ((2 * u3 - 3 * u2 + 1) * z[k].T + (u3 - 2 * u2 + u) * h * self.zd[k].T
-                + (3 * u2 - 2 * u3) * z[j].T + (u3 - u2) * h * self.zd[j].T)
+        weights = hermite((t[steps] - t[k]) / h, h)
+        return sum(w * a for w, a in zip(weights, (z[k].T, self.zd[k].T, self.zdd[k].T,
+                                                   z[j].T, self.zd[j].T, self.zdd[j].T)))
 
     def _batched(self) -> bool:
         """Whether the steps are solved by ``_bulk`` (small square systems)."""
