@@ -16,7 +16,8 @@ from pam2exu.backend.natural import Natural
 from pam2exu.backend.natural import terms as terms_module
 from pam2exu.backend.natural.formulation import Formulation
 from pam2exu.backend.natural.linear import SPARSE_FROM
-from pam2exu.backend.natural.solver import NaturalSettings, Solver, hermite
+from pam2exu.backend.natural.solver import (NaturalSettings, Solver, cubic_hermite,
+                                            quintic_hermite)
 from pam2exu.backend.natural.terms import BINCOUNT_STEPS
 from references.closed_form import FOUR_BAR, four_bar
 
@@ -84,27 +85,28 @@ def test_the_coarse_pass_follows_the_motion(four_bar_mech):
     assert np.max(np.abs(turn(fi("rocker") - psi))) < 1e-12
 
 
-def test_the_fill_guess_is_the_quintic_through_both_ends():
-    """``hermite``'s weights give any polynomial of degree 5 exactly from its value, first
-    and second derivative at both ends (the quintic Hermite interpolant is unique), and
-    they sum to 1 (a constant is kept)."""
+def test_the_fill_guesses_are_the_hermite_interpolants():
+    """``quintic_hermite``'s weights give any polynomial of degree 5 exactly from its value,
+    first and second derivative at both ends, ``cubic_hermite``'s any cubic from its value
+    and first derivative (each interpolant is unique), and both keep a constant."""
     rng = np.random.default_rng(5)
-    c = rng.normal(size=6)                                 # p(x) = Σ c_k x^k
-    p = np.polynomial.Polynomial(c)
     t0, h = 0.3, 0.7
     u = np.linspace(0.0, 1.0, 11)
-    ends = [p(t0), p.deriv()(t0), p.deriv(2)(t0), p(t0 + h), p.deriv()(t0 + h),
-            p.deriv(2)(t0 + h)]
-    weights = hermite(u, h)
-    got = sum(w * e for w, e in zip(weights, ends))
-    assert np.max(np.abs(got - p(t0 + u * h))) < 1e-14 * np.max(np.abs(c))
-    assert np.max(np.abs(weights[0] + weights[3] - 1.0)) == 0.0
+    for weights, degree, orders in ((quintic_hermite(u, h), 5, (0, 1, 2)),
+                                    (cubic_hermite(u, h), 3, (0, 1))):
+        c = rng.normal(size=degree + 1)                    # p(x) = Σ c_k x^k
+        p = np.polynomial.Polynomial(c)
+        ends = [p.deriv(k)(x) for x in (t0, t0 + h) for k in orders]
+        got = sum(w * e for w, e in zip(weights, ends))
+        assert np.max(np.abs(got - p(t0 + u * h))) < 1e-14 * np.max(np.abs(c))
+        assert np.max(np.abs(weights[0] + weights[len(orders)] - 1.0)) < 1e-15
 
 
 def test_the_fill_converges_in_two_newton_iterations(four_bar_mech):
-    """1,000 steps of the four-bar's turn: every step between the coarse ones is solved in
-    two Newton iterations from the quintic guess (before, from the cubic one: three), and
-    the run meets the closed form to 1e-12 of the link lengths."""
+    """1,000 steps of the four-bar's turn: the coarse intervals miss by more than
+    QUINTIC_MISS, so every step between the coarse ones is solved in two Newton iterations
+    from the quintic guess (from the cubic one: three), and the run meets the closed form to
+    1e-12 of the link lengths."""
     form, solver = solver_of(four_bar_mech)
     n = 1001
     t = np.linspace(0.0, 1.0, n)
@@ -123,6 +125,27 @@ def test_the_fill_converges_in_two_newton_iterations(four_bar_mech):
     turn = lambda x: (x + np.pi) % (2 * np.pi) - np.pi          # noqa: E731
     assert np.max(np.abs(turn(fi("coupler") - phi))) < 1e-12
     assert np.max(np.abs(turn(fi("rocker") - psi))) < 1e-12
+
+
+def test_the_quintic_guess_only_where_the_coarse_intervals_are_long(four_bar_mech,
+                                                                    monkeypatch):
+    """The fill takes the quintic guess at 1,000 steps of the four-bar's turn (coarse misses
+    ~8e-5 > QUINTIC_MISS) and the cubic at 10,000 (~1e-5: two Newton iterations a step
+    either way, and the cubic has two terms fewer)."""
+    import pam2exu.backend.natural.solver as solver_module
+    asked = []
+    quintic = solver_module.quintic_hermite
+    monkeypatch.setattr(solver_module, "quintic_hermite",
+                        lambda u, h: asked.append(len(u)) or quintic(u, h))
+    for n, expected in ((1001, True), (10001, False)):
+        asked.clear()
+        form, solver = solver_of(four_bar_mech)
+        t = np.linspace(0.0, 1.0, n)
+        z0, _ = solver.newton(t[:1], form.from_q(four_bar_mech.initial_q()[None]))
+        z, solved = solver.run(t, z0[0])
+        misses = [miss for _, _, miss in solver.intervals]
+        assert solved == n and bool(asked) == expected
+        assert (max(misses) > solver_module.QUINTIC_MISS) == expected
 
 
 def test_a_step_of_a_larger_system_is_solved_dense():

@@ -10,8 +10,10 @@ A run is solved in two passes (vectorised over steps, sequential only where it m
    is cut shorter, down to step by step. Its steps stay close enough that Newton does not
    jump to a nearby branch (a pass with intervals ten times longer, tried, did so next to
    a change point: tests/analyses/test_hard_cases.py);
-2. every step in between at once: Newton started from the quintic Hermite interpolation
-   of z, ż and z̈ at the ends of its interval (``hermite``: error O(h⁶)), Jacobians and solves batched over the
+2. every step in between at once: Newton started from the cubic Hermite interpolation of
+   z and ż at the ends of its interval (error O(h⁴)), or where the coarse pass's intervals
+   are long for the motion from the quintic through z, ż and z̈ (error O(h⁶):
+   ``QUINTIC_MISS``), Jacobians and solves batched over the
    steps (``batched``: blocks of BLOCK steps, the equations ordered as the pivots at the
    start of their interval, so that rows are seldom exchanged; a large system: one sparse
    block-diagonal LU per iteration, ``linear``). A step that does not
@@ -56,6 +58,13 @@ COARSE_MISS = 2e-2
 MAGNITUDE_FLOOR = 1e-6
 #: steps solved together by ``_bulk``: small enough for their arrays to stay in the cache
 BLOCK = 8192
+#: the fill's steps start from the quintic Hermite guess (z, ż, z̈ at both ends) in a block
+#: with an interval whose coarse predictor missed by more than this, else from the cubic (z,
+#: ż): the cubic's error grows as the miss to the 4/3, and above it costs the fill a third
+#: Newton iteration per step (the four-bar at 1,000 steps: intervals missing 8e-5, 3.0
+#: iterations a step with the cubic, 2.05 with the quintic); below it the quintic's two more
+#: terms would only cost (the four-bar at 10,000 steps and more: 1e-5, 2.0 either way)
+QUINTIC_MISS = 3e-5
 #: a step that failed is cut into at most this many sub-steps
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
@@ -67,19 +76,24 @@ CONVERGED = 1e-3
 EPS = float(np.finfo(float).eps)
 
 
-def hermite(u, h):
+def cubic_hermite(u, h):
+    """The weights of z(0), ż(0), z(h), ż(h) in z(u h) on the cubic through them (error
+    O(h⁴)), u in [0, 1]: 2u³ − 3u² + 1, h (u³ − 2u² + u), 3u² − 2u³, h (u³ − u²)."""
+    u2, u3 = u * u, u * u * u
+    return 2 * u3 - 3 * u2 + 1, (u3 - 2 * u2 + u) * h, 3 * u2 - 2 * u3, (u3 - u2) * h
+
+
+def quintic_hermite(u, h):
     """The weights of z(0), ż(0), z̈(0), z(h), ż(h), z̈(h) in z(u h) on the quintic through
-    them (error O(h⁶): a Newton step less than the cubic's O(h⁴) where the fill's steps are
-    far apart), u in [0, 1]: H₀ = 1 − 10u³ + 15u⁴ − 6u⁵, H₁ = h (u − 6u³ + 8u⁴ − 3u⁵),
-    H₂ = h² (u² − 3u³ + 3u⁴ − u⁵)/2, and at the far end H₃ = 1 − H₀, H₄ = h (−4u³ + 7u⁴ −
-    3u⁵), H₅ = h² (u³ − 2u⁴ + u⁵)/2."""
+    them (error O(h⁶)), u in [0, 1]: H₀ = 1 − 10u³ + 15u⁴ − 6u⁵, H₁ = h (u − 6u³ + 8u⁴ −
+    3u⁵), H₂ = h² (u² − 3u³ + 3u⁴ − u⁵)/2, and at the far end H₃ = 1 − H₀, H₄ = h (−4u³ +
+    7u⁴ − 3u⁵), H₅ = h² (u³ − 2u⁴ + u⁵)/2."""
     u2 = u * u
     u3 = u2 * u
     u4, u5 = u3 * u, u3 * u2
     far = 10 * u3 - 15 * u4 + 6 * u5
     return (1 - far, h * (u - 6 * u3 + 8 * u4 - 3 * u5), 0.5 * h * h * (u2 - 3 * u3 + 3 * u4 - u5),
             far, h * (-4 * u3 + 7 * u4 - 3 * u5), 0.5 * h * h * (u3 - 2 * u4 + u5))
-
 
 @dataclass
 class NaturalSettings:
@@ -334,20 +348,23 @@ class Solver(LinearSolves):
         self.own_rates[j] = True
 
     def _fill(self, t, z, intervals) -> list[int]:
-        """Solve the steps inside every interval at once from quintic Hermite guesses; the
+        """Solve the steps inside every interval at once from Hermite guesses (the quintic
+        where some interval of the block has a coarse miss above QUINTIC_MISS); the
         numbers of the intervals where some step failed or left its guess far behind (more
         than 10 times its interval's miss)."""
         if not intervals:
             return []
         k, j = (np.array([iv[i] for iv in intervals]) for i in (0, 1))
-        allowed = np.maximum(10 * np.array([iv[2] for iv in intervals]), 1e-6)
+        miss = np.array([iv[2] for iv in intervals])
+        allowed = np.maximum(10 * miss, 1e-6)
         ranges = [np.arange(a + 1, b) for a, b in zip(k, j)]
         owner = np.repeat(np.arange(len(intervals)), [len(r) for r in ranges])
         steps = np.concatenate(ranges)
         failed = np.zeros(len(intervals), dtype=bool)
         for a, b, order in self._blocks(z, k, owner):
             part, at = steps[a:b], owner[a:b]
-            guess = self._hermite(t, z, part, k[at], j[at])
+            guess = self._hermite(t, z, part, k[at], j[at],
+                                  quintic=bool(np.max(miss[at]) > QUINTIC_MISS))
             if order is not None:
                 found = self._bulk(t[part], guess, order)
             else:
@@ -384,13 +401,18 @@ class Solver(LinearSolves):
             for c in range(a, b, BLOCK):
                 yield c, min(b, c + BLOCK), orders[c]
 
-    def _hermite(self, t, z, steps, k, j):
-        """z at the steps (nz, n) on the quintic through z, ż and z̈ at the ends k, j of
-        their intervals (``hermite``)."""
+    def _hermite(self, t, z, steps, k, j, quintic: bool):
+        """z at the steps (nz, n) on the Hermite interpolant through the ends k, j of their
+        intervals: the cubic through z and ż (``cubic_hermite``), or with ``quintic`` the
+        quintic through z, ż and z̈ (``quintic_hermite``)."""
         h = t[j] - t[k]
-        weights = hermite((t[steps] - t[k]) / h, h)
-        return sum(w * a for w, a in zip(weights, (z[k].T, self.zd[k].T, self.zdd[k].T,
-                                                   z[j].T, self.zd[j].T, self.zdd[j].T)))
+        u = (t[steps] - t[k]) / h
+        if not quintic:
+            w = cubic_hermite(u, h)
+            return w[0] * z[k].T + w[1] * self.zd[k].T + w[2] * z[j].T + w[3] * self.zd[j].T
+        w = quintic_hermite(u, h)
+        return (w[0] * z[k].T + w[1] * self.zd[k].T + w[2] * self.zdd[k].T + w[3] * z[j].T
+                + w[4] * self.zd[j].T + w[5] * self.zdd[j].T)
 
     def _batched(self) -> bool:
         """Whether the steps are solved by ``_bulk`` (small square systems)."""
