@@ -61,9 +61,11 @@ def motion_per_step(law, times: np.ndarray, values=None) -> float:
     with np.errstate(all="ignore"):
         f, df, _ = law(times) if values is None else values
         dt = float(times[1] - times[0])
+        rate = np.abs(df).max()
         inside = transition_times(law, float(times[0]), float(times[-1]))
-        rate = max(np.max(np.abs(df)), np.max(np.abs(law(inside)[1]), initial=0.0))
-        return float(max(np.max(np.abs(np.diff(f))), rate * dt))
+        if inside.size:                          # (a law without a transition: none)
+            rate = max(rate, np.abs(law(inside)[1]).max())
+        return float(max(np.abs(f[1:] - f[:-1]).max(), rate * dt))
 
 
 def transition_times(law, start: float, end: float, count: int = 17) -> np.ndarray:
@@ -96,9 +98,9 @@ def law_values(mech, times: np.ndarray) -> list[tuple]:
     """(law, (f, f', f'') at ``times``) of every actuator (``mech.drivers`` order), evaluated
     once for the checks and the motion per step of a plan."""
     out = []
-    for el in mech.drivers:
-        law = el.time_law()
-        with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"):
+        for el in mech.drivers:
+            law = el.time_law()
             out.append((law, law(times)))
     return out
 
@@ -110,6 +112,8 @@ def check_laws(mech, times: np.ndarray, ranges: bool = True, evaluated=None) -> 
     for el, (law, values) in zip(mech.drivers, evaluated or law_values(mech, times)):
         unit, _ = driver_unit(el)
         limit = limits.LENGTH if unit == "m" else limits.ANGLE
+        if _fine(values, limit if ranges else None, ranges and unit == "m"):
+            continue                             # (the usual case: nothing to name)
         for order, v in enumerate(values):
             bad = ~np.isfinite(v)
             if order == 0 and ranges:
@@ -132,6 +136,15 @@ def check_laws(mech, times: np.ndarray, ranges: bool = True, evaluated=None) -> 
                     f"the actuator would have no direction; change the constants")))
     if problems:
         raise ModelError(problems, mech.model.source)
+
+
+def _fine(values, limit: float | None, positive: bool) -> bool:
+    """Whether ``check_laws`` finds nothing in a law's (f, f', f'') at once: all finite,
+    |f| ≤ ``limit`` (None: any size) and, when ``positive``, f > 0."""
+    f = values[0]
+    return bool(np.isfinite(values).all()
+                and (limit is None or np.abs(f).max() <= limit)
+                and (not positive or f.min() > 0))
 
 
 def plan(mech, t_end: float, steps: int, columns: int) -> Plan:

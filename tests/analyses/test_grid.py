@@ -170,3 +170,42 @@ def test_the_assembly_checks_the_actuators_values_at_t0():
     with pytest.raises(pam2exu.ModelError, match=r"'cylinder' \(linear_actuator\): the "
                                                  r"distance PQ must stay positive"):
         pam2exu.run(model, analysis="assembly")
+
+
+@pytest.mark.parametrize("angular", [True, False])
+def test_the_quick_law_check_passes_exactly_what_the_detailed_one_passes(angular, monkeypatch):
+    """``check_laws`` tests (f, f', f'') at once (``_fine``) before naming what fails: on
+    values at and just past each limit (NaN, ±∞ in each order, |f| = the range and one ulp
+    more, f = 0 and −0 for a distance), it passes exactly what the detailed check passes."""
+    from types import SimpleNamespace
+    from pam2exu import limits
+    limit = limits.ANGLE if angular else limits.LENGTH
+    el = SimpleNamespace(angular=angular, where="'a' (actuator)", name="a")
+    mech = SimpleNamespace(drivers=[el], model=SimpleNamespace(source="m.toml"))
+    law = pam2exu.Law("polynomial", [0.0])
+    times = np.linspace(0.0, 1.0, 5)
+    base = np.array([0.5, 1.0, 2.0, 1.0, 0.5])
+    cases = [(base, base, base)]
+    for order in range(3):
+        for bad in (np.nan, np.inf, -np.inf):
+            values = [base.copy() for _ in range(3)]
+            values[order][2] = bad
+            cases.append(tuple(values))
+    for f0 in (limit, np.nextafter(limit, np.inf), -limit, -np.nextafter(limit, np.inf),
+               0.0, -0.0, -1e-300, 1e-300):
+        f = base.copy()
+        f[3] = f0
+        cases.append((f, base, base))
+
+    def verdict(values, ranges):
+        try:
+            grid.check_laws(mech, times, ranges=ranges, evaluated=[(law, values)])
+            return "passes"
+        except pam2exu.ModelError as exc:
+            return str(exc)
+
+    quick = [verdict(v, r) for v in cases for r in (True, False)]
+    monkeypatch.setattr(grid, "_fine", lambda *_: False)
+    detailed = [verdict(v, r) for v in cases for r in (True, False)]
+    assert quick == detailed
+    assert quick.count("passes") == (16 if angular else 12)
