@@ -30,6 +30,26 @@ def test_the_equilibration_is_the_norms_bits(m, nq):
     assert rank._equilibrated(Z).tobytes() == _norm_equilibrated(Z).tobytes()
 
 
+
+@pytest.mark.parametrize("n, m, nq", [(16, 12, 12), (101, 12, 12), (17, 1, 1), (40, 3, 7),
+                                      (20, 9, 8), (33, 14, 9), (16, 5, 15), (18, 20, 16),
+                                      (25, 6, 17), (16, 30, 24), (19, 4, 127), (16, 3, 128)])
+def test_the_equilibration_of_a_stack_is_the_norms_bits(n, m, nq):
+    """From ``STACKED`` matrices on, ``_equilibrated`` works entry by entry along the steps
+    (each row's squares summed as numpy's reduce sums a row: in order below 8, in 8 partial
+    sums from 8 to 128): np.linalg.norm's passes bit for bit, scales from 1e-8 to 1e8,
+    zeros, NaN and a view that is not C-ordered (the plain passes then) included."""
+    assert n >= rank.STACKED
+    rng = np.random.default_rng(n * 10_000 + m * 100 + nq)
+    J = rng.standard_normal((n, m, nq)) * 10.0 ** rng.uniform(-8, 8, (n, m, nq))
+    J[rng.random(J.shape) < 0.2] = 0.0
+    J[1, 0] = 0.0
+    J[2, :, -1] = 0.0
+    J[3, -1, 0] = np.nan
+    assert rank._equilibrated(J).tobytes() == _norm_equilibrated(J).tobytes()
+    F = np.asfortranarray(J)
+    assert rank._equilibrated(F).tobytes() == _norm_equilibrated(F).tobytes()
+
 def _smooth(rng, steps, m, nq, peak):
     """Equilibrated Cq along a smooth closed path whose κ peaks near step ``peak``."""
     a, b, c = (0.1 * rng.standard_normal((m, nq)) for _ in range(3))
