@@ -63,20 +63,19 @@ def _candidates(A: np.ndarray) -> np.ndarray | None:
     The eigenvalues are taken at every PROBE-th step first; a step between them whose κ
     is below their largest lower bound for certain, from its nearest probed step's σ and
     Weyl's |σ_i(A_k) − σ_i(A_j)| ≤ ‖A_k − A_j‖_F (``_ruled_out``), needs none."""
-    n, m, nq = A.shape
+    n = len(A)
     if n == 0 or np.iscomplexobj(A) or not np.isfinite(A).all():
         return None
-    G = A @ A.transpose(0, 2, 1) if m < nq else A.transpose(0, 2, 1) @ A
     size = np.einsum("nij,nij->n", A, A)             # ‖A‖_F² ≥ λ_max
     error, low, high = GRAM_ERROR * size, np.zeros(n), np.zeros(n)
     known = np.zeros(n, dtype=bool)
     known[::PROBE] = known[-1] = True
-    bounded = _bound(G, known, low, high, size)
+    bounded = _bound(A, known, low, high, size)
     rest = ~known
     if rest.any() and bounded[known].all():
         rest[rest] = ~_ruled_out(A, known, rest, low, high, error)
     if rest.any():
-        bounded = _bound(G, rest, low, high, size)
+        bounded = _bound(A, rest, low, high, size)
         known |= rest
     if not bounded.any():
         return None
@@ -87,10 +86,13 @@ def _candidates(A: np.ndarray) -> np.ndarray | None:
     return np.nonzero(known & (~bounded | (upper * (1 + SVD_ERROR) >= reach)))[0]
 
 
-def _bound(G, steps, low, high, size) -> np.ndarray:
-    """λ_min, λ_max of the Gram matrices G at ``steps`` (a mask) into ``low``, ``high``;
-    the steps whose bounds are tight: λ_min > ‖A‖_F² / BOUNDED² (then λ_min − error > 0)."""
-    lam = np.linalg.eigvalsh(G[steps])
+def _bound(A, steps, low, high, size) -> np.ndarray:
+    """λ_min, λ_max of the Gram matrices of A (A Aᵀ or Aᵀ A, the smaller) at ``steps`` (a
+    mask) into ``low``, ``high``; the steps whose bounds are tight: λ_min > ‖A‖_F² /
+    BOUNDED² (then λ_min − error > 0)."""
+    B = A[steps]
+    G = B @ B.transpose(0, 2, 1) if B.shape[1] < B.shape[2] else B.transpose(0, 2, 1) @ B
+    lam = np.linalg.eigvalsh(G)
     low[steps], high[steps] = lam[:, 0], lam[:, -1]
     return low > size / BOUNDED ** 2
 
@@ -102,7 +104,7 @@ def _ruled_out(A, known, rest, low, high, error) -> np.ndarray:
     the sum of the steps' ‖A_{i+1} − A_i‖_F from j to k (one difference of the stack)."""
     steps = np.flatnonzero(rest)
     j = np.minimum((steps + PROBE // 2) // PROBE * PROBE, len(A) - 1)
-    D = np.diff(A, axis=0)
+    D = A[1:] - A[:-1]
     walked = np.zeros(len(A))
     np.cumsum(np.sqrt(np.einsum("nij,nij->n", D, D)), out=walked[1:])
     # (the sums' round-off: below 1e-12 of the whole walk)
@@ -215,11 +217,27 @@ def _rank(mech, t: float, q: np.ndarray, rtol: float, rows=None, jacobian=None):
     J = equations(mech, State([t], q[None, :])).jacobian[0] if jacobian is None else jacobian
     if rows is not None:
         J = J[rows]
-    J = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
+    J = _scaled(mech, J)
     if J.shape[0] == 0:
         return None
     U, s, Vt = np.linalg.svd(J)
     return U, s, Vt, int(np.sum(s > rtol * max(1.0, s[0] if s.size else 1.0)))
+
+
+def _scaled(mech, J: np.ndarray) -> np.ndarray:
+    """Cq with its angle columns times 1 / the length scale (``_rank``'s coordinates)."""
+    return J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
+
+
+def _regular(mech, J: np.ndarray, rtol: float) -> bool:
+    """Whether Cq (m, nq) at one configuration is square and of full rank by ``_rank``'s
+    test with a margin: its smallest singular value over twice the threshold. Then
+    ``mobility`` needs no singular vectors (the values alone, from another LAPACK path,
+    differ from theirs by round-off, ~1e-15 of the largest: far below the margin)."""
+    if J.shape[0] != J.shape[1] or J.shape[0] == 0:
+        return False
+    s = np.linalg.svd(_scaled(mech, J), compute_uv=False)
+    return bool(s[-1] > 2 * rtol * max(1.0, s[0]))
 
 
 def at_guess(mech, t: float, q: np.ndarray):
@@ -257,6 +275,8 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None,
     the rank and the condition number)."""
     if jacobian is None:
         jacobian = equations(mech, State([t], q[None, :])).jacobian[0]
+    if rows is None and _regular(mech, jacobian, rtol):      # no DOF left, none repeated
+        return Mobility(0, 0, [], [], _condition(mech, t, q, jacobian))
     keep = np.ones(mech.n_equations, dtype=bool) if rows is None else np.asarray(rows)
     svd = _rank(mech, t, q, rtol, None if rows is None else keep, jacobian=jacobian)
     if svd is None:
@@ -275,8 +295,12 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None,
         for el, own in zip(mech.constraints, mech.rows):
             if np.max(weight[own]) > 1e-6:
                 dependent.append(el.name)
-    condition = float(condition_numbers(mech, [t], q[None, :], jacobian[None])[0])
-    return Mobility(dof, redundant, free, dependent, condition)
+    return Mobility(dof, redundant, free, dependent, _condition(mech, t, q, jacobian))
+
+
+def _condition(mech, t: float, q: np.ndarray, jacobian: np.ndarray) -> float:
+    """``condition_numbers`` at one configuration, Cq (m, nq) there given."""
+    return float(condition_numbers(mech, [t], q[None, :], jacobian[None])[0])
 
 
 def contradiction(mech, t: float, q: np.ndarray, rtol: float = 1e-9,

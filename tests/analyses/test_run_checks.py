@@ -138,3 +138,30 @@ def test_the_default_outputs_do_not_make_the_derived_columns(monkeypatch):
     made.clear()
     asked = job_module.prepare(model, "kinetostatic", steps=10, outputs=["coupler.P.x"])
     assert made == [1] and asked.columns == ["coupler.P.x"]
+
+
+@pytest.mark.parametrize("smallest", [None, 3.0, 2.01, 1.99, 0.5, 0.0])
+def test_a_regular_jacobians_mobility_is_the_one_of_the_svd_with_vectors(smallest,
+                                                                        monkeypatch):
+    """``mobility`` of a square Cq of full rank takes its singular values alone
+    (``_regular``): the same Mobility, condition number's bits included, as the SVD with
+    vectors, at the four-bar's guess and with Cq's smallest singular value set to
+    ``smallest`` × the rank threshold (1e-9 of the largest) around the margin of 2 (s_max = 4.15)."""
+    from pathlib import Path
+    import pam2exu
+    mech = pam2exu.load(Path(__file__).resolve().parents[2] / "examples" /
+                        "four_bar.toml").mechanism()
+    q0 = mech.initial_q()
+    J = rank.at_guess(mech, 0.0, q0).jacobian[0]
+    if smallest is not None:
+        scale = rank._scaled(mech, np.ones((1, mech.nq)))
+        U, s, Vt = np.linalg.svd(J * scale)
+        s[-1] = smallest * 1e-9 * s[0]
+        J = (U * s) @ Vt / scale
+    assert rank._regular(mech, J, 1e-9) == (smallest is None or smallest > 2.0)
+    fast = rank.mobility(mech, 0.0, q0, jacobian=J)
+    monkeypatch.setattr(rank, "_regular", lambda *_: False)
+    full = rank.mobility(mech, 0.0, q0, jacobian=J)
+    assert fast == full and str(fast.condition) == str(full.condition)
+    assert (fast.dof, fast.redundant) == ((0, 0) if smallest is None or smallest > 1.5
+                                          else (1, 1))
