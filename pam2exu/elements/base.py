@@ -245,7 +245,7 @@ class Element:
 
     def problems(self, scope) -> list[str]:
         """Every problem with this element's keys and references (empty when it is sound)."""
-        out = []
+        out, refs = [], []
         for k, kind in enumerate(("anc1", "anc2")):
             value = getattr(self, kind)
             if k < len(self.anchors):
@@ -257,7 +257,7 @@ class Element:
                                f"({ANCHOR_FORMS[self.anchors[k]]}), got {echo(value)}")
                     continue
                 try:
-                    scope.resolve(self.anchors[k], value)
+                    refs.append(scope.resolve(self.anchors[k], value))
                 except LookupError as exc:
                     out.append(f"{kind} = {echo(value)}: {exc}")
             elif value is not None:
@@ -272,8 +272,7 @@ class Element:
                 except LookupError as exc:
                     out.append(f"{key} = {echo(getattr(self, key))}: {exc}")
         if not out and len(self.anchors) == 2 and self.equations:
-            a, b = (scope.resolve(kind, getattr(self, f"anc{k + 1}"))
-                    for k, kind in enumerate(self.anchors))
+            a, b = refs                          # (both anchors found: nothing is wrong)
             if a.solid == b.solid:
                 out.append(f"anc1 and anc2 are on the same solid '{scope.solids[a.solid].name}': "
                            "an element must join two different solids")
