@@ -51,7 +51,10 @@ class Equations:
 
 def target_values(target, t, m):
     """(f, f', f'') of a constraint's right-hand side, each (n, m) or broadcastable to it
-    (a constant: a read-only view of it, not ``np.broadcast_to``'s, 5 µs a constraint)."""
+    (a constant: a read-only view of it, not ``np.broadcast_to``'s, 5 µs a constraint; a
+    float: itself)."""
+    if type(target) is float:                   # (a joint's 0.0: no array to make)
+        return target, 0.0, 0.0
     if isinstance(target, Law):
         f, df, ddf = target(t)
         return f[:, None], df[:, None], ddf[:, None]
@@ -67,7 +70,8 @@ def equations(mech, st: State, jacobian: bool = True) -> Equations:
     """All constraint equations of a mechanism at the states ``st`` (without ``jacobian``,
     Cq is not assembled: ``Equations.jacobian`` is None)."""
     n, m, dtype = st.n, mech.n_equations, st.q.dtype    # complex in the complex step
-    residual, c_t = np.zeros((n, m), dtype), np.zeros((n, m), dtype)
+    # C_t = −f' of each row: −0.0 where the target is constant (f' = 0.0, not written)
+    residual, c_t = np.zeros((n, m), dtype), np.full((n, m), -0.0, dtype)
     jac = np.zeros((n, m, mech.nq), dtype) if jacobian else None
     gamma = np.zeros((n, m), dtype) if st.qd is not None else None
     points = mech.__dict__.get(POINTS) if st.jacobians else None
@@ -79,7 +83,8 @@ def equations(mech, st: State, jacobian: bool = True) -> Equations:
         parts.append(v)
         f, df, ddf = target_values(target, st.t, el.equations)
         residual[:, rows] = v.value - f
-        c_t[:, rows] = np.negative(df)          # broadcast over the steps
+        if isinstance(target, Law):             # (a constant's f' = 0.0: −0.0 there)
+            c_t[:, rows] = np.negative(df)      # broadcast over the steps
         if jac is not None:
             v.rows(jac, rows.start)
         if gamma is not None:

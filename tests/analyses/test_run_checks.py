@@ -165,3 +165,27 @@ def test_a_regular_jacobians_mobility_is_the_one_of_the_svd_with_vectors(smalles
     assert fast == full and str(fast.condition) == str(full.condition)
     assert (fast.dof, fast.redundant) == ((0, 0) if smallest is None or smallest > 1.5
                                           else (1, 1))
+
+
+@pytest.mark.parametrize("name", ["four_bar", "all_elements"])
+def test_the_equations_residual_and_c_t_are_the_targets_bits(name):
+    """``native.equations`` writes C_t only where the target moves (a law; a constant's
+    rows keep −0.0, −f' of f' = 0.0) and subtracts a float target as itself: C and C_t bit
+    for bit the plain v − f and −f' of every element's ``target_values``."""
+    from pathlib import Path
+    import pam2exu
+    from pam2exu.analyses import native
+    from pam2exu.kinematics import State
+    mech = pam2exu.load(Path(__file__).resolve().parents[2] / "examples" /
+                        f"{name}.toml").mechanism()
+    t = np.linspace(0.0, 0.7, 4)
+    st = State(t, np.repeat(mech.initial_q()[None], len(t), axis=0))
+    eq = native.equations(mech, st)
+    for el, rows in zip(mech.constraints, mech.rows):
+        v, target = el.constraint(st)
+        f, df, _ = native.target_values(np.asarray(target) if isinstance(target, float)
+                                        else target, t, el.equations)
+        shape = (len(t), el.equations)
+        assert eq.residual[:, rows].tobytes() == np.broadcast_to(v.value - f,
+                                                                 shape).tobytes()
+        assert eq.c_t[:, rows].tobytes() == np.broadcast_to(np.negative(df), shape).tobytes()
