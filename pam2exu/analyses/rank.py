@@ -138,7 +138,7 @@ def _equilibrated(J: np.ndarray) -> np.ndarray:
 
 #: from this many matrices on, ``_equilibrated`` lays the stack out entry by entry
 #: (``_equilibrated_stack``)
-STACKED = 16
+STACKED = 20
 #: numpy's reduce sums up to this many numbers in one pairwise block (8 partial sums)
 PAIRWISE = 128
 

@@ -31,9 +31,9 @@ def test_the_equilibration_is_the_norms_bits(m, nq):
 
 
 
-@pytest.mark.parametrize("n, m, nq", [(16, 12, 12), (101, 12, 12), (17, 1, 1), (40, 3, 7),
-                                      (20, 9, 8), (33, 14, 9), (16, 5, 15), (18, 20, 16),
-                                      (25, 6, 17), (16, 30, 24), (19, 4, 127), (16, 3, 128)])
+@pytest.mark.parametrize("n, m, nq", [(20, 12, 12), (101, 12, 12), (21, 1, 1), (40, 3, 7),
+                                      (20, 9, 8), (33, 14, 9), (22, 5, 15), (23, 20, 16),
+                                      (25, 6, 17), (20, 30, 24), (21, 4, 127), (20, 3, 128)])
 def test_the_equilibration_of_a_stack_is_the_norms_bits(n, m, nq):
     """From ``STACKED`` matrices on, ``_equilibrated`` works entry by entry along the steps
     (each row's squares summed as numpy's reduce sums a row: in order below 8, in 8 partial
