@@ -225,8 +225,11 @@ def _rank(mech, t: float, q: np.ndarray, rtol: float, rows=None, jacobian=None):
 
 
 def _scaled(mech, J: np.ndarray) -> np.ndarray:
-    """Cq with its angle columns times 1 / the length scale (``_rank``'s coordinates)."""
-    return J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
+    """Cq with its angle columns (x, y, fi of each solid) times 1 / the length scale
+    (``_rank``'s coordinates; a copy)."""
+    out = J.copy()
+    out[..., 2::3] *= 1.0 / mech.scale()
+    return out
 
 
 def _regular(mech, J: np.ndarray, rtol: float) -> bool:

@@ -189,3 +189,16 @@ def test_the_equations_residual_and_c_t_are_the_targets_bits(name):
         assert eq.residual[:, rows].tobytes() == np.broadcast_to(v.value - f,
                                                                  shape).tobytes()
         assert eq.c_t[:, rows].tobytes() == np.broadcast_to(np.negative(df), shape).tobytes()
+
+
+def test_the_rank_tests_coordinates_are_cq_times_the_length_scale_per_solid():
+    """``_scaled``: Cq's angle columns times 1 / the length scale in place of a tiled
+    (1, 1, 1/scale) row, bit for bit (−0.0 and NaN included), all_elements' 36 columns."""
+    from pathlib import Path
+    import pam2exu
+    mech = pam2exu.load(Path(__file__).resolve().parents[2] / "examples" /
+                        "all_elements.toml").mechanism()
+    J = rank.at_guess(mech, 0.0, mech.initial_q()).jacobian[0]
+    J[0, 2], J[1, 5] = -0.0, np.nan
+    tiled = J * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
+    assert rank._scaled(mech, J).tobytes() == tiled.tobytes()
