@@ -220,6 +220,25 @@ def test_csr_is_scipys_matrix_of_the_dense_array():
     assert np.array_equal(inverse.times(x, ours), inverse.times(x, theirs))
 
 
+def test_csr_of_one_pattern_shares_the_indices_and_keeps_its_own_numbers():
+    """A second matrix of one nonzero pattern (a study's next variant) gets scipy's matrix of
+    its own numbers, sharing the first's read-only index arrays; the first keeps its numbers;
+    a matrix whose zeros fall elsewhere gets its own pattern."""
+    from scipy import sparse
+    dense = np.array([[0.0, 2.5, 0.0], [-3.0, 0.0, 0.125]])
+    first = inverse.csr(dense)
+    second = inverse.csr(dense * 7.0 - 0.5 * (dense != 0))
+    theirs = sparse.csr_matrix(dense * 7.0 - 0.5 * (dense != 0))
+    for name in ("data", "indices", "indptr"):
+        assert np.array_equal(getattr(second, name), getattr(theirs, name))
+    assert second.indices is first.indices and second.indptr is first.indptr
+    assert not first.indices.flags.writeable and not first.indptr.flags.writeable
+    assert np.array_equal(first.data, [2.5, -3.0, 0.125])
+    moved = dense.copy()
+    moved[0, 1], moved[0, 0] = 0.0, 1.0
+    assert np.array_equal(inverse.csr(moved).indices, sparse.csr_matrix(moved).indices)
+
+
 @pytest.mark.parametrize("d", [1.0, -1.0])
 def test_one_revolute_incidence_is_its_own_inverse(d):
     """A pin of one revolute on one moving solid: D = [[±1]], D⁺ = D exactly (pinv's)."""

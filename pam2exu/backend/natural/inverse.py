@@ -21,6 +21,7 @@ Every quantity is an array over the steps; the solids' constants (masses, a_G, b
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,13 +68,33 @@ def times(x: np.ndarray, A) -> np.ndarray:
     return (A @ flat.T).T.reshape(x.shape[:-1] + (A.shape[0],))
 
 
+#: a CSR matrix of each nonzero pattern met last (at most ``KEPT_PATTERNS``): a study's
+#: variants share their constant matrices' patterns (the rates, the mass matrices), not their
+#: numbers
+_PATTERNS: dict = {}
+KEPT_PATTERNS = 64
+
+
 def csr(dense: np.ndarray) -> sparse.csr_matrix:
-    """A 2-D array's nonzeros as a CSR matrix, built from its arrays (row-major, columns
-    ascending: the matrix ``scipy.sparse.csr_matrix(dense)`` makes, without its COO pass)."""
+    """A 2-D array's nonzeros as a CSR matrix (row-major, columns ascending: the matrix
+    ``scipy.sparse.csr_matrix(dense)`` makes): a copy of the first matrix of the same pattern
+    with the array's own numbers, sharing its read-only index arrays (the key is the shape
+    and the nonzeros' rows and columns); scipy's constructor runs once per pattern."""
     rows, cols = np.nonzero(dense)
-    starts = np.searchsorted(rows, np.arange(dense.shape[0] + 1))
-    return sparse.csr_matrix((dense[rows, cols], cols.astype(np.int32),
-                              starts.astype(np.int32)), shape=dense.shape)
+    key = (dense.shape, rows.tobytes(), cols.tobytes())
+    like = _PATTERNS.get(key)
+    if like is None:
+        if len(_PATTERNS) >= KEPT_PATTERNS:
+            _PATTERNS.pop(next(iter(_PATTERNS)))
+        starts = np.searchsorted(rows, np.arange(dense.shape[0] + 1))
+        like = sparse.csr_matrix((dense[rows, cols], cols.astype(np.int32),
+                                  starts.astype(np.int32)), shape=dense.shape)
+        like.indices.setflags(write=False)
+        like.indptr.setflags(write=False)
+        _PATTERNS[key] = like
+    out = copy.copy(like)
+    out.data = dense[rows, cols]
+    return out
 
 
 #: ``shared_csr`` of the matrices met last (at most ``KEPT_MATRICES``): a study's variants
