@@ -249,16 +249,41 @@ def test_one_revolute_incidence_is_its_own_inverse(d):
     assert np.array_equal(_incidence_inverse(two), np.linalg.pinv(two))
 
 
-def test_incidence_inverse_is_made_once_per_incidence_and_read_only():
-    """A pin's D⁺ depends on D alone: the same entries give the same read-only array
-    (numpy.linalg.pinv's), other entries another one."""
-    from pam2exu.backend.natural.reactions import _incidence_inverse
-    D = np.array([[1.0], [-1.0]])
-    first = _incidence_inverse(D)
-    assert _incidence_inverse(D.copy()) is first and not first.flags.writeable
-    assert np.array_equal(first, np.linalg.pinv(D))
-    other = _incidence_inverse(np.array([[-1.0], [1.0]]))
-    assert other is not first and np.array_equal(other, -first)
+def _four_bar(o4=0.4, b=0.35):
+    """The four-bar with its rocker's ground pin at (o4, 0) and its coupler's B at (b, 0)."""
+    model = pam2exu.load(ROOT / "examples/four_bar.toml")
+    model["ground"].points["O4"], model["coupler"].points["B"] = [o4, 0.0], [b, 0.0]
+    return model
+
+
+def test_plans_of_one_structure_share_their_shape_and_keep_their_numbers(monkeypatch):
+    """A variant of the four-bar (another ground pin and coupler: one structure) gets the
+    first's plan shape (the same read-only index arrays and pins' incidences) with its own
+    ground points and rates, and its reactions from the shared shape are, bit for bit,
+    those of its plan made afresh."""
+    from pam2exu.backend.natural import reactions
+    from pam2exu.backend.natural.formulation import Formulation
+    monkeypatch.setattr(reactions, "_SHAPES", {})
+    runs = []
+    for fresh in (True, False):
+        if fresh:
+            reactions._SHAPES.clear()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            runs.append(pam2exu.run(_four_bar(0.41, 0.36), analysis="kinetostatic", steps=6,
+                                    backend="natural"))
+        first = reactions.plan(Formulation(_four_bar().mechanism()))
+    assert runs[1].info.reactions_from.endswith("inverse dynamics")
+    for name in ("B.Fx", "B.Fy", "motor.Mz", "base.Mz"):
+        assert np.array_equal(runs[0][name], runs[1][name]), name
+    other = reactions.plan(Formulation(_four_bar(0.41, 0.36).mechanism()))
+    assert other.rows_of is first.rows_of and other.copy_terms is first.copy_terms
+    assert not first.hat_frames[0].flags.writeable and not first.y_rows.flags.writeable
+    ground = [p for p in other.ordered_pins if p.columns is None]
+    assert [p.inverse is q.inverse for p, q in zip(ground, first.ordered_pins[2:])] == [1, 1]
+    assert [list(p.constant) for p in ground] == [[0.0, 0.0], [0.41, 0.0]]
+    assert [list(p.constant) for p in first.ordered_pins[2:]] == [[0.0, 0.0], [0.4, 0.0]]
+    assert not np.array_equal(other.rates.toarray(), first.rates.toarray())
 
 
 def _rigid_rows_made(form):

@@ -98,46 +98,92 @@ class _Pin:
     at: list | None = None
 
 
-#: ``_incidence_inverse`` of the incidences met last (at most ``KEPT_INCIDENCES``): a study's
-#: variants share their pins' incidences (entries ±1 and 0, from which solids meet where)
-_INCIDENCES: dict = {}
-KEPT_INCIDENCES = 64
-
-
 def _incidence_inverse(D: np.ndarray) -> np.ndarray:
-    """D⁺, the least-norm inverse of a pin's incidence (read-only, made once per D: the key
-    is D's shape and entries); one revolute between one moving solid and the ground,
-    D = [[±1]], is its own inverse (what ``numpy.linalg.pinv`` gives, without its SVD)."""
-    key = (D.shape, D.tobytes())
-    if key not in _INCIDENCES:
-        if len(_INCIDENCES) >= KEPT_INCIDENCES:
-            _INCIDENCES.pop(next(iter(_INCIDENCES)))
-        made = D.copy() if D.shape == (1, 1) else np.linalg.pinv(D)
-        made.setflags(write=False)
-        _INCIDENCES[key] = made
-    return _INCIDENCES[key]
+    """D⁺, the least-norm inverse of a pin's incidence; one revolute between one moving
+    solid and the ground, D = [[±1]], is its own inverse (what ``numpy.linalg.pinv`` gives,
+    without its SVD). Made once per structure (``_Shape``)."""
+    return D.copy() if D.shape == (1, 1) else np.linalg.pinv(D)
+
+
+#: the ``_Shape`` of the structures met last (at most ``KEPT_SHAPES``): a study's variants
+#: share one structure, and their plans differ only in numbers
+_SHAPES: dict = {}
+KEPT_SHAPES = 32
 
 
 class Plan:
-    """What the natural reactions need of a formulation, made once (``plan``)."""
+    """What the natural reactions need of a formulation, made once (``plan``): its numbers
+    (the element rows' terms, the rates' matrix, the ground points) and the ``_Shape`` of
+    its structure (index arrays, pins, ``copied``), shared by the plans of one structure."""
 
     def __init__(self, form: Formulation):
         mech = form.mech
         self.form, self.mech = form, mech
         self.frame_eq = eq = _FrameEquations(form)
         self.terms = Terms(eq.nz, [r[1:] for r in eq._rows])
-        self.first = form.m - len(eq._rows)            # the element rows' first row
-        self.ok = (form.nz > 0 and not eq.unshared       # nz = 0: every solid held
-                   and form.labels[self.first:] == [r[0] for r in eq._rows])
+        first = form.m - len(eq._rows)                 # the element rows' first row
+        index = {el: k for k, el in enumerate(mech.constraints)}
+        owners = tuple(index[el] for el in eq.owners)
+        points, groups = _points(form, mech.constraints, set(owners))
+        A = inverse.bodies(form).A
+        key = (len(form.frames), tuple(form.grounds), tuple(f.angle for f in form.frames),
+               form.nz, first, owners, tuple(form.rigid_owners), points,
+               tuple((el.solids, el.receiver, el.pins, el.grounds, el.holds)
+                     for el in mech.constraints), A.shape, A.tobytes())
+        shape = _SHAPES.get(key)
+        if shape is None:
+            if len(_SHAPES) >= KEPT_SHAPES:
+                _SHAPES.pop(next(iter(_SHAPES)))
+            shape = _SHAPES[key] = _Shape(form, eq, owners, points, A)
+        self.__dict__.update(shape.__dict__)            # shared: never to be changed
+        self.first = first
+        self.ok = (shape.ok and form.nz > 0 and not eq.unshared   # nz = 0: every solid held
+                   and form.labels[first:] == [r[0] for r in eq._rows])
+        self.pins = [pin if pin.columns is not None else _Pin(
+            None, np.array([vec.x.linear().get(ONE, 0.0), vec.y.linear().get(ONE, 0.0)]),
+            pin.solids, pin.revolutes, pin.inverse) for pin, vec in zip(shape.pins, groups)]
+        self.ordered_pins = [self.pins[k] for k in shape.order]
+        K = form.pose_forms()
+        self.offsets = np.concatenate([K[:, -1], np.zeros(len(self.angle_cols))])
+        Q, R = np.linalg.qr(np.vstack([K[:, :-1], shape.angles]))  # full column rank
+        self.rates = inverse.csr(np.linalg.solve(R, Q.T))           # its left inverse
+
+
+def _points(form, constraints, owned) -> tuple[tuple, list]:
+    """The shared basic points of the revolutes without rows (the pins), first met first:
+    (each pin's point's number, each point's z columns or None at a ground point) and the
+    points (``Vec``)."""
+    numbers: dict[int, int] = {}
+    groups, pins, columns = [], [], []
+    for k, el in enumerate(constraints):
+        if not el.pins or k in owned:
+            continue
+        vec = form.basic[(el.ref1.solid, tuple(el.ref1.local))]
+        if id(vec) not in numbers:
+            numbers[id(vec)] = len(groups)
+            groups.append(vec)
+            columns.append(None if vec.x.is_constant else tuple(
+                next(iter(e.linear().keys() - {ONE})) for e in (vec.x, vec.y)))
+        pins.append((k, numbers[id(vec)]))
+    return (tuple(pins), tuple(columns)), groups
+
+
+class _Shape:
+    """The parts of a plan that depend only on its structure (the key of ``_SHAPES``: the
+    solids held and their angle columns, the element rows' owners, the rigid rows' owners,
+    the pins' points, the constraint elements' solids and kinds, the solids' A), read-only;
+    the pins at ground points without their point (``Plan.pins``)."""
+
+    def __init__(self, form: Formulation, eq: _FrameEquations, owners, points, A):
+        mech = form.mech
         self.rigid = np.array(form.rigid_owners, dtype=int)
-        self.ok &= len(self.rigid) == self.first
+        self.ok = len(self.rigid) == form.m - len(eq._rows)
         self.moving = [i for i in range(len(form.frames)) if i not in form.grounds]
         self.angle_cols = {i: form.frames[i].angle for i in self.moving
                            if form.frames[i].angle is not None}
-        index = {el: k for k, el in enumerate(mech.constraints)}
         self.rows_of: dict[int, np.ndarray] = {}
-        for r, el in enumerate(eq.owners):
-            self.rows_of.setdefault(index[el], []).append(r)
+        for r, k in enumerate(owners):
+            self.rows_of.setdefault(k, []).append(r)
         self.rows_of = {k: np.array(v) for k, v in self.rows_of.items()}
         self.solids_of = [el.solids for el in mech.constraints]
         self.receivers = [el.receiver for el in mech.constraints]
@@ -152,13 +198,15 @@ class Plan:
             i: np.array([k, k + 1, k + 2, k + 3] + (
                 [] if eq.frames[i].angle is None else [eq.frames[i].angle]))
             for i, k in eq.start.items()}
-        self._pins(form, mech, index)
-        self._fixed(form, mech)
-        self._copied(form)
-        K = form.pose_forms()
-        angles = np.zeros((len(self.angle_cols), form.nz))
+        self._pins(form, mech, points)
+        held = [el.holds for el in mech.constraints if el.grounds]
+        self.ok &= len(set(held)) == len(held) and not any(   # no rows between ground solids
+            not el.grounds and all(s in form.grounds for s in el.solids)
+            for el in mech.constraints)
+        self._copied(A)
+        self.angles = np.zeros((len(self.angle_cols), form.nz))
         for r, c in enumerate(self.angle_cols.values()):
-            angles[r, c] = 1.0
+            self.angles[r, c] = 1.0
         self.angle_solids = np.array(list(self.angle_cols), dtype=int)
         # ``natural_rates``: the rows of y that are columns of q (x, y of every solid, the
         # angle coordinates), those columns, and every solid's fi column
@@ -171,56 +219,46 @@ class Plan:
         # ``_wrenches``: the columns of each constraint element's receiver's x and y
         self.receiver_columns = np.array([[column(el.receiver, k) for el in mech.constraints]
                                           for k in (0, 1)], dtype=int).reshape(2, -1)
-        self.offsets = np.concatenate([K[:, -1], np.zeros(len(self.angle_cols))])
-        Q, R = np.linalg.qr(np.vstack([K[:, :-1], angles]))       # full column rank
-        self.rates = inverse.csr(np.linalg.solve(R, Q.T))           # its left inverse
+        _frozen(list(self.__dict__.values()))
 
-    def _pins(self, form, mech, index) -> None:
-        groups: dict[int, list] = {}
-        for el in mech.constraints:
-            if not el.pins or index[el] in self.rows_of:
-                continue
-            vec = form.basic[(el.ref1.solid, tuple(el.ref1.local))]
-            groups.setdefault(id(vec), [vec, []])[1].append(el)
+    def _pins(self, form, mech, points) -> None:
+        (pins, columns), members = points, [[] for _ in points[1]]
+        for k, number in pins:
+            members[number].append(k)
         self.pins, grounded = [], {}
-        for vec, els in groups.values():
+        for cols, revolutes in zip(columns, members):
+            els = [mech.constraints[k] for k in revolutes]
             solids = sorted({s for el in els for s in el.solids if s not in form.grounds})
-            cols = None
-            if not vec.x.is_constant:
-                cols = np.array([next(iter(e.linear().keys() - {ONE})) for e in (vec.x, vec.y)])
             D = np.zeros((len(solids), len(els)))      # the force on each solid, per revolute
             for k, el in enumerate(els):
                 for r, s in enumerate(solids):
                     if s in el.solids:
                         D[r, k] = 1.0 if s == el.receiver else -1.0
-            constant = None
             if cols is None:
-                constant = np.array([vec.x.linear().get(ONE, 0.0), vec.y.linear().get(ONE, 0.0)])
                 for s in solids:
                     grounded[s] = grounded.get(s, 0) + 1
-            self.pins.append(_Pin(cols, constant, solids, [index[el] for el in els],
-                                  _incidence_inverse(D)))
+            self.pins.append(_Pin(None if cols is None else np.array(cols), None, solids,
+                                  revolutes, _incidence_inverse(D)))
         self.ok &= all(k == 1 for k in grounded.values())
         # a column point's coordinates are exactly one z column each
         self.ok &= all(p.columns is None or len(p.columns) == 2 for p in self.pins)
 
-    def _copied(self, form) -> None:
+    def _copied(self, A) -> None:
         """The columns of each solid's copy of its basic points that the reactions read (its
         column pins'), stacked solid after solid (``_wrenches``' copy, rows ``copy_rows``
         {solid: slice}), with A_s's nonzero entries there: ``copied`` {solid: (columns,
         [[(k, A_s[k, c])] per column c])}, and as rounds of one operation each: A_sᵀ W_s
         (``copy_terms``: the k-th nonzero of every column in round k, as ``_combined``) and
         the rigid-body rows' Φ_zᵀ μ (``copy_rigid``: the j-th rigid row of every solid in
-        round j); the pins, column points first (``ordered_pins``), each with the copy's rows
+        round j); the pins, column points first (``order``), each with the copy's rows
         of its columns for each of its solids (``_Pin.at``)."""
-        bd = inverse.bodies(form)
         wanted: dict[int, list] = {}
         for pin in self.pins:
             for i in pin.solids if pin.columns is not None else ():
                 wanted.setdefault(i, [])
                 wanted[i] += [c for c in pin.columns if c not in wanted[i]]
-        self.copied = {i: (np.array(cols), [[(k, bd.A[i][k, c]) for k in range(4)
-                                              if bd.A[i][k, c]] for c in cols])
+        self.copied = {i: (np.array(cols), [[(k, A[i][k, c]) for k in range(4)
+                                              if A[i][k, c]] for c in cols])
                        for i, cols in wanted.items()}
         self.copy_rows, size = {}, 0
         for i, cols in wanted.items():
@@ -248,14 +286,17 @@ class Plan:
             if pin.columns is not None:
                 pin.at = [np.array([self.copy_rows[i].start + wanted[i].index(c)
                                     for c in pin.columns]) for i in pin.solids]
-        self.ordered_pins = sorted(self.pins, key=lambda p: p.columns is None)
+        self.order = sorted(range(len(self.pins)), key=lambda k: self.pins[k].columns is None)
 
-    def _fixed(self, form, mech) -> None:
-        held = [el.holds for el in mech.constraints if el.grounds]
-        self.ok &= len(set(held)) == len(held)
-        for el in mech.constraints:
-            if not el.grounds and all(s in form.grounds for s in el.solids):
-                self.ok = False                        # between ground solids: no rows
+
+def _frozen(value) -> None:
+    """The arrays in ``value`` (through dicts, lists, tuples and pins) made read-only."""
+    if isinstance(value, np.ndarray):
+        value.setflags(write=False)
+    elif isinstance(value, (dict, list, tuple, _Pin)):
+        for v in (value.values() if isinstance(value, dict) else value.__dict__.values()
+                  if isinstance(value, _Pin) else value):
+            _frozen(v)
 
 
 def plan(form: Formulation) -> Plan:
