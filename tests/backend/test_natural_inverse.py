@@ -286,6 +286,18 @@ def test_plans_of_one_structure_share_their_shape_and_keep_their_numbers(monkeyp
     assert not np.array_equal(other.rates.toarray(), first.rates.toarray())
 
 
+@pytest.mark.parametrize("index", [[2, 3, 4], [0], [0, 2], [3, 2], []])
+def test_taken_indices_are_a_slice_where_consecutive_and_take_the_same_entries(index):
+    """The wrench pass's indices: a slice (a view) where consecutive, the array elsewhere;
+    either takes the same entries."""
+    from pam2exu.backend.natural.reactions import _taken
+    x = np.arange(30.0).reshape(6, 5)
+    taken = _taken(index)
+    consecutive = len(index) > 0 and list(index) == list(range(index[0], index[0] + len(index)))
+    assert isinstance(taken, slice) == consecutive
+    assert np.array_equal(x[taken], x[np.array(index, dtype=int)])
+
+
 def _rigid_rows_made(form):
     """Each moving solid's rigid-body rows made by ``Formulation._rigid_equations`` alone
     (every other solid taken as ground), their solid for each: the reference."""

@@ -21,7 +21,6 @@ Every quantity is an array over the steps; the solids' constants (masses, a_G, b
 """
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -92,7 +91,8 @@ def csr(dense: np.ndarray) -> sparse.csr_matrix:
         like.indices.setflags(write=False)
         like.indptr.setflags(write=False)
         _PATTERNS[key] = like
-    out = copy.copy(like)
+    out = like.__class__.__new__(like.__class__)          # a shallow copy
+    out.__dict__.update(like.__dict__)
     out.data = dense[rows, cols]
     return out
 

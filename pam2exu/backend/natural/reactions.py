@@ -61,10 +61,7 @@ class _FrameEquations(Formulation):
                 continue
             self.start[i] = n
             p, v = (Vec(Expr.coordinate(n + k), Expr.coordinate(n + k + 1)) for k in (0, 2))
-            n += 4
-            angle = None
-            if f.angle is not None:
-                angle, n = n, n + 1
+            angle, n = (None, n + 4) if f.angle is None else (n + 4, n + 5)
             frames.append(replace(f, p=p, v=v, angle=angle))
         self.frames, self.nz = frames, n
         self._rows, self.owners, self.unshared = [], [], False
@@ -94,8 +91,10 @@ class _Pin:
     solids: list
     revolutes: list               # indices into mech.constraints
     inverse: np.ndarray           # (revolutes, solids)
-    #: the rows of the point's columns in ``_wrenches``' copy, for each of its solids
+    #: the rows of the point's columns in ``_wrenches``' copy, for each of its solids, and
+    #: its columns, as ``_taken``
     at: list | None = None
+    take: slice | np.ndarray | None = None
 
 
 def _incidence_inverse(D: np.ndarray) -> np.ndarray:
@@ -181,10 +180,8 @@ class _Shape:
         self.moving = [i for i in range(len(form.frames)) if i not in form.grounds]
         self.angle_cols = {i: form.frames[i].angle for i in self.moving
                            if form.frames[i].angle is not None}
-        self.rows_of: dict[int, np.ndarray] = {}
-        for r, k in enumerate(owners):
-            self.rows_of.setdefault(k, []).append(r)
-        self.rows_of = {k: np.array(v) for k, v in self.rows_of.items()}
+        self.rows_of = {k: np.array([r for r, o in enumerate(owners) if o == k])
+                        for k in dict.fromkeys(owners)}
         self.solids_of = [el.solids for el in mech.constraints]
         self.receivers = [el.receiver for el in mech.constraints]
         # ``_chunk``: ζ̂'s columns of every moving solid's p, v (from ζ's) and angle (from z's)
@@ -199,10 +196,11 @@ class _Shape:
                 [] if eq.frames[i].angle is None else [eq.frames[i].angle]))
             for i, k in eq.start.items()}
         self._pins(form, mech, points)
-        held = [el.holds for el in mech.constraints if el.grounds]
-        self.ok &= len(set(held)) == len(held) and not any(   # no rows between ground solids
+        #: the fixed links, and the solid each holds
+        self.held = [(k, el.holds) for k, el in enumerate(mech.constraints) if el.grounds]
+        self.ok &= len({g for _, g in self.held}) == len(self.held) and not any(
             not el.grounds and all(s in form.grounds for s in el.solids)
-            for el in mech.constraints)
+            for el in mech.constraints)                     # (no rows between grounds)
         self._copied(A)
         self.angles = np.zeros((len(self.angle_cols), form.nz))
         for r, c in enumerate(self.angle_cols.values()):
@@ -280,13 +278,23 @@ class _Shape:
                 for a, c in enumerate(cols):
                     for part, value in zip(rigid[j], (first + a, r, c)):
                         part.append(value)
-        self.copy_terms = [(np.array(a), np.array(b), np.array(c)[:, None]) for a, b, c in terms]
-        self.copy_rigid = [tuple(np.array(x) for x in round_) for round_ in rigid]
+        self.copy_terms = [(_taken(a), _taken(b), np.array(c)[:, None]) for a, b, c in terms]
+        self.copy_rigid = [(_taken(a), np.array(b), np.array(c)) for a, b, c in rigid]
         for pin in self.pins:
             if pin.columns is not None:
-                pin.at = [np.array([self.copy_rows[i].start + wanted[i].index(c)
-                                    for c in pin.columns]) for i in pin.solids]
+                pin.at = [_taken([self.copy_rows[i].start + wanted[i].index(c)
+                                  for c in pin.columns]) for i in pin.solids]
+                pin.take = _taken(pin.columns)
         self.order = sorted(range(len(self.pins)), key=lambda k: self.pins[k].columns is None)
+
+
+def _taken(index) -> slice | np.ndarray:
+    """Indices as a slice where they are consecutive (a view of the same entries, cheaper
+    than taking them one by one), else as an array."""
+    index = np.asarray(index, dtype=int)
+    if len(index) and np.array_equal(index, np.arange(index[0], index[0] + len(index))):
+        return slice(int(index[0]), int(index[0]) + len(index))
+    return index
 
 
 def _frozen(value) -> None:
@@ -348,10 +356,7 @@ def _combined(rows, terms) -> np.ndarray:
     out = np.zeros((len(terms), rows.shape[-1]))
     for r, pairs in enumerate(terms):
         for number, (k, c) in enumerate(pairs):
-            if number:
-                out[r] += rows[k] * c
-            else:
-                out[r] = rows[k] * c
+            out[r] = out[r] + rows[k] * c if number else rows[k] * c
     return out
 
 
@@ -410,7 +415,7 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
     copies of the inputs): every operation runs along the steps, none along an axis of 2."""
     form, mech = pl.form, pl.mech
     n, nc = len(z), len(mech.constraints)
-    Wt, Zt = (np.ascontiguousarray(np.moveaxis(x, 0, -1)) for x in (W, zeta))  # (ns, 4, n)
+    Wt, Zt = (np.ascontiguousarray(x.transpose(1, 2, 0)) for x in (W, zeta))  # (ns, 4, n)
     mut, zt = np.ascontiguousarray(mu.T), z.T
     wrench = np.zeros((nc, 3, n))                              # about O, on the receiver
     on = {}                                                    # (element, solid) -> about O
@@ -447,17 +452,18 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
     balance = _about_origin(Zt, Wt[:, :2], Wt[:, 2:])          # (ns, 3, n)
     left = balance.copy()                                      # what the pins must give
     for (k, i), w in on.items():
-        left[i] -= w
+        if i not in form.grounds:                              # (a ground's is not read)
+            left[i] -= w
     for pin in pl.ordered_pins:                                # column points first
         if pin.columns is not None:
-            point = zt[pin.columns]
+            point = zt[pin.take]
             force = [copy[at] for at in pin.at]
             for r, i in enumerate(pin.solids):
                 left[i, :2] -= force[r]
                 left[i, 2] -= _cross(point, force[r])
         else:
             point = pin.constant
-            force = [left[i, :2].copy() for i in pin.solids]
+            force = [left[i, :2] for i in pin.solids]      # (column points done)
         for e, k in enumerate(pin.revolutes):                  # on each receiver
             w = wrench[k]
             w[:2] = _mixed(pin.inverse[e], force)
@@ -466,14 +472,12 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
                 if i in form.grounds:
                     sign = 1.0 if i == pl.receivers[k] else -1.0
                     on[(k, i)] = on.get((k, i), 0.0) + sign * w
-    for k, el in enumerate(mech.constraints):
-        if el.grounds:                                         # the held solid's balance
-            g = el.holds
-            w = balance[g].copy()
-            for (kk, i), other in on.items():
-                if i == g and kk != k:
-                    w -= other
-            wrench[k] = w
+    for k, g in pl.held:                                       # the held solid's balance
+        w = balance[g].copy()
+        for (kk, i), other in on.items():
+            if i == g and kk != k:
+                w -= other
+        wrench[k] = w
     ox, oy = origins                                           # about the receiver's origin
     wrench[:, 2] -= ox * wrench[:, 1] - oy * wrench[:, 0]
     return wrench.transpose(2, 0, 1)
