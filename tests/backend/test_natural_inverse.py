@@ -298,6 +298,28 @@ def test_taken_indices_are_a_slice_where_consecutive_and_take_the_same_entries(i
     assert np.array_equal(x[taken], x[np.array(index, dtype=int)])
 
 
+@pytest.mark.parametrize("massless", [None, "link"])
+def test_gravity_is_each_solid_s_weight_at_its_centre_of_mass(massless):
+    """Loads.gravity, made for all solids at once, is bit for bit what Loads.force gives
+    for (0, −m g) at each solid's centre of mass, solid by solid (a massless solid in
+    between: the solids are not consecutive)."""
+    from pam2exu.backend.natural.formulation import Formulation
+    from pam2exu.backend.natural.loads import Loads
+    model = _six_bar()[0]
+    if massless:
+        model[massless].mass = 0.0
+    mech = model.mechanism()
+    form = Formulation(mech)
+    made, expected = (Loads(form, np.zeros((3, form.nz)), np.zeros((3, mech.nq)))
+                      for _ in range(2))
+    made.gravity(mech.gravity)
+    for i, s in enumerate(mech.solids):
+        if float(s.mass):
+            expected.force(i, (float(s.cog[0]), float(s.cog[1])),
+                           np.tile([0.0, -float(s.mass) * mech.gravity], (3, 1)))
+    assert np.array_equal(made.Q, expected.Q) and np.any(made.Q)
+
+
 def _rigid_rows_made(form):
     """Each moving solid's rigid-body rows made by ``Formulation._rigid_equations`` alone
     (every other solid taken as ground), their solid for each: the reference."""

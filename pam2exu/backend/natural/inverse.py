@@ -122,16 +122,23 @@ def sparse_of(form, name: str, make):
     return kept[name]
 
 
+#: I and Ω (read-only)
+_EYE, _OMEGA = np.eye(2), np.array([[0.0, -1.0], [1.0, 0.0]])
+_EYE.setflags(write=False)
+_OMEGA.setflags(write=False)
+
+
 def body_mass_matrices(m, jp, a, b, d2) -> np.ndarray:
     """M_b (…, 4, 4) = [[m I, m G], [m Gᵀ, J_p / |d|² I]], G = a I + b Ω (arrays over solids)."""
-    m, jp, a, b, d2 = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (m, jp, a, b, d2)))
-    eye, omega = np.eye(2), np.array([[0.0, -1.0], [1.0, 0.0]])
-    G = (m * a)[..., None, None] * eye + (m * b)[..., None, None] * omega
-    out = np.zeros(m.shape + (4, 4))
-    out[..., :2, :2] = m[..., None, None] * eye
+    m, jp, a, b, d2 = (np.asarray(x, dtype=float) for x in (m, jp, a, b, d2))
+    if not m.shape == jp.shape == a.shape == b.shape == d2.shape:
+        m, jp, a, b, d2 = np.broadcast_arrays(m, jp, a, b, d2)
+    G = (m * a)[..., None, None] * _EYE + (m * b)[..., None, None] * _OMEGA
+    out = np.empty(m.shape + (4, 4))
+    out[..., :2, :2] = m[..., None, None] * _EYE
     out[..., :2, 2:] = G
     out[..., 2:, :2] = np.swapaxes(G, -1, -2)
-    out[..., 2:, 2:] = (jp / d2)[..., None, None] * eye
+    out[..., 2:, 2:] = (jp / d2)[..., None, None] * _EYE
     return out
 
 

@@ -102,18 +102,19 @@ class Loads:
 
     def gravity(self, g: float) -> None:
         """(0, −m g) at every solid's centre of mass: on (p, v) the same (F, a F − b Ω F) at
-        every step (``force``'s sums), added for all solids in one operation."""
-        solids, rows = [], []
+        every step (``force``'s sums), made for all solids at once and added in one
+        operation."""
+        solids, levers, weights = [], [], []
         for i, s in enumerate(self.form.mech.solids):
             if float(s.mass) and g:
-                a, b = _lever(self.form.frames[i], (float(s.cog[0]), float(s.cog[1])))
-                weight = np.array([0.0, -float(s.mass) * g])
                 solids.append(i)
-                rows.append(np.concatenate([weight, _on_v(a, b, weight)]))   # (p, v)
+                levers.append(_lever(self.form.frames[i], (float(s.cog[0]), float(s.cog[1]))))
+                weights.append([0.0, -float(s.mass) * g])
         if solids:                 # consecutive solids: a slice (no per-element indexing)
+            (a, b), weight = np.array(levers).T[:, :, None], np.array(weights)
             at = slice(solids[0], solids[-1] + 1) if solids[-1] - solids[0] == len(solids) - 1 \
                 else solids
-            self.Q[:, at] += np.array(rows)
+            self.Q[:, at] += np.concatenate([weight, _on_v(a, b, weight)], axis=1)  # (p, v)
 
     def on_coordinates(self) -> np.ndarray:
         """Q (n, nz) on the natural coordinates: Σ Pᵀ Q_p + Vᵀ Q_v over the solids."""
