@@ -91,8 +91,7 @@ class _Pin:
     solids: list
     revolutes: list               # indices into mech.constraints
     inverse: np.ndarray           # (revolutes, solids)
-    #: the rows of the point's columns in ``_wrenches``' copy, for each of its solids, and
-    #: its columns, as ``_taken``
+    #: the rows of its columns in ``_wrenches``' copy per solid, and its columns (``_taken``)
     at: list | None = None
     take: slice | np.ndarray | None = None
 
@@ -326,9 +325,9 @@ def natural_rates(pl: Plan, q, qd, qdd):
         out[pl.y_rows] = v[:, pl.y_columns].T                # x, y and the angle coordinates
     f, w, a = (v[:, pl.fi_columns].T for v in (q, qd, qdd))   # (ns, n) each
     c, s = np.cos(f), np.sin(f)
-    y[0, 2:4 * ns:4], y[0, 3:4 * ns:4] = c, s
-    y[1, 2:4 * ns:4], y[1, 3:4 * ns:4] = -s * w, c * w
-    y[2, 2:4 * ns:4], y[2, 3:4 * ns:4] = -s * a - c * w * w, c * a - s * w * w
+    y[0, 2:4 * ns:4], y[0, 3:4 * ns:4], minus_s, cw = c, s, -s, c * w
+    y[1, 2:4 * ns:4], y[1, 3:4 * ns:4] = minus_s * w, cw
+    y[2, 2:4 * ns:4], y[2, 3:4 * ns:4] = minus_s * a - cw * w, c * a - s * w * w
     y[0] -= pl.offsets[:, None]
     return tuple((pl.rates @ v).T for v in y)      # (n, nz) views, as ``inverse.times``
 
@@ -439,8 +438,9 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
             wanted = pl.frame_columns[i]
             part = np.ascontiguousarray(Jh[:, rows[:, None], wanted].transpose(1, 2, 0))
             g = _summed(weights, part)                                  # (Φ_ζ̂ᵀ μ) there
-            moment = -g[4] if len(wanted) == 5 else 0.0
-            on[(k, i)] = w = _about_origin(Zt[i], -g[0:2], -g[2:4], moment)
+            minus = -g
+            on[(k, i)] = w = _about_origin(Zt[i], minus[0:2], minus[2:4],
+                                           minus[4] if len(wanted) == 5 else 0.0)
             total += w
             if i in pl.copy_rows:          # (its angle column is no pin's)
                 copy[pl.copy_rows[i]] += _combined(g, pl.copied[i][1])
