@@ -147,12 +147,12 @@ def bodies(form) -> Bodies:
     kept = form.__dict__.setdefault("_kept", {})
     if "bodies" not in kept:
         ns, mech = len(form.frames), form.mech
-        A, c = np.zeros((ns, 4, form.nz)), np.zeros((ns, 4))
-        m, jp, a, b, d2 = (np.zeros(ns) for _ in range(5))
-        d2[:] = 1.0
+        parts = [form.affine(i, None, kind) for i in range(ns) for kind in ("p", "v")]
+        A = np.concatenate([p[0] for p in parts]).reshape(ns, 4, form.nz)
+        c = np.concatenate([p[1] for p in parts]).reshape(ns, 4)
+        m, jp, a, b, d2 = ([0.0] * ns for _ in range(5))       # numbers, made arrays below
+        d2[:] = [1.0] * ns
         for i, f in enumerate(form.frames):
-            for k, kind in enumerate(("p", "v")):
-                A[i, 2 * k:2 * k + 2], c[i, 2 * k:2 * k + 2] = form.affine(i, None, kind)
             if i in form.grounds:
                 continue
             s = mech.solids[i]
@@ -161,7 +161,7 @@ def bodies(form) -> Bodies:
             a[i], b[i] = f._ab(g)
             jp[i] = float(s.inertia) + m[i] * (g[0] ** 2 + g[1] ** 2)
             d2[i] = f.d[0] ** 2 + f.d[1] ** 2
-        kept["bodies"] = Bodies(A, c, body_mass_matrices(m, jp, a, b, d2))
+        kept["bodies"] = Bodies(A, c, body_mass_matrices(*map(np.array, (m, jp, a, b, d2))))
     return kept["bodies"]
 
 
