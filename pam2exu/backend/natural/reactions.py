@@ -103,8 +103,7 @@ def _incidence_inverse(D: np.ndarray) -> np.ndarray:
     return D.copy() if D.shape == (1, 1) else np.linalg.pinv(D)
 
 
-#: the ``_Shape`` of the structures met last (at most ``KEPT_SHAPES``): a study's variants
-#: share one structure, and their plans differ only in numbers
+#: the ``_Shape`` of the structures met last (at most ``KEPT_SHAPES``: one per study)
 _SHAPES: dict = {}
 KEPT_SHAPES = 32
 
@@ -317,19 +316,20 @@ def plan(form: Formulation) -> Plan:
 def natural_rates(pl: Plan, q, qd, qdd):
     """(z, ż, z̈) of the motion q, q̇, q̈: the least-squares solutions of K z = y − k,
     K ż = ẏ, K z̈ = ÿ, y = (x, y, cos fi, sin fi) of every solid and the angle coordinates
-    (exact: they are linear in z, ``Formulation.pose_forms``). y is built one row per
-    quantity with the steps along it, all solids' rows of a kind in one operation."""
+    (exact: linear in z, ``Formulation.pose_forms``); y, ẏ, ÿ side by side, a row per
+    quantity with the steps along it (a kind's rows of all solids at once), one product."""
     ns, n = len(pl.form.frames), len(q)
-    y = np.empty((3, 4 * ns + len(pl.angle_solids), n))
-    for out, v in zip(y, (q, qd, qdd)):
-        out[pl.y_rows] = v[:, pl.y_columns].T                # x, y and the angle coordinates
+    y = np.empty((4 * ns + len(pl.angle_solids), 3, n))
+    for k, v in enumerate((q, qd, qdd)):
+        y[pl.y_rows, k] = v[:, pl.y_columns].T                # x, y and the angle coordinates
     f, w, a = (v[:, pl.fi_columns].T for v in (q, qd, qdd))   # (ns, n) each
     c, s = np.cos(f), np.sin(f)
-    y[0, 2:4 * ns:4], y[0, 3:4 * ns:4], minus_s, cw = c, s, -s, c * w
-    y[1, 2:4 * ns:4], y[1, 3:4 * ns:4] = minus_s * w, cw
-    y[2, 2:4 * ns:4], y[2, 3:4 * ns:4] = minus_s * a - cw * w, c * a - s * w * w
-    y[0] -= pl.offsets[:, None]
-    return tuple((pl.rates @ v).T for v in y)      # (n, nz) views, as ``inverse.times``
+    y[2:4 * ns:4, 0], y[3:4 * ns:4, 0], minus_s, cw = c, s, -s, c * w
+    y[2:4 * ns:4, 1], y[3:4 * ns:4, 1] = minus_s * w, cw
+    y[2:4 * ns:4, 2], y[3:4 * ns:4, 2] = minus_s * a - cw * w, c * a - s * w * w
+    y[:, 0] -= pl.offsets[:, None]
+    out = (pl.rates @ y.reshape(len(y), 3 * n)).reshape(pl.rates.shape[0], 3, n)
+    return tuple(np.ascontiguousarray(out[:, k]).T for k in range(3))   # as ``inverse.times``
 
 
 def _about_origin(zeta, force_p, force_v, moment=0.0):
