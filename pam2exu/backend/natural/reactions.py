@@ -340,7 +340,7 @@ def _about_origin(zeta, force_p, force_v, moment=0.0):
     out[..., :2, :] = force_p
     px, py, vx, vy = (zeta[..., k, :] for k in range(4))
     fx, fy, gx, gy = force_p[..., 0, :], force_p[..., 1, :], force_v[..., 0, :], force_v[..., 1, :]
-    out[..., 2, :] = (px * fy - py * fx) + (gx * -vy + gy * vx) + moment
+    out[..., 2, :] = (px * fy - py * fx) + (gy * vx - gx * vy) + moment
     return out
 
 
