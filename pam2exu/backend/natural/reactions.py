@@ -463,7 +463,7 @@ def _wrenches(pl: Plan, z, zeta, J, Jh, W, mu, origins):
                 left[i, 2] -= _cross(point, force[r])
         else:
             point = pin.constant
-            force = [left[i, :2] for i in pin.solids]      # (column points done)
+            force = [left[i, :2] for i in pin.solids]      # (views: left is done)
         for e, k in enumerate(pin.revolutes):                  # on each receiver
             w = wrench[k]
             w[:2] = _mixed(pin.inverse[e], force)
