@@ -28,39 +28,39 @@ from ..results.extremes import clearance_columns
 from ..results.names import select_columns
 
 
-def minimum(y: np.ndarray) -> float:
-    """min_i y_i."""
-    return float(np.min(y))
+def minimum(y: np.ndarray) -> np.ndarray:
+    """min_i y_i (over the last axis: one value per row of a 2-D y)."""
+    return np.min(y, axis=-1)
 
 
-def maximum(y: np.ndarray) -> float:
+def maximum(y: np.ndarray) -> np.ndarray:
     """max_i y_i."""
-    return float(np.max(y))
+    return np.max(y, axis=-1)
 
 
-def absmax(y: np.ndarray) -> float:
+def absmax(y: np.ndarray) -> np.ndarray:
     """max_i |y_i|."""
-    return float(np.max(np.abs(y)))
+    return np.max(np.abs(y), axis=-1)
 
 
-def mean(y: np.ndarray) -> float:
+def mean(y: np.ndarray) -> np.ndarray:
     """(1/n) Σ_i y_i."""
-    return float(np.mean(y))
+    return np.mean(y, axis=-1)
 
 
-def rms(y: np.ndarray) -> float:
+def rms(y: np.ndarray) -> np.ndarray:
     """sqrt((1/n) Σ_i y_i²)."""
-    return float(np.sqrt(np.mean(np.square(y))))
+    return np.sqrt(np.mean(np.square(y), axis=-1))
 
 
-def final(y: np.ndarray) -> float:
+def final(y: np.ndarray) -> np.ndarray:
     """y_n: the last row (t = t_end)."""
-    return float(y[-1])
+    return y[..., -1]
 
 
-def spread(y: np.ndarray) -> float:
+def spread(y: np.ndarray) -> np.ndarray:
     """max_i y_i − min_i y_i."""
-    return float(np.max(y) - np.min(y))
+    return np.max(y, axis=-1) - np.min(y, axis=-1)
 
 
 # ---- first order: ∂(reduction)/∂p from the series' ∂y/∂p (the linear method) -------------
@@ -105,15 +105,17 @@ def d_spread(y: np.ndarray, dy: np.ndarray) -> np.ndarray:
 
 
 class Reduction(NamedTuple):
-    """One reduction: its value over a run's rows, and its first-order derivative from
-    the series' ∂y/∂p (the linear method). Called, it gives its value."""
+    """One reduction: its value over a run's rows (the last axis: several outputs' series
+    at once, one per row of a 2-D array, each reduced as alone: the same bits), and its
+    first-order derivative from the series' ∂y/∂p (the linear method). Called on one
+    series, it gives its value as a float."""
 
-    value: Callable[[np.ndarray], float]
+    value: Callable[[np.ndarray], np.ndarray]
     derivative: Callable[[np.ndarray, np.ndarray], np.ndarray]
 
     def __call__(self, y: np.ndarray) -> float:
-        """The reduction of the rows y."""
-        return self.value(y)
+        """The reduction of the rows y (n,)."""
+        return float(self.value(y))
 
 
 #: the reductions of a variant's output column, by the name a study file gives them, in
@@ -243,15 +245,20 @@ def reduce_run(results, outputs=None, reductions=tuple(REDUCTIONS)) -> dict[str,
     """
     reductions = check_reductions(reductions)
     columns = output_columns(results.columns, outputs)
+    if not columns:
+        return {}
     absolute = set(clearance_columns(results))
+    y = np.array([results[column] for column in columns], dtype=float)   # one row each
+    magnitudes = [i for i, column in enumerate(columns) if column in absolute]
+    if magnitudes:
+        y[magnitudes] = np.abs(y[magnitudes])
+    unknown = np.isnan(y).any(axis=1)              # never dropped: every reduction NaN
+    with np.errstate(invalid="ignore"):
+        values = {r: REDUCTIONS[r].value(y) for r in reductions}
     out = {}
-    for column in columns:
-        y = np.asarray(results[column], dtype=float)
-        if column in absolute:
-            y = np.abs(y)
-        unknown = bool(np.isnan(y).any())          # never dropped: every reduction NaN
+    for i, column in enumerate(columns):
         for r in reductions:
-            out[reduced_name(column, r)] = np.nan if unknown else REDUCTIONS[r](y)
+            out[reduced_name(column, r)] = np.nan if unknown[i] else float(values[r][i])
     return out
 
 

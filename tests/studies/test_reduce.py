@@ -36,6 +36,23 @@ def test_the_seven_reductions_are_the_contracts_in_its_order():
                for reduction in REDUCTIONS.values() for f in reduction)
 
 
+def test_several_series_at_once_are_each_reduced_as_alone():
+    """A reduction of a 2-D array (``Reduction.value``, what ``reduce_run`` takes for all
+    of a run's outputs at once) gives each row's reduction bit for bit (numpy sums a
+    contiguous row in the same order alone or as a row of a table), at lengths across
+    the pairwise summation's block edges, with NaN rows and scales from 1e-5 to 1e5."""
+    rng = np.random.default_rng(7)
+    for n in (1, 2, 7, 8, 9, 101, 127, 128, 129, 1000):
+        y = rng.normal(size=(5, n)) * 10.0 ** rng.integers(-5, 6, size=(5, 1))
+        y[3, n // 2] = np.nan
+        for name, reduction in REDUCTIONS.items():
+            with np.errstate(invalid="ignore"):
+                rows = reduction.value(y)
+            alone = [reduction(row) for row in y]
+            assert rows.shape == (5,)
+            assert np.array_equal(rows, alone, equal_nan=True), (name, n)
+
+
 def test_each_reduction_equals_the_computation_by_hand():
     rng = np.random.default_rng(24)
     t = np.linspace(0.0, 1.0, 11)
