@@ -21,7 +21,7 @@ import numpy as np
 
 from ..elements.base import Load
 from ..errors import TranslationError
-from ..complex_step import scalar
+from ..complex_step import as_array, scalar
 from ..kinematics import State, column, generalized_force, move_wrench, pose, to_basis
 from . import native
 
@@ -38,16 +38,25 @@ def gravity(mech, st: State, forces: bool = True) -> Load:
     """Weight (0, −m g) at each solid's G; V = Σ m g y_G (``forces=False``: V alone, the
     generalized forces left empty)."""
     force, potential = {}, np.zeros(st.n, st.q.dtype)     # complex in the complex step
-    at = st if forces else st.values_only()
     for i, s in enumerate(mech.solids):
         m = scalar(s.mass)
         if m.real > 0 and mech.gravity:
-            G = at.point(i, [scalar(c) for c in s.cog])
             if forces:
+                G = st.point(i, [scalar(c) for c in s.cog])
                 weight = np.broadcast_to([0.0, -m * mech.gravity], (st.n, 2))
                 force.update(generalized_force(G, weight))
-            potential += m * mech.gravity * G.value[:, 1]
+                y = G.value[:, 1]
+            else:
+                y = height(st, i, as_array([scalar(c) for c in s.cog]))
+            potential += m * mech.gravity * y
     return Load(force, {}, potential)
+
+
+def height(st: State, solid: int, local) -> np.ndarray:
+    """y_G (n,) = (sin fi sx + cos fi sy) + y of the point s of a solid: ``State.point``'s
+    y, the same products and sums, without its x and its Quantity."""
+    c, s = st.trig(solid)
+    return (s * local[0] + c * local[1]) + st.q[:, column(solid, 1)]
 
 
 @dataclass
