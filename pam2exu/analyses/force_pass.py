@@ -343,10 +343,10 @@ def reported_wrenches(mech, st: State, wrenches: np.ndarray) -> np.ndarray:
     order, moved to the reporting points and turned into the reporting bases."""
     if not mech.constraints:
         return np.array(wrenches, dtype=float)
-    at = st.values_only()
-    frames = [el.report_frame(at) for el in mech.constraints]
-    point = np.stack([f[0] for f in frames], axis=1)                     # (n, constraints, 2)
-    direction = np.stack([f[1] for f in frames], axis=1)
+    at, shape = st.values_only(), (st.n, len(mech.constraints), 2)
+    frames = [el.report_frame(at) for el in mech.constraints]   # (n, 2) each: side by side
+    point = np.concatenate([f[0] for f in frames], axis=1).reshape(shape)
+    direction = np.concatenate([f[1] for f in frames], axis=1).reshape(shape)
     origin = st.q[:, [[column(el.receiver, 0), column(el.receiver, 1)]
                       for el in mech.constraints]]
     return to_basis(move_wrench(wrenches, origin, point), direction)
