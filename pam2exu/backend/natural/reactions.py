@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...kinematics import ANGLES, column, cross
+from ...kinematics import column
 from ..base import Reactions
 from . import inverse
 from .forms import ONE, Expr, Vec
