@@ -268,21 +268,40 @@ def _in_degrees(limit: float, unit: str) -> tuple[float, str]:
     return limit, unit
 
 
+#: ``_SOLID_NUMBERS`` of a model written in degrees (``_in_degrees``)
+_SOLID_NUMBERS_DEG = tuple((key, *_in_degrees(limit, unit))
+                           for key, limit, unit in _SOLID_NUMBERS)
+
+
+def _within(v, limit: float) -> bool:
+    """|v| ≤ limit for a plain float or int (not a bool): a number with nothing to report
+    (NaN and ±inf are not within; anything else goes through the full checks)."""
+    return type(v) in (float, int) and -limit <= v <= limit
+
+
+def _fine_pair(p) -> bool:
+    """[x, y] of two numbers within the range of lengths: nothing to report."""
+    return (type(p) in (list, tuple) and len(p) == 2 and _within(p[0], limits.LENGTH)
+            and _within(p[1], limits.LENGTH))
+
+
 def solid_problems(s: Solid, degrees: bool = False) -> list[str]:
     """Every problem with a solid's values (``Model.problems`` puts them under its place);
     ``degrees``: the model's angles are in degrees (``[model] angles``), and so are the
     messages' units and the range of angles."""
-    out = []
-    for key, limit, unit in _SOLID_NUMBERS:
+    out, negative = [], []
+    for key, limit, unit in _SOLID_NUMBERS_DEG if degrees else _SOLID_NUMBERS:
         value = getattr(s, key)
-        if not is_number(value):
-            out.append(f"{key} must be a number, got {echo(value)}")
-        out += range_problems(key, value, *(_in_degrees(limit, unit) if degrees
-                                           else (limit, unit)))
-    for key in ("mass", "inertia"):
-        if is_number(getattr(s, key)) and getattr(s, key) < 0:
-            out.append(f"{key} is negative ({getattr(s, key)}): it must be ≥ 0")
-    if not _pair(s.cog):
+        if not _within(value, limit):          # (within: the usual case, nothing to report)
+            if not is_number(value):
+                out.append(f"{key} must be a number, got {echo(value)}")
+            out += range_problems(key, value, limit, unit)
+        if key in ("mass", "inertia") and is_number(value) and value < 0:
+            negative.append(f"{key} is negative ({value}): it must be ≥ 0")
+    out += negative
+    if _fine_pair(s.cog):
+        pass
+    elif not _pair(s.cog):
         out.append(f"cog must be [x, y] in the local frame, got {echo(s.cog)}")
     else:
         out += _point_range("cog", s.cog)
@@ -290,6 +309,8 @@ def solid_problems(s: Solid, degrees: bool = False) -> list[str]:
         out.append(f"points must be a table {{ A = [x, y] }}, got {echo(s.points)}")
     else:
         for name, p in s.points.items():
+            if _fine_pair(p):
+                continue
             if not _pair(p):
                 out.append(f"point {echo(name)} must be [x, y], got {echo(p)}")
             else:

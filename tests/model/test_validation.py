@@ -1063,3 +1063,25 @@ def test_a_point_of_an_integer_too_large_for_a_float_is_reported_not_raised():
     found = [str(p) for p in m.problems()]
     assert "[[solid]] #1 'ground': point 'O' must be [x, y], got [0, " in found[0]
     assert any("point 'O' of solid 'ground' is not [x, y]" in p for p in found)
+
+
+def test_solid_problems_each_value_once_in_order():
+    """Numbers in range (floats, ints) say nothing, the others their problem, in the order
+    of the keys, negative mass and inertia after them, then cog, points, lines."""
+    from pam2exu.model.solid import solid_problems
+    s = Solid("a", x=3, y=True, fi=float("nan"), mass=-1.0, inertia=-2, Dx=1e30, Dy=-5e9,
+              cog=[1e9, True], points={"A": [0, 2e7], "B": (1.0, 2.0, 3.0), "C": [-1, 2]},
+              lines={"l": {"point": [1e9, 0], "angle": 1e9}})
+    limit = "its magnitude must be at most"
+    assert solid_problems(s) == [
+        "y must be a number, got True", "fi must be a number, got nan",
+        f"Dx = 1e+30 m/s is out of range: {limit} 1e+12 m/s (are the units right?)",
+        "mass is negative (-1.0): it must be ≥ 0", "inertia is negative (-2): it must be ≥ 0",
+        "cog must be [x, y] in the local frame, got [1000000000.0, True]",
+        f"point 'A' y = 2e+07 m is out of range: {limit} 1e+06 m (are the units right?)",
+        "point 'B' must be [x, y], got (1.0, 2.0, 3.0)",
+        f"line 'l' point x = 1e+09 m is out of range: {limit} 1e+06 m (are the units right?)",
+        f"line 'l' angle = 1e+09 rad is out of range: {limit} 1e+07 rad (are the units "
+        "right?)"]
+    assert solid_problems(Solid("c", x=10**400, mass=-3, cog=[1, 2]), degrees=True)[1:] == [
+        "mass is negative (-3): it must be ≥ 0"]
