@@ -244,3 +244,20 @@ def test_from_q_of_an_assembled_pose_is_on_the_constraints_with_a_ground_point_a
     names = [c.name for c in form.coordinates]
     assert z[0, names.index("crank.fi")] == q[0, column(1, 2)] == pytest.approx(0.0)
     assert np.max(np.abs(form.terms.residual(np.zeros(1), z))) < 1e-12
+
+
+def test_pose_forms_are_the_frames_origins_and_axes_as_linear_forms():
+    """K [z; 1] = (x, y, cos fi, sin fi) per solid: K's rows hold, bit for bit, the
+    coefficients of each frame's ``origin()`` and ``cos_sin()`` expressions."""
+    from pam2exu.backend.natural.forms import ONE
+    from pam2exu.backend.natural.formulation import Formulation
+    root = Path(__file__).parents[2] / "examples"
+    for name in ("all_elements.toml", "slider_crank.toml"):
+        f = Formulation(pam2exu.load(root / name).mechanism(), all_angles=True)
+        K = np.zeros((4 * len(f.frames), f.nz + 1))
+        for k, frame in enumerate(f.frames):
+            o, (c, s) = frame.origin(), frame.cos_sin()
+            for r, e in enumerate((o.x, o.y, c, s)):
+                for i, v in e.linear().items():
+                    K[4 * k + r, f.nz if i == ONE else i] += v
+        assert f.pose_forms().tobytes() == K.tobytes()
