@@ -54,22 +54,26 @@ class Frame:
     def point(self, local) -> Vec:
         """r(s) = p + a v + b Ω v: the point s (local) of the solid."""
         a, b = self._ab((local[0] - self.sp[0], local[1] - self.sp[1]))
-        return self._plus(self.p + Vec(Expr(), Expr()), a, b)
+        return self._plus(self.p, a, b)
 
     def direction(self, local) -> Vec:
         """A u = a v + b Ω v: the local vector u of the solid in the global basis."""
         a, b = self._ab(local)
-        return self._plus(Vec(Expr(), Expr()), a, b)
+        return self._plus(None, a, b)
 
-    def _plus(self, out: Vec, a: float, b: float) -> Vec:
-        """out + a v + b Ω v, a term whose coefficient is 0 left out and a coefficient 1 not
-        multiplied (the same sums: such a term adds nothing, c · 1 is c)."""
+    def _plus(self, out: Vec | None, a: float, b: float) -> Vec:
+        """out + a v + b Ω v (out None: 0), a term whose coefficient is 0 left out, a
+        coefficient 1 not multiplied, and 0 + e taken as e (the same sums: such a term adds
+        nothing, c · 1 is c, 0 + c is c; expressions are never changed once made, so the
+        result may share the frame's)."""
         if a:
-            out = out + (self.v if a == 1.0 else self.v * a)
+            term = self.v if a == 1.0 else self.v * a
+            out = term if out is None else out + term
         if b:
             perp = self.v.perp()
-            out = out + (perp if b == 1.0 else perp * b)
-        return out
+            term = perp if b == 1.0 else perp * b
+            out = term if out is None else out + term
+        return Vec(Expr(), Expr()) if out is None else out
 
     def cos_sin(self) -> tuple[Expr, Expr]:
         """(cos fi, sin fi) = (d·v, d×v) / |d|²: linear in z."""
