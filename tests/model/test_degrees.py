@@ -247,3 +247,23 @@ def test_range_messages_of_a_degrees_model_are_in_degrees():
                   .replace("1e10", "0"))
     with pytest.raises(pam2exu.ModelError, match="fi = 1e\\+09 rad is out of range"):
         pam2exu.loads(text.format(a="rad"))
+
+
+def test_radians_model_inputs_are_shallow_copies_of_every_element_and_variation():
+    """``si_inputs`` of a radians model: new objects of the same class with the same
+    attribute values (``copy.copy``'s), the model's own left alone."""
+    import copy
+    from pathlib import Path
+    import pam2exu
+    from pam2exu.model.angles import si_inputs
+    root = Path(__file__).parents[2] / "examples"
+    for name in ("all_elements.toml", "clearance/locomotive.toml"):
+        model = pam2exu.load(root / name)
+        solids, elements, variations = si_inputs(model)
+        assert solids == model.solids
+        for mine, theirs in zip(elements + variations, model.elements + model.variations):
+            assert mine is not theirs and type(mine) is type(theirs)
+            assert vars(mine) == vars(copy.copy(theirs))
+            assert all(vars(mine)[k] is v for k, v in vars(theirs).items())
+        assert len(elements) == len(model.elements) > 5
+    assert len(variations) == 2                     # (the locomotive's)
