@@ -28,15 +28,15 @@ def model_problems(model) -> list[Problem]:
     elif len(model.name) > limits.MODEL_NAME:
         out.append(Problem("[model]", f"name is {len(model.name)} characters long: at most "
                                       f"{limits.MODEL_NAME} are allowed"))
-    seen: dict[str, str] = {}
+    seen: dict = {}
     for solid in model.solids:
         out += [Problem(solid.where, m)
                 for m in solid_problems(solid, degrees=model.angles == "deg")]
-        _unique(solid.name, solid.where, seen, out)
+        _unique(solid, seen, out)
     scope = Scope(model.solids)
     scope.elements = model.elements
     for el in model.elements:
-        _unique(el.name, el.where, seen, out)
+        _unique(el, seen, out)
         out += [Problem(el.where, m) for m in el.problems(scope)]
     out += [Problem(*p) for p in variation_problems(model.variations, scope,
                                                      model.elements)[0]]
@@ -54,16 +54,19 @@ def model_warnings(model) -> list[Problem]:
                                                      model.elements)[1]]
 
 
-def _unique(name, where, seen, out):
-    """A problem when ``name`` is no valid name or is ``seen`` already (solids and elements
-    share one namespace); else ``seen[name] = where``."""
+def _unique(item, seen, out):
+    """A problem when the name of ``item`` (a solid or an element) is no valid name or is
+    ``seen`` already (solids and elements share one namespace); else ``seen[name] = item``
+    (its ``where`` made only for a message)."""
+    name = item.name
     problem = limits.name_problem(name)
     if problem:
-        out.append(Problem(where, problem))
+        out.append(Problem(item.where, problem))
         if not isinstance(name, str) or len(name) > limits.NAME:
             return
     if name in seen:
-        out.append(Problem(where, f"name '{name}' is already used by {seen[name]}: "
-                                  "solids and elements share one namespace, rename one of them"))
+        out.append(Problem(item.where, f"name '{name}' is already used by {seen[name].where}: "
+                                       "solids and elements share one namespace, rename one "
+                                       "of them"))
     else:
-        seen[name] = where
+        seen[name] = item
