@@ -109,6 +109,18 @@ class Frame:
             _into(ry, self.v.x, nz, k)
 
 
+def _alone(e: Expr) -> int | None:
+    """k where the linear form e is z_k alone (coefficient 1), else None (a constant 1.0,
+    a ground point's, is no coordinate)."""
+    if len(e.products) != 1 or e.sines:
+        return None
+    ((a, b), c), = e.products.items()
+    if a != ONE and b != ONE:
+        raise ValueError("not a linear form")
+    k = a if b == ONE else b
+    return k if c == 1.0 and k != ONE else None
+
+
 def _into(row: list, e: Expr, nz: int, k: float | None = None, negated: bool = False) -> None:
     """row[i] += (−1 ·) c (· k) for each term c z_i of the linear form e (the constant's
     column nz): the products ``Expr`` arithmetic takes, in its order."""
@@ -387,12 +399,10 @@ class Formulation:
 
             def place(vec: Vec, what, loc):
                 for e, name in zip((vec.x, vec.y), what):
-                    lin = e.linear()
-                    if len(lin) == 1 and next(iter(lin.values())) == 1.0:
-                        k = next(iter(lin))
-                        if k != ONE and not placed[k]:     # (ONE: a ground point's 1.0)
-                            writes.append((k, name, loc))
-                            placed[k] = True
+                    k = _alone(e)
+                    if k is not None and not placed[k]:
+                        writes.append((k, name, loc))
+                        placed[k] = True
 
             for loc, vec in self.own.get(i, []):
                 place(vec, ("x", "y"), loc)
