@@ -99,20 +99,11 @@ def si_inputs(model) -> tuple[list[Solid], list[Element], list[Variation]]:
     90.0
     """
     if model.angles != "deg":
-        return (list(model.solids), [_copied(e) for e in model.elements],
-                [_copied(v) for v in model.variations])
+        return (list(model.solids), [copy.copy(e) for e in model.elements],
+                [copy.copy(v) for v in model.variations])
     return ([solid_in_radians(s) for s in model.solids],
             [element_in_radians(e) for e in model.elements],
             [variation_in_radians(v) for v in model.variations])
-
-
-def _copied(obj):
-    """``copy.copy`` of an element or a variation (plain classes: no ``__slots__``,
-    ``__copy__`` or ``__setstate__``): a new instance of its class with the same attributes,
-    without ``copy``'s protocol look-ups."""
-    new = object.__new__(type(obj))
-    new.__dict__.update(obj.__dict__)
-    return new
 
 
 def angles_problem(angles) -> str | None:

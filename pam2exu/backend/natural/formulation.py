@@ -84,54 +84,6 @@ class Frame:
         """The solid's frame origin (x, y) = r(0)."""
         return self.point((0.0, 0.0))
 
-    def pose_rows(self, nz: int) -> list[list[float]]:
-        """(x, y, cos fi, sin fi) = r(0) and A (1, 0) as four rows of coefficients of
-        [z; 1] (``Formulation.pose_forms``): the sums of ``origin`` and ``cos_sin`` term
-        after term, in their order, without making their expressions."""
-        rows = [[0.0] * (nz + 1) for _ in range(4)]
-        ox, oy, c, s = rows
-        _into(ox, self.p.x, nz)
-        _into(oy, self.p.y, nz)
-        self._plus_into(ox, oy, *self._ab((0.0 - self.sp[0], 0.0 - self.sp[1])), nz)
-        self._plus_into(c, s, *self._ab((1.0, 0.0)), nz)
-        return rows
-
-    def _plus_into(self, rx: list, ry: list, a: float, b: float, nz: int) -> None:
-        """rows += a v + b Ω v, Ω v = (−v_y, v_x) (``_plus``'s terms: 0 left out, 1 not
-        multiplied)."""
-        if a:
-            k = None if a == 1.0 else a
-            _into(rx, self.v.x, nz, k)
-            _into(ry, self.v.y, nz, k)
-        if b:
-            k = None if b == 1.0 else b
-            _into(rx, self.v.y, nz, k, negated=True)
-            _into(ry, self.v.x, nz, k)
-
-
-def _alone(e: Expr) -> int | None:
-    """k where the linear form e is z_k alone (coefficient 1), else None (a constant 1.0,
-    a ground point's, is no coordinate)."""
-    if len(e.products) != 1 or e.sines:
-        return None
-    ((a, b), c), = e.products.items()
-    if a != ONE and b != ONE:
-        raise ValueError("not a linear form")
-    k = a if b == ONE else b
-    return k if c == 1.0 and k != ONE else None
-
-
-def _into(row: list, e: Expr, nz: int, k: float | None = None, negated: bool = False) -> None:
-    """row[i] += (−1 ·) c (· k) for each term c z_i of the linear form e (the constant's
-    column nz): the products ``Expr`` arithmetic takes, in its order."""
-    for (i, j), c in e.products.items():
-        if j != ONE and i != ONE:
-            raise ValueError("not a linear form")
-        col = i if j == ONE else j
-        if negated:
-            c = c * -1.0
-        row[nz if col == ONE else col] += c if k is None else c * k
-
 
 class _Recorder:
     """The first reading of the elements' declarations: which solids are ground, which
@@ -362,8 +314,16 @@ class Formulation:
         return self._pose_forms.copy()
 
     def _make_pose_forms(self) -> np.ndarray:
-        rows = [r for f in self.frames for r in f.pose_rows(self.nz)]
-        return np.array(rows, dtype=float).reshape(len(rows), self.nz + 1)
+        rows = []
+        for f in self.frames:
+            c, s = f.cos_sin()
+            o = f.origin()
+            rows += [o.x, o.y, c, s]
+        K = np.zeros((len(rows), self.nz + 1))
+        for r, e in enumerate(rows):
+            for i, c in e.linear().items():
+                K[r, self.nz if i == ONE else i] += c
+        return K
 
     def from_q(self, q: np.ndarray) -> np.ndarray:
         """z (n, nz) of configurations q (n, nq): each coordinate from the first solid that
@@ -399,10 +359,12 @@ class Formulation:
 
             def place(vec: Vec, what, loc):
                 for e, name in zip((vec.x, vec.y), what):
-                    k = _alone(e)
-                    if k is not None and not placed[k]:
-                        writes.append((k, name, loc))
-                        placed[k] = True
+                    lin = e.linear()
+                    if len(lin) == 1 and next(iter(lin.values())) == 1.0:
+                        k = next(iter(lin))
+                        if k != ONE and not placed[k]:     # (ONE: a ground point's 1.0)
+                            writes.append((k, name, loc))
+                            placed[k] = True
 
             for loc, vec in self.own.get(i, []):
                 place(vec, ("x", "y"), loc)

@@ -95,6 +95,7 @@ def quintic_hermite(u, h):
     return (1 - far, h * (u - 6 * u3 + 8 * u4 - 3 * u5), 0.5 * h * h * (u2 - 3 * u3 + 3 * u4 - u5),
             far, h * (-4 * u3 + 7 * u4 - 3 * u5), 0.5 * h * h * (u3 - 2 * u4 + u5))
 
+
 @dataclass
 class NaturalSettings:
     """Settings of the natural-coordinate Newton solver.
