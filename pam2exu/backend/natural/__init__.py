@@ -25,6 +25,7 @@ from .anchored import anchored
 from .reactions import constraint_wrenches
 from .solver import MAX_SUBSTEPS, NaturalSettings, Solver
 from .variants import Answered, Stack, solve, stackable, structure
+from . import population
 from .statics import Statics, pose_distance
 
 __all__ = ["Natural", "NaturalSettings", "Formulation", "Frame", "Coordinate"]
@@ -82,7 +83,8 @@ class Natural(Backend):
             given = self.answered.positions(form, times, start, w, settings.tolerance)
             if given is not None:
                 z, zd, zdd = given
-                return self._found(form, mech, times, start, z, forces, rates, zd, zdd)
+                return self._found(form, mech, times, start, z, forces, rates, zd, zdd,
+                                   converted=self.answered.converted(len(z), start))
         solver = Solver(form.terms, w, settings, least_squares=redundant)
         n = len(times)
         q = np.full((n, mech.nq), np.nan)
@@ -145,13 +147,15 @@ class Natural(Backend):
         return z0
 
     def _found(self, form, mech, times, start, z, forces, rates, zd, zdd, error=None,
-               iterations=0) -> Positions:
+               iterations=0, converted=None) -> Positions:
         """The ``Positions`` of the solved steps z (the first len(z) of ``times``): x, y,
-        fi, with ``rates`` their rates from ż, z̈, with ``forces`` the multipliers."""
+        fi, with ``rates`` their rates from ż, z̈, with ``forces`` the multipliers;
+        ``converted``: (q, q̇, q̈) of z already (the pass's)."""
         n, solved = len(times), len(z)
         q = np.full((n, mech.nq), np.nan)
         with_rates = rates and solved
-        converted = self._converted(form, mech, z, start, zd if with_rates else None, zdd)
+        if converted is None:
+            converted = self._converted(form, mech, z, start, zd if with_rates else None, zdd)
         q[:solved] = converted[0]
         found = Positions(q, solved, error, q[solved - 1], iterations=iterations)
         if with_rates:
@@ -181,12 +185,37 @@ class Natural(Backend):
                           [self.weights(f, mechs[i]) for f, i in zip(forms, members)], times)
             z0 = np.stack([f.from_q(g)[0] for f, g in zip(forms, guesses)], axis=1)
             found = solve(stack, z0, settings.tolerance, settings.max_iterations)
-            for j, i in enumerate(members):
-                if found.solved[j] == len(times):
-                    z, zd, zdd = (np.ascontiguousarray(a) for a in found.variant(j))
-                    out[i] = Natural(Answered(times, guesses[j], z, zd, zdd))
-                    out[i]._forms[(id(mechs[i]), False)] = (mechs[i], forms[j])
+            done = np.flatnonzero(found.solved == len(times))
+            group, poses = self._group([forms[j] for j in done], times,
+                                       *(a[:, :, done] for a in (found.z, found.zd, found.zdd)),
+                                       np.stack([guesses[j] for j in done], axis=1)
+                                       if done.size else None)
+            for k, j in enumerate(done):
+                i = members[j]
+                z, zd, zdd = (np.ascontiguousarray(a) for a in found.variant(j))
+                answer = Answered(times, guesses[j], z, zd, zdd)
+                if poses is not None:
+                    answer.q, answer.qd, answer.qdd = (p[k] for p in poses)
+                    answer.group, answer.index = group, k
+                out[i] = Natural(answer)
+                out[i]._forms[(id(mechs[i]), False)] = (mechs[i], forms[j])
         return out
+
+    def _group(self, forms, times, z, zd, zdd, guesses):
+        """(``population.Group``, (q, q̇, q̈) each (V, n, nq)) of the variants solved to the
+        end, or (None, None) when there are none or their angles are not of one kind (each
+        run converts its own)."""
+        if not forms:
+            return None, None
+        kinds = [self._angle_kinds(f) for f in forms]
+        first = kinds[0]
+        if any(not all(np.array_equal(a, b) for a, b in zip(vars(k).values(),
+                                                                vars(first).values()))
+               for k in kinds[1:]):
+            return None, None
+        K = np.stack([f.pose_forms() for f in forms], axis=2)
+        poses = population.poses(first, K, guesses, z, zd, zdd)
+        return population.Group(forms, times, z, zd, zdd, poses[0]), poses
 
     def _anchored(self, form, mech, t0, z_start, settings, w):
         """The assembly with free degrees of freedom: nearest the model's x, y, fi (the same
@@ -244,8 +273,12 @@ class Natural(Backend):
         """See ``Backend.reactions``: M z̈ + Φ_zᵀ μ = Q with the constant mass matrix, the
         reactions from μ and each solid's equilibrium at the shared basic points
         (``reactions``); None in the cases that module names."""
-        return constraint_wrenches(self.formulation(mech), np.asarray(times, dtype=float), q, qd,
-                                   qdd, redundant)
+        times = np.asarray(times, dtype=float)
+        if self.answered is not None and not redundant:
+            given = self.answered.reactions(times, q, qd, qdd)
+            if given is not None:            # made with the other variants of its pass
+                return given
+        return constraint_wrenches(self.formulation(mech), times, q, qd, qdd, redundant)
 
     # ---- back to x, y, fi ---------------------------------------------------------------------
     def to_q(self, form: Formulation, mech, z: np.ndarray, start: np.ndarray) -> np.ndarray:
@@ -306,10 +339,16 @@ class Natural(Backend):
     @staticmethod
     def _chunk_rates(kind, K, pose, zdT, zddT, qdT, qddT) -> None:
         """q̇, q̈ of a chunk into qdT, qddT (views) from its pose and ż, z̈."""
-        f = kind.free
         # K [ż; 0]: a row's sum ends with + c·0 = ±0, which changes no sum (one matrix
         # for x, y, cos, sin and their rates)
         d1, d2 = K @ extended(zdT, 0.0), K @ extended(zddT, 0.0)
+        Natural._pose_rates(kind, pose, d1, d2, zdT, zddT, qdT, qddT)
+
+    @staticmethod
+    def _pose_rates(kind, pose, d1, d2, zdT, zddT, qdT, qddT) -> None:
+        """q̇, q̈ into qdT, qddT (views) from the pose, its rates d1 = K [ż; 0] and
+        d2 = K [z̈; 0] (x, y, cos, sin of each solid: one row each), and ż, z̈."""
+        f = kind.free
         for out, d in ((qdT, d1), (qddT, d2)):
             out[0::PER_SOLID], out[1::PER_SOLID] = d[0::4], d[1::4]
         w, a = qdT[2::PER_SOLID], qddT[2::PER_SOLID]

@@ -31,6 +31,7 @@ ground solids only, two fixed links on one solid.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -141,10 +142,18 @@ class Plan:
             None, np.array([vec.x.linear().get(ONE, 0.0), vec.y.linear().get(ONE, 0.0)]),
             pin.solids, pin.revolutes, pin.inverse) for pin, vec in zip(shape.pins, groups)]
         self.ordered_pins = [self.pins[k] for k in shape.order]
-        K = form.pose_forms()
-        self.offsets = np.concatenate([K[:, -1], np.zeros(len(self.angle_cols))])
-        Q, R = np.linalg.qr(np.vstack([K[:, :-1], shape.angles]))  # full column rank
-        self.rates = inverse.csr(np.linalg.solve(R, Q.T))           # its left inverse
+
+    @cached_property
+    def offsets(self) -> np.ndarray:
+        """k of y = K z + k (``natural_rates``): the pose forms' constants, 0 for the angles."""
+        return np.concatenate([self.form.pose_forms()[:, -1], np.zeros(len(self.angle_cols))])
+
+    @cached_property
+    def rates(self):
+        """The left inverse of [K; the angle rows] (``natural_rates``: z from y), CSR."""
+        K = self.form.pose_forms()
+        Q, R = np.linalg.qr(np.vstack([K[:, :-1], self.angles]))   # full column rank
+        return inverse.csr(np.linalg.solve(R, Q.T))
 
 
 def _points(form, constraints, owned) -> tuple[tuple, list]:

@@ -75,7 +75,9 @@ class Answered:
     """One variant's run from the batched pass, for its own run to read (``Natural``).
 
     ``times`` the run's, ``guess`` the x, y, fi it started from (the model's), z, ż, z̈
-    (n, nz) every step's.
+    (n, nz) every step's; ``q``, ``qd``, ``qdd`` (n, nq) its x, y, fi and rates from them
+    when the pass converted them (``population.poses``: the bits of ``Natural._converted``),
+    ``group`` and ``index`` where its reactions are made (``population.Group``), if at all.
     """
 
     times: np.ndarray
@@ -83,6 +85,27 @@ class Answered:
     z: np.ndarray
     zd: np.ndarray
     zdd: np.ndarray
+    q: np.ndarray | None = None
+    qd: np.ndarray | None = None
+    qdd: np.ndarray | None = None
+    group: object = None
+    index: int = 0
+
+    def converted(self, n: int, start: np.ndarray):
+        """(q, q̇, q̈) of the first n steps (copies) for a run that starts from the guess
+        itself (its angles' whole turns are the guess's), else None (converted as usual)."""
+        if self.q is None or not np.array_equal(start, self.guess):
+            return None
+        return self.q[:n].copy(), self.qd[:n].copy(), self.qdd[:n].copy()
+
+    def reactions(self, times: np.ndarray, q, qd, qdd):
+        """The ``Reactions`` of this motion from the pass's group when it is the pass's own
+        (the run's times, x, y, fi and rates as the pass found them), else None."""
+        if self.group is None or self.q is None or not (
+                np.array_equal(times, self.times) and np.array_equal(q, self.q)
+                and np.array_equal(qd, self.qd) and np.array_equal(qdd, self.qdd)):
+            return None
+        return self.group.reactions(self.index)
 
     def positions(self, form, times: np.ndarray, start: np.ndarray, w: np.ndarray,
                   tolerance: float):
@@ -101,8 +124,38 @@ class Answered:
         return self.z[:n], self.zd[:n], self.zdd[:n]
 
 
-class Stack:
-    """The equations of V variants with one structure: the constants of each as a column.
+class Stacked:
+    """Equations of one structure with the constants of each of V variants as a column
+    (``CONSTANTS``): ``terms(columns)`` evaluates them for any columns at once.
+
+    Parameters
+    ----------
+    terms : list of Terms
+        Each variant's equations, all with one ``structure``.
+    """
+
+    def __init__(self, terms: list[Terms]):
+        first = terms[0]
+        if any(structure(t) != structure(first) for t in terms[1:]):
+            raise ValueError("variants with different equation structures do not stack")
+        self.base = copy.copy(first)
+        self.base.laws = []                  # the targets are added here, per variant
+        self.constants = {c: np.concatenate([getattr(t, c) for t in terms], axis=1)
+                          for c in CONSTANTS}
+        self.nz, self.m = first.nz, first.m
+
+    def terms(self, columns: np.ndarray) -> Terms:
+        """The equations of the variants ``columns``, one column each (a shallow copy of
+        the structure with their constants)."""
+        out = copy.copy(self.base)
+        for c, value in self.constants.items():
+            setattr(out, c, value[:, columns])
+        return out
+
+
+class Stack(Stacked):
+    """The equations of V variants with one structure (``Stacked``), with what their run
+    needs: each variant's Newton weights and its laws' targets at the run's times.
 
     Parameters
     ----------
@@ -115,27 +168,12 @@ class Stack:
     """
 
     def __init__(self, terms: list[Terms], weights: list[np.ndarray], times: np.ndarray):
-        first = terms[0]
-        if any(structure(t) != structure(first) for t in terms[1:]):
-            raise ValueError("variants with different equation structures do not stack")
-        self.base = copy.copy(first)
-        self.base.laws = []                  # the targets are added here, per variant
-        self.constants = {c: np.concatenate([getattr(t, c) for t in terms], axis=1)
-                          for c in CONSTANTS}
+        super().__init__(terms)
         self.w = np.stack(weights, axis=1)                                   # (nz, V)
         self.times = np.asarray(times, dtype=float)
         #: g^(order) (3, laws, V, n): the laws' targets of every variant at every time
         self.g = np.stack([np.stack([t.targets(self.times, order) for t in terms], axis=1)
-                           for order in range(3)]) if first.laws else None
-        self.nz, self.m = first.nz, first.m
-
-    def terms(self, columns: np.ndarray) -> Terms:
-        """The equations of the variants ``columns``, one column each (a shallow copy of
-        the structure with their constants)."""
-        out = copy.copy(self.base)
-        for c, value in self.constants.items():
-            setattr(out, c, value[:, columns])
-        return out
+                           for order in range(3)]) if terms[0].laws else None
 
     def targets(self, order: int, steps: np.ndarray, columns: np.ndarray
                 ) -> np.ndarray | None:
