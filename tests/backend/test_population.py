@@ -118,7 +118,13 @@ def test_another_motion_is_not_answered():
     moved[5, 2] += 1e-9                     # a step solved again, say: its own reactions
     assert a.reactions(times, moved, a.qd, a.qdd) is None
     assert a.reactions(times[:-1], a.q[:-1], a.qd[:-1], a.qdd[:-1]) is None
-    assert a.converted(len(times), a.guess + 1e-12) is None      # another start: converted
+    near = a.guess + 1e-3                   # (the run starts from its assembly, say)
+    own = Natural()._converted(Natural().formulation(mechs[0]), mechs[0], a.z, near, a.zd,
+                               a.zdd)
+    assert all(np.array_equal(x, y) for x, y in zip(a.converted(len(times), near), own))
+    turned = a.guess.copy()
+    turned[a.free_fi[0]] += 2 * np.pi       # a whole turn on: converted as usual
+    assert a.free_fi.size and a.converted(len(times), turned) is None
     got = backend.reactions(mechs[0], times, moved, a.qd, a.qdd)
     ref = constraint_wrenches(Natural().formulation(mechs[0]), times, moved, a.qd, a.qdd)
     assert np.array_equal(got.wrenches, ref.wrenches)

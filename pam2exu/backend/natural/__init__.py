@@ -24,7 +24,7 @@ from .loads import multipliers
 from .anchored import anchored
 from .reactions import constraint_wrenches
 from .solver import MAX_SUBSTEPS, NaturalSettings, Solver
-from .variants import Answered, Stack, solve, stackable, structure
+from .variants import Answered, Stack, solve, stackable, structure, turns
 from . import population
 from .statics import Statics, pose_distance
 
@@ -195,16 +195,17 @@ class Natural(Backend):
                 z, zd, zdd = (np.ascontiguousarray(a) for a in found.variant(j))
                 answer = Answered(times, guesses[j], z, zd, zdd)
                 if poses is not None:
-                    answer.q, answer.qd, answer.qdd = (p[k] for p in poses)
-                    answer.group, answer.index = group, k
+                    answer.q, answer.qd, answer.qdd = (p[k] for p in poses[:3])
+                    answer.free_fi = self._angle_kinds(forms[j]).free_fi
+                    answer.first, answer.group, answer.index = poses[3][:, k], group, k
                 out[i] = Natural(answer)
                 out[i]._forms[(id(mechs[i]), False)] = (mechs[i], forms[j])
         return out
 
     def _group(self, forms, times, z, zd, zdd, guesses):
-        """(``population.Group``, (q, q̇, q̈) each (V, n, nq)) of the variants solved to the
-        end, or (None, None) when there are none or their angles are not of one kind (each
-        run converts its own)."""
+        """(``population.Group``, ``population.poses``) of the variants solved to the end,
+        or (None, None) when there are none or their angles are not of one kind (each run
+        converts its own)."""
         if not forms:
             return None, None
         kinds = [self._angle_kinds(f) for f in forms]
@@ -314,7 +315,7 @@ class Natural(Backend):
         if qT is not None and kind.free.size:
             if n > 1:                                    # (one step: nothing to unwrap)
                 raw = np.unwrap(raw, axis=1)
-            raw += 2 * np.pi * np.rint((start[kind.free_fi] - raw[:, 0]) / (2 * np.pi))[:, None]
+            raw += 2 * np.pi * turns(start[kind.free_fi], raw[:, 0])[:, None]
             qT[kind.free_fi] = raw
         return (None if qT is None else qT.T,
                 *((None, None) if rates is None else (rates[0].T, rates[1].T)))

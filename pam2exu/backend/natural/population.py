@@ -38,7 +38,7 @@ from ..base import Reactions
 from . import inverse
 from .reactions import plan
 from .terms import extended
-from .variants import Stacked, structure
+from .variants import Stacked, structure, turns
 from .wrenches import wrenches
 
 #: variant × step rows per block of the reactions (bounded memory: ~2 kB a row for a small
@@ -63,7 +63,8 @@ def pose_sums(K: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def poses(kinds, K: np.ndarray, guesses: np.ndarray, z, zd, zdd):
-    """(q, q̇, q̈) each (V, n, nq) of every variant, as its own ``Natural._converted``: K
+    """(q, q̇, q̈) each (V, n, nq) of every variant, as its own ``Natural._converted``, and
+    the free solids' angles at the first step before their whole turns (nfree, V): K
     (4 ns, nz + 1, V) the variants' pose forms, ``kinds`` their one ``Natural._angle_kinds``,
     ``guesses`` (nq, V) where each started (its angles' whole turns), z, ż, z̈ (n, nz, V)."""
     from . import Natural                       # its conversion steps, run on all columns
@@ -79,14 +80,16 @@ def poses(kinds, K: np.ndarray, guesses: np.ndarray, z, zd, zdd):
         ext[:nz], ext[nz] = a.transpose(1, 0, 2), 0.0
         rates.append(pose_sums(K, ext).reshape(len(K), n * V))
     Natural._pose_rates(kinds, pose, *rates, columns(zd), columns(zdd), qdT, qddT)
+    raw = raw.reshape(-1, n, V)
+    first = raw[:, 0].copy()
     if kinds.free.size:
-        raw = raw.reshape(-1, n, V)
         if n > 1:
             raw = np.unwrap(raw, axis=1)
-        raw += 2 * np.pi * np.rint((guesses[kinds.free_fi] - raw[:, 0]) / (2 * np.pi))[:, None]
+        raw += 2 * np.pi * turns(guesses[kinds.free_fi], first)[:, None]
         qT.reshape(nq, n, V)[kinds.free_fi] = raw
-    return tuple(np.ascontiguousarray(a.reshape(nq, n, V).transpose(2, 1, 0))
-                 for a in (qT, qdT, qddT))
+    return (*(np.ascontiguousarray(a.reshape(nq, n, V).transpose(2, 1, 0))
+              for a in (qT, qdT, qddT)), first)
+
 
 
 class Group:

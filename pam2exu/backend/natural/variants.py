@@ -29,6 +29,12 @@ from .solver import (COARSE, COARSE_GROW, COARSE_LONGEST, COARSE_LONGEST_STEPS,
                      COARSE_MISS, SHORT, quintic_hermite)
 from .terms import Terms
 
+
+def turns(start: np.ndarray, first: np.ndarray) -> np.ndarray:
+    """The whole turns k added to the free solids' angles: rint((start − first) / 2π), the
+    turns of ``start`` nearest the first step's atan2 (``Natural._converted``)."""
+    return np.rint((start - first) / (2 * np.pi))
+
 #: steps between the coarse pass's steps at the start of a run (``_coarse``)
 STRIDE = 4
 #: variant × step columns solved at once by the fill (bounded memory: about 1 kB each for a
@@ -77,7 +83,9 @@ class Answered:
     ``times`` the run's, ``guess`` the x, y, fi it started from (the model's), z, ż, z̈
     (n, nz) every step's; ``q``, ``qd``, ``qdd`` (n, nq) its x, y, fi and rates from them
     when the pass converted them (``population.poses``: the bits of ``Natural._converted``),
-    ``group`` and ``index`` where its reactions are made (``population.Group``), if at all.
+    with ``free_fi`` the columns of the free solids' angles and ``first`` their atan2 at the
+    first step (another start with the same whole turns has the same x, y, fi); ``group``
+    and ``index`` where its reactions are made (``population.Group``), if at all.
     """
 
     times: np.ndarray
@@ -88,13 +96,20 @@ class Answered:
     q: np.ndarray | None = None
     qd: np.ndarray | None = None
     qdd: np.ndarray | None = None
+    free_fi: np.ndarray | None = None
+    first: np.ndarray | None = None
     group: object = None
     index: int = 0
 
     def converted(self, n: int, start: np.ndarray):
-        """(q, q̇, q̈) of the first n steps (copies) for a run that starts from the guess
-        itself (its angles' whole turns are the guess's), else None (converted as usual)."""
-        if self.q is None or not np.array_equal(start, self.guess):
+        """(q, q̇, q̈) of the first n steps (copies) for a run from ``start``: the pass's, when
+        the start puts the free solids' angles in the same whole turns as the guess did
+        (``population.turns``); else None (converted as usual)."""
+        if self.q is None:
+            return None
+        if not np.array_equal(start, self.guess) and not np.array_equal(
+                turns(start[self.free_fi], self.first), turns(self.guess[self.free_fi],
+                                                              self.first)):
             return None
         return self.q[:n].copy(), self.qd[:n].copy(), self.qdd[:n].copy()
 
