@@ -163,7 +163,7 @@ def _reactions(group: Group, members: list[int], plans: list) -> list:
         cols = np.tile(np.arange(V), steps)               # the variant of each row
         rows = [columns(x[s]).T for x in (z, zd, zdd)]    # (R, nz): rows step-major
         qR = np.ascontiguousarray(q[:, s].transpose(1, 0, 2)).reshape(steps * V, -1)
-        wrench, kinetic, ok = _block(first, bd, c[cols], mass[cols], main.terms(cols),
+        wrench, kinetic, ok = _block(first, bd, c, mass, main.terms(cols),
                                      frame.terms(cols), grounds, cols, *rows, qR,
                                      applied[s].reshape(steps * V, *c.shape[1:]))
         good &= ok.reshape(steps, V).all(axis=0)
@@ -173,11 +173,11 @@ def _reactions(group: Group, members: list[int], plans: list) -> list:
 
 
 def _block(pl, bd, c, mass, terms, frame_terms, grounds, cols, z, zd, zdd, q, applied):
-    """(wrenches (R, nc, 3), kinetic energy (R,), ok (R,)) of R rows, each with its own
-    constants: c (R, ns, 4), mass (R, ns, 4, 4), the equations ``terms`` and
-    ``frame_terms`` (one column per row), the ground pins' points ``grounds`` {pin: (2, V)},
-    Q_b ``applied`` (R, ns, 4) (``reactions._chunk`` on every row)."""
-    R, ns = len(z), c.shape[1]
+    """(wrenches (R, nc, 3), kinetic energy (R,), ok (R,)) of R = steps × V rows (step-major),
+    each with its variant's constants: c (V, ns, 4), mass (V, ns, 4, 4), the equations
+    ``terms`` and ``frame_terms`` (one column per row), the ground pins' points ``grounds``
+    {pin: (2, V)}, Q_b ``applied`` (R, ns, 4) (``reactions._chunk`` on every row)."""
+    R, (V, ns) = len(z), c.shape[:2]
     accel = inverse.body_coordinates(bd, zdd, constant=False)    # ζ̈ (R, ns, 4)
     W = _mass_times(mass, accel) - applied
     rhs = -inverse.on_coordinates(bd, W)                           # (R, nz)
@@ -187,7 +187,8 @@ def _block(pl, bd, c, mass, terms, frame_terms, grounds, cols, z, zd, zdd, q, ap
     swaps, ok = lu_factor(At)
     mu = lu_solve(At, swaps, rhs.T).T                              # (R, m)
     ok &= np.isfinite(mu).all(axis=1)
-    zeta = inverse.body_coordinates(bd, z, constant=False) + c     # (R, ns, 4): p, v
+    zeta = (inverse.body_coordinates(bd, z, constant=False).reshape(-1, V, ns, 4)
+            + c).reshape(R, ns, 4)                                 # (R, ns, 4): p, v
     hat = np.empty((R, frame_terms.nz))
     hat[:, pl.hat_frames[0]] = zeta.reshape(R, -1)[:, pl.hat_frames[1]]
     hat[:, pl.hat_angles[0]] = z[:, pl.hat_angles[1]]
@@ -204,12 +205,15 @@ def _block(pl, bd, c, mass, terms, frame_terms, grounds, cols, z, zd, zdd, q, ap
 
 
 def _mass_times(mass: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """M_b x_b (R, ns, 4) per row and solid, mass (R, ns, 4, 4): each entry's four terms
-    added in order from 0 (as the single run's sparse product of the block-diagonal mass)."""
+    """M_b x_b (R, ns, 4) per row and solid, mass (V, ns, 4, 4) of the rows' variants (R =
+    steps × V, step-major): each entry's four terms added in order from 0 (as the single
+    run's sparse product of the block-diagonal mass)."""
+    V = len(mass)
+    x = x.reshape(-1, V, *x.shape[1:])
     out = np.zeros_like(x)
     for k in range(4):
         out += mass[..., k] * x[..., k, None]
-    return out
+    return out.reshape(-1, *x.shape[2:])
 
 
 __all__ = ["Group", "columns", "pose_sums", "poses"]
