@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
+from ...batched import lu_factor, lu_solve
 from .loads import Loads
 
 #: rank tolerance of the least-norm multipliers, relative to the largest singular value
@@ -213,10 +214,22 @@ def multipliers(form, z, W, redundant: bool, jacobian: np.ndarray | None = None)
     (``jacobian``: Φ_z (n, m, nz) when already evaluated)."""
     rhs = -on_coordinates(bodies(form), W)
     J = form.terms.dense(form.terms.jacobian(z)) if jacobian is None else jacobian
-    Jt = np.swapaxes(J, 1, 2)
     if not redundant and J.shape[1] == J.shape[2]:
-        return np.linalg.solve(Jt, rhs[..., None])[..., 0]
-    return np.einsum("nmz,nz->nm", np.linalg.pinv(Jt, rcond=RCOND), rhs)
+        return transposed_solve(J, rhs)
+    return np.einsum("nmz,nz->nm", np.linalg.pinv(np.swapaxes(J, 1, 2), rcond=RCOND), rhs)
+
+
+def transposed_solve(J: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """x (n, m) with J_kᵀ x_k = b_k at every step, J (n, m, m): one batched LU with partial
+    pivoting over all steps (``batched``: LAPACK's per-matrix call costs more than the
+    elimination for small systems); NaN where J_k is singular (``numpy.linalg.solve``
+    raises there: these multipliers then do not exist)."""
+    At = np.ascontiguousarray(J.transpose(2, 1, 0))         # Jᵀ with the steps last
+    swaps, ok = lu_factor(At)
+    x = lu_solve(At, swaps, b.T).T
+    if not ok.all():
+        x[~ok] = np.nan
+    return x
 
 
 __all__ = ["Bodies", "applied", "bodies", "body_coordinates", "body_mass_matrices",

@@ -32,7 +32,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...batched import lu_factor, lu_solve
 from ...errors import Pam2ExuError
 from ..base import Reactions
 from . import inverse
@@ -181,12 +180,9 @@ def _block(pl, bd, c, mass, terms, frame_terms, grounds, cols, z, zd, zdd, q, ap
     accel = inverse.body_coordinates(bd, zdd, constant=False)    # ζ̈ (R, ns, 4)
     W = _mass_times(mass, accel) - applied
     rhs = -inverse.on_coordinates(bd, W)                           # (R, nz)
-    A = terms.dense_cols(terms.jacobian_cols(z.T))                 # Φ_z (m, nz, R)
-    J = A.transpose(2, 0, 1)
-    At = np.ascontiguousarray(A.transpose(1, 0, 2))                # Φ_zᵀ, LU in place
-    swaps, ok = lu_factor(At)
-    mu = lu_solve(At, swaps, rhs.T).T                              # (R, m)
-    ok &= np.isfinite(mu).all(axis=1)
+    J = terms.dense_cols(terms.jacobian_cols(z.T)).transpose(2, 0, 1)   # Φ_z (R, m, nz)
+    mu = inverse.transposed_solve(J, rhs)                          # (R, m)
+    ok = np.isfinite(mu).all(axis=1)
     zeta = (inverse.body_coordinates(bd, z, constant=False).reshape(-1, V, ns, 4)
             + c).reshape(R, ns, 4)                                 # (R, ns, 4): p, v
     hat = np.empty((R, frame_terms.nz))
