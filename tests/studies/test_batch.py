@@ -239,3 +239,22 @@ def test_a_chunk_gives_the_garbage_collector_back_as_it_found_it(monkeypatch):
     finally:
         gc.unfreeze()
     assert mine
+
+
+def test_the_pass_makes_the_reactions_of_its_variants(monkeypatch):
+    """A kinetostatic study on the natural backend: the reactions of the variants the pass
+    solved come from its one inverse dynamics of them all (``population.Group``); only the
+    variants it left out compute their own, in their own runs."""
+    import pam2exu.backend.natural as natural
+    from pam2exu.studies.runner import run_variants
+    s = loads_study(FOUR_BAR, folder=EXAMPLES)
+    p = payload(s, nominal(s)[0])
+    own = []
+    original = natural.constraint_wrenches
+    monkeypatch.setattr(natural, "constraint_wrenches",
+                        lambda form, *a, **k: own.append(form.mech) or original(form, *a, **k))
+    values = np.asarray(s.variants())
+    table = run_variants(p, 0, len(values), values)
+    status = table["status"].tolist()
+    assert status.count("ok") + status.count("rejected") == 2
+    assert own == []                          # the 4 others fail before their forces
