@@ -27,6 +27,7 @@ import numpy as np
 from scipy import sparse
 
 from ...batched import lu_factor, lu_solve
+from .linear import PIVOT_THRESHOLD
 from .loads import Loads
 
 #: rank tolerance of the least-norm multipliers, relative to the largest singular value
@@ -220,12 +221,12 @@ def multipliers(form, z, W, redundant: bool, jacobian: np.ndarray | None = None)
 
 
 def transposed_solve(J: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """x (n, m) with J_kᵀ x_k = b_k at every step, J (n, m, m): one batched LU with partial
-    pivoting over all steps (``batched``: LAPACK's per-matrix call costs more than the
-    elimination for small systems); NaN where J_k is singular (``numpy.linalg.solve``
-    raises there: these multipliers then do not exist)."""
+    """x (n, m) with J_kᵀ x_k = b_k at every step, J (n, m, m): one batched LU over all
+    steps with the backend's threshold pivoting (``batched``, ``linear.PIVOT_THRESHOLD``:
+    LAPACK's per-matrix call costs more than the elimination for small systems); NaN where
+    J_k is singular (``numpy.linalg.solve`` raises there: these multipliers do not exist)."""
     At = np.ascontiguousarray(J.transpose(2, 1, 0))         # Jᵀ with the steps last
-    swaps, ok = lu_factor(At)
+    swaps, ok = lu_factor(At, PIVOT_THRESHOLD)
     x = lu_solve(At, swaps, b.T).T
     if not ok.all():
         x[~ok] = np.nan
