@@ -160,3 +160,18 @@ def test_blocks_of_rows_give_the_same_bits(monkeypatch, columns):
         x, y = a.answered, b.answered
         rx, ry = x.reactions(x.times, x.q, x.qd, x.qdd), y.reactions(y.times, y.q, y.qd, y.qdd)
         assert np.array_equal(rx.wrenches, ry.wrenches)
+
+
+def test_a_pass_too_large_to_convert_leaves_each_run_its_own(monkeypatch):
+    from pam2exu.backend.natural import population
+    mechs = _variants(load(EXAMPLES / "four_bar.toml"), {"coupler.B.x": [0.35, 0.351]})
+    times = np.linspace(0.0, 1.0, 21)
+    monkeypatch.setattr(population, "MOST_BYTES", 3 * 8 * 2 * 21 * mechs[0].nq - 1)
+    found = Natural().solved_variants(mechs, times, NaturalSettings())
+    assert all(b.answered.q is None and b.answered.group is None for b in found)
+    a = found[0].answered                      # its run converts, and makes its reactions
+    got = found[0].solve_positions(mechs[0], times, a.guess, NaturalSettings(), rates=True)
+    own = Natural()._converted(Natural().formulation(mechs[0]), mechs[0], a.z, a.guess,
+                               a.zd, a.zdd)
+    assert np.array_equal(got.q, own[0]) and np.array_equal(got.qdd, own[2])
+    assert a.reactions(times, got.q, got.qd, got.qdd) is None

@@ -287,8 +287,11 @@ def test_a_local_cluster_is_started_and_stopped_by_the_run(tmp_path, payload):
         run = run_chunks(chunk_tasks.rows, payload, CHUNKS, tmp_path / "OUT.parts",
                          executor=client)
         assert_same_bytes(run.columns, reference)
-        with pytest.raises(ChunkError, match=r"chunk of variants 10 … 14: its worker process "
-                                             r"was lost more often than the scheduler allows"):
+        # the chunk 10 … 14 kills its worker; a chunk the same worker was running beside it
+        # is lost with it, and the scheduler may report either first (seen at load 3)
+        with pytest.raises(ChunkError, match=r"chunk of variants \d+ … \d+: its worker "
+                                             r"process was lost more often than the "
+                                             r"scheduler allows"):
             run_chunks(chunk_tasks.always_dies, payload, CHUNKS, tmp_path / "lost.parts",
                        executor=client)
     assert client.status == "closed"

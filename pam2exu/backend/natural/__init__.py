@@ -186,14 +186,16 @@ class Natural(Backend):
             z0 = np.stack([f.from_q(g)[0] for f, g in zip(forms, guesses)], axis=1)
             found = solve(stack, z0, settings.tolerance, settings.max_iterations)
             done = np.flatnonzero(found.solved == len(times))
-            group, poses = self._group([forms[j] for j in done], times,
-                                       *(a[:, :, done] for a in (found.z, found.zd, found.zdd)),
-                                       np.stack([guesses[j] for j in done], axis=1)
-                                       if done.size else None)
+            # the variants solved to the end, read-only: each one's answers are views
+            answers = [a if done.size == len(members) else a[:, :, done]
+                       for a in (found.z, found.zd, found.zdd)]
+            for a in answers:
+                a.setflags(write=False)
+            group, poses = self._group([forms[j] for j in done], times, *answers,
+                                       [guesses[j] for j in done])
             for k, j in enumerate(done):
                 i = members[j]
-                z, zd, zdd = (np.ascontiguousarray(a) for a in found.variant(j))
-                answer = Answered(times, guesses[j], z, zd, zdd)
+                answer = Answered(times, guesses[j], *(a[:, :, k] for a in answers))
                 if poses is not None:
                     answer.q, answer.qd, answer.qdd = (p[k] for p in poses[:3])
                     answer.free_fi = self._angle_kinds(forms[j]).free_fi
@@ -204,9 +206,10 @@ class Natural(Backend):
 
     def _group(self, forms, times, z, zd, zdd, guesses):
         """(``population.Group``, ``population.poses``) of the variants solved to the end,
-        or (None, None) when there are none or their angles are not of one kind (each run
-        converts its own)."""
-        if not forms:
+        or (None, None) when there are none, their x, y, fi would take more than
+        ``population.MOST_BYTES``, or their angles are not of one kind (each run converts
+        its own)."""
+        if not forms or not population.fits(len(forms), len(times), guesses[0].size):
             return None, None
         kinds = [self._angle_kinds(f) for f in forms]
         first = kinds[0]
@@ -215,7 +218,7 @@ class Natural(Backend):
                for k in kinds[1:]):
             return None, None
         K = np.stack([f.pose_forms() for f in forms], axis=2)
-        poses = population.poses(first, K, guesses, z, zd, zdd)
+        poses = population.poses(first, K, np.stack(guesses, axis=1), z, zd, zdd)
         return population.Group(forms, times, z, zd, zdd, poses[0]), poses
 
     def _anchored(self, form, mech, t0, z_start, settings, w):

@@ -43,6 +43,15 @@ from .wrenches import wrenches
 #: variant × step rows per block of the reactions (bounded memory: ~2 kB a row for a small
 #: mechanism)
 BLOCK_ROWS = 1 << 13
+#: the most bytes the x, y, fi and rates of a pass's variants may take (``fits``): beyond,
+#: each run converts its own, one at a time, as without the pass
+MOST_BYTES = 1 << 28
+
+
+def fits(variants: int, steps: int, nq: int) -> bool:
+    """Whether the x, y, fi, q̇, q̈ of ``variants`` runs of ``steps`` steps (nq each) fit in
+    MOST_BYTES."""
+    return 3 * 8 * variants * steps * nq <= MOST_BYTES
 
 
 def columns(a: np.ndarray) -> np.ndarray:
@@ -212,4 +221,4 @@ def _mass_times(mass: np.ndarray, x: np.ndarray) -> np.ndarray:
     return out.reshape(-1, *x.shape[2:])
 
 
-__all__ = ["Group", "columns", "pose_sums", "poses"]
+__all__ = ["Group", "columns", "fits", "pose_sums", "poses"]
