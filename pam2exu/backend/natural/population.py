@@ -115,8 +115,9 @@ class Group:
 
     def reactions(self, v: int) -> Reactions | None:
         """Variant v's ``Reactions`` (None: its run computes its own)."""
-        if self._made is None:
-            self._made = self._make()
+        if self._made is None:               # inside the run of the variant that asks first:
+            with np.errstate(all="ignore"):  # no floating-point warning of another's rows
+                self._made = self._make()   # (a row that is not finite: that variant's None)
         return self._made[v]
 
     def _make(self) -> list:
@@ -177,6 +178,7 @@ def _reactions(group: Group, members: list[int], plans: list) -> list:
         good &= ok.reshape(steps, V).all(axis=0)
         wrench_out[:, s] = wrench.reshape(steps, V, nc, 3).transpose(1, 0, 2, 3)
         kinetic_out[:, s] = kinetic.reshape(steps, V).T
+    good &= np.isfinite(wrench_out).all(axis=(1, 2, 3)) & np.isfinite(kinetic_out).all(axis=1)
     return [Reactions(wrench_out[j], kinetic_out[j]) if good[j] else None for j in range(V)]
 
 
