@@ -150,8 +150,52 @@ def _fine(values, limit: float | None, positive: bool) -> bool:
 def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
     """The solve grid of a run over [0, t_end] in ``steps`` steps (see the module's doc).
 
-    ``columns`` is the number of result columns, for the memory bound.
+    ``columns`` is the number of result columns, for the memory bound. The grid of the same
+    laws, interval and steps is made once (``_PLANS``: the variants of a study share it).
     """
+    key = _key(mech, t_end, steps)
+    made = _PLANS.get(key) if key is not None else None
+    if made is None:
+        made = _planned(mech, t_end, steps)
+        if key is not None:
+            if len(_PLANS) >= KEPT_PLANS:
+                _PLANS.pop(next(iter(_PLANS)))
+            _PLANS[key] = made
+    times = made.times
+    memory = 8 * (len(times) * (4 * mech.nq + mech.n_equations)
+                  + (int(steps) + 1) * (columns + 1))
+    if memory > limits.MEMORY:
+        raise ModelError(Problem(
+            "[analysis]",
+            f"this run would hold {memory / 2**30:.3g} GiB of coordinates and results "
+            f"({len(times):,} solve steps, {columns} columns), more than pam2exu allows "
+            f"({limits.MEMORY / 2**30:g} GiB): use fewer steps, or fewer outputs "
+            f"(--outputs)"), mech.model.source)
+    return Plan(times.copy(), made.every, made.motion)
+
+
+#: the plans made (``plan``), by ``_key``: at most KEPT_PLANS, the oldest dropped first
+_PLANS: dict = {}
+KEPT_PLANS = 32
+
+
+def _key(mech, t_end, steps) -> tuple | None:
+    """What a plan is made of (``_planned``): the interval, the steps, each actuator's
+    name, kind and law, the length scale when an actuator is linear, and the limits; None
+    when a law's constants are not hashable."""
+    drivers = tuple((el.name, el.angular, el.time_law()) for el in mech.drivers)
+    key = (float(t_end), int(steps), drivers,
+           None if all(angular for _, angular, _ in drivers) else mech.scale(),
+           MAX_ANGLE_STEP, MAX_LENGTH_STEP, limits.SOLVE_STEPS, limits.LENGTH, limits.ANGLE)
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key
+
+
+def _planned(mech, t_end: float, steps: int) -> Plan:
+    """``plan`` without its memory bound: the laws checked, the sub-steps, the grid."""
     user = np.linspace(0.0, float(t_end), int(steps) + 1)
     evaluated = law_values(mech, user)       # each law once on the user's grid
     check_laws(mech, user, ranges=False, evaluated=evaluated)  # the motion per step first
@@ -187,13 +231,5 @@ def plan(mech, t_end: float, steps: int, columns: int) -> Plan:
     every = int(every)
     times = np.linspace(0.0, float(t_end), int(steps) * every + 1) if every > 1 else user
     check_laws(mech, times, evaluated=evaluated if every == 1 else None)
-
-    memory = 8 * (len(times) * (4 * mech.nq + mech.n_equations) + len(user) * (columns + 1))
-    if memory > limits.MEMORY:
-        raise ModelError(Problem(
-            "[analysis]",
-            f"this run would hold {memory / 2**30:.3g} GiB of coordinates and results "
-            f"({len(times):,} solve steps, {columns} columns), more than pam2exu allows "
-            f"({limits.MEMORY / 2**30:g} GiB): use fewer steps, or fewer outputs "
-            f"(--outputs)"), mech.model.source)
+    times.setflags(write=False)                  # (kept in ``_PLANS``: ``plan`` copies it)
     return Plan(times, every, (worst[0].name, *worst[1:]) if every > 1 else None)

@@ -209,3 +209,36 @@ def test_the_quick_law_check_passes_exactly_what_the_detailed_one_passes(angular
     detailed = [verdict(v, r) for v in cases for r in (True, False)]
     assert quick == detailed
     assert quick.count("passes") == (16 if angular else 12)
+
+
+def test_a_plan_of_the_same_laws_and_interval_is_made_once(monkeypatch):
+    """``plan`` of the same laws, interval and steps is the plan made before (its grid a
+    writable copy, equal to a plan made afresh); another law, number of steps or limit
+    makes its own, failures are not kept, and at most KEPT_PLANS plans are."""
+    monkeypatch.setattr(grid, "_PLANS", {})
+    made = []
+    planned = grid._planned
+    monkeypatch.setattr(grid, "_planned", lambda *a: made.append(a[1:]) or planned(*a))
+    slow, fast = (fast_four_bar(s).mechanism() for s in (2.0, 360.0))
+    first, again = grid.plan(slow, 1.0, 50, 10), grid.plan(slow, 1.0, 50, 3)
+    assert made == [(1.0, 50)] and again.times is not first.times
+    again.times[0] = 1.0                               # (a copy: the kept one unchanged)
+    assert grid.plan(slow, 1.0, 50, 10).times[0] == 0.0
+    sub = grid.plan(fast, 1.0, 200, 10)
+    assert (sub.every, sub.motion) == (8, ("motor", pytest.approx(1.8), "rad"))
+    assert (grid.plan(fast, 1.0, 200, 10).every, len(made)) == (8, 2)
+    grid.plan(slow, 1.0, 51, 10)
+    monkeypatch.setattr(grid, "MAX_ANGLE_STEP", 0.125)
+    assert grid.plan(fast, 1.0, 200, 10).every == 15 and len(made) == 4
+    monkeypatch.setattr(grid.limits, "SOLVE_STEPS", 1000)
+    for _ in range(2):
+        with pytest.raises(pam2exu.ModelError, match="more than pam2exu runs"):
+            grid.plan(fast, 1.0, 200, 10)
+    monkeypatch.setattr(grid.limits, "MEMORY", 1000)
+    with pytest.raises(pam2exu.ModelError, match="GiB"):
+        grid.plan(slow, 1.0, 50, 10)                    # (the memory bound: every time)
+    assert len(made) == 7 and len(grid._PLANS) == 5         # (a limit is in the key)
+    monkeypatch.setattr(grid.limits, "MEMORY", 2**30)
+    for steps in range(1, 2 * grid.KEPT_PLANS):
+        grid.plan(slow, 1.0, steps, 10)
+    assert len(grid._PLANS) == grid.KEPT_PLANS
