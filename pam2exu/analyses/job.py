@@ -57,7 +57,33 @@ def available_columns(mech, kind: registry.AnalysisType,
                       derived: bool = True) -> dict[str, Var]:
     """Every column the analysis ``kind`` can produce, in order: solids, then elements;
     without ``derived``, not the opt-in columns of ``derived_columns`` (the default outputs
-    leave them out)."""
+    leave them out). Made once per structure (``_structure``: a study's variants share it;
+    a copy each time)."""
+    key = (kind, derived, _structure(mech))
+    if key not in _COLUMNS:
+        if len(_COLUMNS) >= KEPT_COLUMNS:
+            _COLUMNS.pop(next(iter(_COLUMNS)))
+        _COLUMNS[key] = _available(mech, kind, derived)
+    return dict(_COLUMNS[key])
+
+
+#: ``available_columns`` by analysis, ``derived`` and structure: at most KEPT_COLUMNS, the
+#: oldest dropped first
+_COLUMNS: dict = {}
+KEPT_COLUMNS = 32
+
+
+def _structure(mech) -> tuple:
+    """What a mechanism's columns are made of: each solid's name and points' names, each
+    element's type, name, clearance, equations and solids (its references'), the ground."""
+    return (tuple((s.name, tuple(s.points)) for s in mech.solids),
+            tuple((type(el), el.name, el.clearance, el.equations, el.solids,
+                   tuple(r.solid for r in el.refs)) for el in mech.elements),
+            mech.held)
+
+
+def _available(mech, kind: registry.AnalysisType, derived: bool) -> dict[str, Var]:
+    """``available_columns``, made."""
     out, levels = {}, kind.levels
     own = [var for var in SOLID_OUTPUTS if var.level in levels]
     extra = _derived(mech, levels) if kind.element_outputs and derived else None

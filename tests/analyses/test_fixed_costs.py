@@ -221,3 +221,32 @@ def test_a_short_run_takes_the_svd_of_the_steps_that_can_be_the_worst(four_bar, 
     q = np.column_stack([res[f"{s.name}.{v}"] for s in mech.solids for v in ("x", "y", "fi")])
     every = rank.condition_numbers(mech, res.t, q)
     assert res.info["max_condition_number"] == float(np.max(every))
+
+
+def test_the_columns_of_a_structure_are_made_once(four_bar, monkeypatch):
+    """``available_columns`` of a mechanism whose solids, points and elements are those of
+    one made before is its columns again (a copy, equal to them made afresh); a point
+    more, another analysis or ``derived`` make their own."""
+    from pam2exu import registry
+    monkeypatch.setattr(job_module, "_COLUMNS", {})
+    made = []
+    available = job_module._available
+    monkeypatch.setattr(job_module, "_available",
+                        lambda *a: made.append(a[1:]) or available(*a))
+    kinetostatic = registry.ANALYSES["kinetostatic"]
+    mech = four_bar.mechanism()
+    first = job_module.available_columns(mech, kinetostatic)
+    other = pam2exu.load(ROOT / "examples" / "four_bar.toml")
+    other["motor"].C = [0.0, 3.0, 0.0, 0.0]                 # (not the columns')
+    again = job_module.available_columns(other.mechanism(), kinetostatic)
+    assert len(made) == 1 and again == first and again is not first
+    again.clear()
+    assert job_module.available_columns(mech, kinetostatic) == available(mech, kinetostatic,
+                                                                          True)
+    pointed = pam2exu.load(ROOT / "examples" / "four_bar.toml")
+    pointed.solids[2].points["extra"] = [0.1, 0.0]
+    columns = job_module.available_columns(pointed.mechanism(), kinetostatic)
+    assert len(made) == 2 and any(".extra." in c for c in columns)
+    job_module.available_columns(mech, registry.ANALYSES["kinematic"])
+    job_module.available_columns(mech, kinetostatic, derived=False)
+    assert len(made) == 4
