@@ -243,6 +243,19 @@ def _regular(mech, J: np.ndarray, rtol: float) -> bool:
     return bool(s[-1] > 2 * rtol * max(1.0, s[0]))
 
 
+def _regular_condition(mech, J: np.ndarray, rtol: float) -> tuple[bool, float | None]:
+    """(``_regular``, ``_condition``) of a square Cq (m, nq) of one configuration, the same
+    bits from one SVD call on the two matrices; (False, None) for another Cq."""
+    m, nq = J.shape
+    if m != nq or m == 0:
+        return False, None
+    s = np.linalg.svd(np.stack([_scaled(mech, J), _equilibrated(J[None])[0]]),
+                      compute_uv=False)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        condition = s[1, 0] / s[1, m - 1]
+    return bool(s[0, -1] > 2 * rtol * max(1.0, s[0, 0])), float(condition)
+
+
 def at_guess(mech, t: float, q: np.ndarray):
     """The constraint equations (``native.Equations``) at one configuration q (the initial
     guess), evaluated once for ``require_defined`` and ``mobility`` (NaN where undefined,
@@ -278,8 +291,11 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None,
     the rank and the condition number)."""
     if jacobian is None:
         jacobian = equations(mech, State([t], q[None, :])).jacobian[0]
-    if rows is None and _regular(mech, jacobian, rtol):      # no DOF left, none repeated
-        return Mobility(0, 0, [], [], _condition(mech, t, q, jacobian))
+    condition = None
+    if rows is None:
+        regular, condition = _regular_condition(mech, jacobian, rtol)
+        if regular:                                  # no DOF left, none repeated
+            return Mobility(0, 0, [], [], condition)
     keep = np.ones(mech.n_equations, dtype=bool) if rows is None else np.asarray(rows)
     svd = _rank(mech, t, q, rtol, None if rows is None else keep, jacobian=jacobian)
     if svd is None:
@@ -298,7 +314,8 @@ def mobility(mech, t: float, q: np.ndarray, rtol: float = 1e-9, rows=None,
         for el, own in zip(mech.constraints, mech.rows):
             if np.max(weight[own]) > 1e-6:
                 dependent.append(el.name)
-    return Mobility(dof, redundant, free, dependent, _condition(mech, t, q, jacobian))
+    return Mobility(dof, redundant, free, dependent,
+                    _condition(mech, t, q, jacobian) if condition is None else condition)
 
 
 def _condition(mech, t: float, q: np.ndarray, jacobian: np.ndarray) -> float:

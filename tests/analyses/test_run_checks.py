@@ -146,7 +146,7 @@ def test_the_default_outputs_do_not_make_the_derived_columns(monkeypatch):
 def test_a_regular_jacobians_mobility_is_the_one_of_the_svd_with_vectors(smallest,
                                                                         monkeypatch):
     """``mobility`` of a square Cq of full rank takes its singular values alone
-    (``_regular``): the same Mobility, condition number's bits included, as the SVD with
+    (``_regular``, with the condition number's in one call): the same Mobility, condition number's bits included, as the SVD with
     vectors, at the four-bar's guess and with Cq's smallest singular value set to
     ``smallest`` × the rank threshold (1e-9 of the largest) around the margin of 2 (s_max = 4.15)."""
     from pathlib import Path
@@ -161,8 +161,11 @@ def test_a_regular_jacobians_mobility_is_the_one_of_the_svd_with_vectors(smalles
         s[-1] = smallest * 1e-9 * s[0]
         J = (U * s) @ Vt / scale
     assert rank._regular(mech, J, 1e-9) == (smallest is None or smallest > 2.0)
+    regular, condition = rank._regular_condition(mech, J, 1e-9)    # (one SVD call)
+    assert regular == rank._regular(mech, J, 1e-9)
+    assert str(condition) == str(rank._condition(mech, 0.0, q0, J))
     fast = rank.mobility(mech, 0.0, q0, jacobian=J)
-    monkeypatch.setattr(rank, "_regular", lambda *_: False)
+    monkeypatch.setattr(rank, "_regular_condition", lambda *_: (False, None))
     full = rank.mobility(mech, 0.0, q0, jacobian=J)
     assert fast == full and str(fast.condition) == str(full.condition)
     assert (fast.dof, fast.redundant) == ((0, 0) if smallest is None or smallest > 1.5
