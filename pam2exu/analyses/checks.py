@@ -13,6 +13,8 @@ from .job import Job
 
 #: constraint residual above this (× the length scale) means a wrong translation
 RESIDUAL_TOLERANCE = 1e-8
+#: the smallest length scale a mechanism has (``Mechanism.scale``) [m]
+SMALLEST_SCALE = 1e-3
 
 
 def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = None) -> None:
@@ -25,14 +27,17 @@ def check_residual(mech, t, q, job: Job | None = None, res: np.ndarray | None = 
         return
     if res is None:
         res = native.residuals(mech, t, q)
-    per_step = np.max(np.abs(res), axis=1)
-    worst = float(np.max(per_step))
+    worst = float(np.max(np.abs(res)))
     if job is not None:
         job.info["max_residual"] = worst
     # a looser Newton tolerance leaves a larger residual: not a translation error
     tolerance = job.solver.tolerance if job is not None else 0.0
-    tol = max(RESIDUAL_TOLERANCE, 100 * tolerance) * mech.scale()
+    relative = max(RESIDUAL_TOLERANCE, 100 * tolerance)
+    if worst <= relative * SMALLEST_SCALE:       # within it at any length scale
+        return
+    tol = relative * mech.scale()
     if worst > tol:
+        per_step = np.max(np.abs(res), axis=1)
         first = int(np.argmax(per_step > tol))
         if job is not None:
             # redundant constraints whose targets part: the solver (told to ignore the

@@ -91,3 +91,30 @@ def test_following_the_branch_has_bounded_work(monkeypatch):
                                                   r"[0-9,]+ position solves, more than 0 "
                                                   r"times the run\)"):
         pam2exu.run(model, analysis="kinematic", t_end=1.0, steps=600)
+
+
+def test_the_residual_check_takes_the_length_scale_only_above_its_smallest():
+    """``check_residual`` leaves out the length scale when the residual is within the check
+    at any scale: ``SMALLEST_SCALE`` is the least ``Mechanism.scale`` (a mechanism of
+    points at the origin); a residual of 1.5e-8 × 1e-3 m is caught at that scale, not at
+    the four-bar's 0.4 m; one of 0.5e-8 × 1e-3 m at neither."""
+    from pam2exu.analyses import checks
+    from pam2exu.errors import TranslationError
+    four_bar = pam2exu.load(EXAMPLES / "four_bar.toml").mechanism()
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    for s in model.solids:
+        s.x = s.y = 0.0
+        for name in s.points:
+            s.points[name] = [0.0, 0.0]
+    point = model.mechanism()
+    assert point.scale() == checks.SMALLEST_SCALE < four_bar.scale()
+    t, q = np.zeros(1), np.zeros((1, point.nq))
+    for size, caught in ((1.5, True), (0.5, False)):
+        res = np.zeros((1, point.n_equations))
+        res[0, 3] = size * checks.RESIDUAL_TOLERANCE * checks.SMALLEST_SCALE
+        checks.check_residual(four_bar, t, q, res=res)
+        if caught:
+            with pytest.raises(TranslationError, match="violates"):
+                checks.check_residual(point, t, q, res=res)
+        else:
+            checks.check_residual(point, t, q, res=res)
