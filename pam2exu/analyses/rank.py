@@ -64,9 +64,11 @@ def _candidates(A: np.ndarray) -> np.ndarray | None:
     is below their largest lower bound for certain, from its nearest probed step's σ and
     Weyl's |σ_i(A_k) − σ_i(A_j)| ≤ ‖A_k − A_j‖_F (``_ruled_out``), needs none."""
     n = len(A)
-    if n == 0 or np.iscomplexobj(A) or not np.isfinite(A).all():
+    if n == 0 or np.iscomplexobj(A):
         return None
     size = np.einsum("nij,nij->n", A, A)             # ‖A‖_F² ≥ λ_max
+    if not np.isfinite(size).all():                  # (A has a NaN or an ∞: so has it)
+        return None
     error, low, high = GRAM_ERROR * size, np.zeros(n), np.zeros(n)
     known = np.zeros(n, dtype=bool)
     known[::PROBE] = known[-1] = True
