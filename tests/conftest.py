@@ -103,3 +103,19 @@ def every_backend(request, monkeypatch):
 
     monkeypatch.setattr(pam2exu, "run", run_on)
     return request.param
+
+
+def varied_mechanisms(model, values: dict):
+    """The mechanisms of ``model`` with each parameter's k-th value written in (the names
+    of ``studies.parameters.targets``): a study's variants, made directly."""
+    import copy
+    from pam2exu.studies.parameters import targets, write
+    found = targets(model)
+    count = len(next(iter(values.values())))
+    out = []
+    for k in range(count):
+        m = copy.deepcopy(model)
+        for name, vals in values.items():
+            write(m, found[name], vals[k])
+        out.append(m.mechanism())
+    return out

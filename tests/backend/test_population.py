@@ -5,7 +5,6 @@ what its run would do): x, y, fi and their rates bit for bit; its own natural in
 dynamics (``reactions.constraint_wrenches`` on those x, y, fi: z taken back by least
 squares), every wrench and the kinetic energy to 1e-12 of the largest value of its kind.
 """
-import copy
 
 import numpy as np
 import pytest
@@ -15,23 +14,16 @@ from pam2exu.backend.natural import Natural, NaturalSettings
 from pam2exu.backend.natural.reactions import constraint_wrenches
 from pam2exu.errors import ModelError
 from pam2exu.model import load
-from pam2exu.studies.parameters import targets, write
+from tests.conftest import varied_mechanisms
+from pam2exu.studies.parameters import targets
 
 from pathlib import Path
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
-def _variants(model, values: dict[str, list[float]]):
-    found = targets(model)
-    count = len(next(iter(values.values())))
-    out = []
-    for k in range(count):
-        m = copy.deepcopy(model)
-        for name, vals in values.items():
-            write(m, found[name], vals[k])
-        out.append(m.mechanism())
-    return out
+_variants = varied_mechanisms
+
 
 
 def _own(backend, mech):

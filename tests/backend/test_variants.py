@@ -7,7 +7,6 @@ column by column relative to the column's largest value. The pass steps differen
 (every variant at once, its own coarse pass and fill), so the two agree to Newton's
 tolerance, not bit for bit.
 """
-import copy
 
 import numpy as np
 import pytest
@@ -16,24 +15,16 @@ from benchmarks.cases import chain_model
 from pam2exu.backend.natural import Natural, NaturalSettings
 from pam2exu.backend.natural.variants import structure
 from pam2exu.model import load
-from pam2exu.studies.parameters import targets, write
+from tests.conftest import varied_mechanisms
+from pam2exu.studies.parameters import targets
 
 from pathlib import Path
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
-def _variants(model, values: dict[str, list[float]]):
-    """The mechanisms of ``model`` with each parameter's k-th value written in."""
-    found = targets(model)
-    count = len(next(iter(values.values())))
-    out = []
-    for k in range(count):
-        m = copy.deepcopy(model)
-        for name, vals in values.items():
-            write(m, found[name], vals[k])
-        out.append(m.mechanism())
-    return out
+_variants = varied_mechanisms
+
 
 
 def _alone(mech, times):
