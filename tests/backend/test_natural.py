@@ -223,6 +223,25 @@ def test_chunked_solves_and_conversions_give_the_same_run(monkeypatch):
         np.testing.assert_array_equal(chunked[c], whole[c], err_msg=c)
 
 
+def test_the_unwrapping_is_numpys_bit_for_bit():
+    """The conversion's unwrapping of the free angles (``_unwrapped``: corrections only at
+    the wraps) gives ``numpy.unwrap``'s bits: wraps either way, steps of exactly ±π (numpy's
+    boundary rule), −0.0 (numpy's + 0.0), more wraps than MOST_WRAPS, non-finite values."""
+    from pam2exu.backend import natural
+    rng = np.random.default_rng(7)
+    turning = np.linspace(0.0, 40.0, 3001)
+    angles = np.arctan2(np.sin([turning, -0.7 * turning + 1.0]),
+                        np.cos([turning, -0.7 * turning + 1.0]))
+    cases = [angles, angles[:, :2], np.array([[0.0, np.pi, 0.0, -np.pi, -0.0, 2 * np.pi]]),
+             np.array([[-0.0, -0.0, 4.0, -0.0]]),
+             np.arctan2(np.sin(np.linspace(0, 900, 2000)), np.cos(np.linspace(0, 900, 2000)))[None],
+             np.array([[0.1, 3.5, np.inf, 2.0, np.nan]])]
+    cases += [np.cumsum(rng.normal(0.0, 2.5, (2, 50)), axis=1) for _ in range(20)]
+    with np.errstate(invalid="ignore"):
+        for raw in cases:
+            assert natural._unwrapped(raw).tobytes() == np.unwrap(raw, axis=1).tobytes()
+
+
 def test_from_q_of_an_assembled_pose_is_on_the_constraints_with_a_ground_point_at_1():
     """``Formulation.from_q`` of a configuration that satisfies the constraints gives z with
     Φ(z) = 0 (each coordinate a basic point's x, y, or an angle, of that configuration).
