@@ -69,8 +69,10 @@ def solve_in_parts(job: Job, start: np.ndarray, redundant: bool, rates: bool) ->
         return job.backend.solve_positions(mech, times, start, job.solver,
                                            redundant=redundant, rates=rates)
     firsts = range(0, n - 1, PART_STEPS)
-    q = np.full((n, mech.nq), np.nan)
+    # the rows no part gives are made NaN (not every row NaN first: a pass less over each)
+    q = np.empty((n, mech.nq))
     rates_of: dict[str, np.ndarray] = {}          # the backend's qd, qdd if it gives them
+    written: dict[str, int] = {}                  # ... and the rows given so far
     solved, error, last, iterations = 0, None, start, 0
     with Progress(len(firsts), "solving the positions") as bar:
         for done, a in enumerate(firsts, start=1):
@@ -82,13 +84,18 @@ def solve_in_parts(job: Job, start: np.ndarray, redundant: bool, rates: bool) ->
             q[keep] = part.q[keep.start - a:part.solved]
             for mine, theirs in (("qd", part.qd), ("qdd", part.qdd)):
                 if theirs is not None:
-                    rows = rates_of.setdefault(mine, np.full_like(q, np.nan))
+                    rows = rates_of.setdefault(mine, np.empty_like(q))
+                    rows[written.get(mine, 0):a] = np.nan    # after parts without them
                     rows[a:a + part.solved] = theirs[:part.solved]
+                    written[mine] = max(written.get(mine, 0), a + part.solved)
             solved = a + max(part.solved, 1 if a else 0)
             bar.update(done)
             if part.solved < b - a + 1:
                 error, last = part.error, part.last
                 break
+    q[solved:] = np.nan
+    for mine, rows in rates_of.items():
+        rows[written[mine]:] = np.nan
     return Positions(q, solved, error, last, None, iterations, rates_of.get("qd"),
                      rates_of.get("qdd"))
 
