@@ -247,10 +247,13 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
     values, notes = column_values(job, t, q, qd, qdd, extra)
     if notes:
         job.info["undefined"] = "; ".join(notes)
-    res = Results(t, {c: values[c] for c in job.columns}, job.units, job.analysis_type,
-                  mech.name, job.warnings, job.info, job.backend.label)
-    table = res.to_numpy()[:, 1:]        # a view of the table's storage: no copies
-    np.add(table, 0.0, out=table)        # no negative zeros in tables
+    data = np.empty((1 + len(job.columns), len(t)))
+    data[0] = t
+    for row, c in zip(data[1:], job.columns):
+        _plus_zero(values[c], row)       # no negative zeros in tables
+    res = Results._on(job.columns, data, job.units, job.analysis_type, mech.name,
+                      job.warnings, job.info, job.backend.label)
+    table = data[1:].T                   # a view of the table's storage: no copies
     wanted = set(job.columns)
     if not (np.isfinite(table).all() and _finite([v for k, v in values.items()
                                                   if k not in wanted])):
@@ -258,6 +261,16 @@ def collect(job: Job, q, qd=None, qdd=None, extra: dict | None = None) -> Result
         check_finite(job, t, {k: v for k, v in values.items()
                               if k.rpartition(".")[2] not in ("ICx", "ICy")})
     return res
+
+
+def _plus_zero(values, row: np.ndarray) -> None:
+    """row = values + 0.0 (−0.0 becomes 0.0), in the copy into the table; the bits of
+    copying first and adding 0.0 after (a column that is not float64 is copied first)."""
+    if isinstance(values, np.ndarray) and values.dtype == np.float64:
+        np.add(values, 0.0, out=row)
+    else:
+        row[...] = values
+        np.add(row, 0.0, out=row)
 
 
 def _finite(arrays: list) -> bool:

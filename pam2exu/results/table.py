@@ -106,11 +106,26 @@ class Results(Exports, Instants):
                  analysis: str = "", model: str = "", warnings=None, info=None,
                  backend: str = ""):
         t = np.asarray(t, dtype=float)
-        self._names = ["t", *map(one_form, columns)]      # names in one Unicode form
-        self._data = np.empty((len(self._names), len(t)))
-        self._data[0] = t
+        data = np.empty((1 + len(columns), len(t)))
+        data[0] = t
         for i, values in enumerate(columns.values(), start=1):
-            self._data[i] = values
+            data[i] = values
+        self._own(list(columns), data, units, analysis, model, warnings, info, backend)
+
+    @classmethod
+    def _on(cls, names: list[str], data: np.ndarray, units: dict[str, str] | None = None,
+            analysis: str = "", model: str = "", warnings=None, info=None,
+            backend: str = "") -> "Results":
+        """The table of the columns ``names`` whose storage is ``data`` itself (1 + columns,
+        rows; t first), not copied: for the analyses, which write their table in place."""
+        res = cls.__new__(cls)
+        res._own(names, data, units, analysis, model, warnings, info, backend)
+        return res
+
+    def _own(self, names, data, units, analysis, model, warnings, info, backend) -> None:
+        """Set the table on its storage ``data`` (``__init__``, ``_on``)."""
+        self._names = ["t", *map(one_form, names)]        # names in one Unicode form
+        self._data = data
         self._index = {name: i for i, name in enumerate(self._names)}
         self.units = {"t": "s", **{one_form(k): v for k, v in (units or {}).items()}}
         self.analysis, self.model = analysis, model     # the name (``analysis``'s setter)
