@@ -395,12 +395,16 @@ class Solver(LinearSolves):
         if len(owner) <= BLOCK:                  # one block (a few numpy calls less)
             yield 0, len(owner), self.pivot_orders(z[k[:1]])[0]
             return
-        orders = self.pivot_orders(z[k])[owner]
-        change = np.nonzero(np.any(orders[1:] != orders[:-1], axis=1))[0] + 1
-        edges = [0, *change, len(owner)]
+        orders = np.ascontiguousarray(self.pivot_orders(z[k]))     # of each interval
+        # the order changes where an interval's differs from the last one with steps
+        counts = np.bincount(owner, minlength=len(k))
+        filled = np.nonzero(counts)[0]
+        firsts = (np.cumsum(counts) - counts)[filled]
+        change = firsts[1:][np.any(orders[filled[1:]] != orders[filled[:-1]], axis=1)]
+        edges = [0, *change.tolist(), len(owner)]
         for a, b in zip(edges[:-1], edges[1:]):
             for c in range(a, b, BLOCK):
-                yield c, min(b, c + BLOCK), orders[c]
+                yield c, min(b, c + BLOCK), orders[owner[c]]
 
     def _hermite(self, t, z, steps, k, j, quintic: bool):
         """z at the steps (nz, n) on the Hermite interpolant through the ends k, j of their
