@@ -426,6 +426,18 @@ def move_wrench(wrench, origin, point):
     return out
 
 
+def moved_to_basis(wrench, origin, point, direction):
+    """``to_basis(move_wrench(wrench, origin, point), direction)``, the same products and
+    sums, with one array made (the moved wrench is not copied first)."""
+    ex, ey = direction[..., 0], direction[..., 1]
+    fx, fy = wrench[..., 0], wrench[..., 1]
+    out = np.empty(wrench.shape, np.result_type(float, wrench, origin, point, direction))
+    np.add(ex * fx, ey * fy, out=out[..., 0])
+    np.add(-ey * fx, ex * fy, out=out[..., 1])
+    np.subtract(wrench[..., 2], cross(point - origin, wrench[..., :2]), out=out[..., 2])
+    return out
+
+
 def to_basis(wrench, direction):
     """The wrench (..., 3) with its force in the basis whose x axis is the unit vector
     ``direction`` (..., 2)."""

@@ -22,7 +22,8 @@ import numpy as np
 from ..elements.base import Load
 from ..errors import TranslationError
 from ..complex_step import as_array, scalar
-from ..kinematics import State, column, generalized_force, move_wrench, pose, to_basis
+from ..kinematics import (State, column, generalized_force, move_wrench, moved_to_basis, pose,
+                          to_basis)
 from . import native
 
 #: a reaction component that is zero by construction must be below this × the element's force scale
@@ -349,7 +350,7 @@ def reported_wrenches(mech, st: State, wrenches: np.ndarray) -> np.ndarray:
     direction = np.concatenate([f[1] for f in frames], axis=1).reshape(shape)
     origin = st.q[:, [[column(el.receiver, 0), column(el.receiver, 1)]
                       for el in mech.constraints]]
-    return to_basis(move_wrench(wrenches, origin, point), direction)
+    return moved_to_basis(wrenches, origin, point, direction)
 
 
 def _least_reported(mech, st: State, wrenches: np.ndarray, modes: np.ndarray) -> np.ndarray:
