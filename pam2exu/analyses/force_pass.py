@@ -172,16 +172,20 @@ def reactions(mech, st: State, lam: np.ndarray, parts=None) -> dict[str, np.ndar
                                                                     mech.rows, parts)], axis=1))
 
 
-def checked_reactions(mech, wrenches: np.ndarray) -> dict[str, np.ndarray]:
+def checked_reactions(mech, wrenches: np.ndarray, views: bool = False
+                      ) -> dict[str, np.ndarray]:
     """The reported components of every constraint element's wrench in its reporting frame
-    (``wrenches`` (n, constraints, 3), in ``mech.constraints`` order), by column name; the
-    components that are zero by construction are checked to be zero."""
+    (``wrenches`` (n, constraints, 3), in ``mech.constraints`` order), by column name
+    (``views``: views of ``wrenches``, for a caller that copies them, not columns of their
+    own); the components that are zero by construction are checked to be zero."""
     out, length = {}, mech.scale()
     if not mech.constraints:
         return out
     largest = np.max(np.abs(wrenches), axis=0, initial=0.0)         # (constraints, 3)
     scales = (np.maximum(largest[:, 0], largest[:, 1]) + largest[:, 2] / length).tolist()
-    columns = np.ascontiguousarray(np.moveaxis(wrenches, 0, -1))    # (constraints, 3, n)
+    columns = np.moveaxis(wrenches, 0, -1)                          # (constraints, 3, n)
+    if not views:
+        columns = np.ascontiguousarray(columns)
     for e, (el, top, scale) in enumerate(zip(mech.constraints, largest.tolist(), scales)):
         for k, name in enumerate(el.wrench):
             if name is not None:
@@ -328,8 +332,8 @@ def over_time_given(mech, t, q, qd, given):
         wrenches = reported_wrenches(mech, st, given.wrenches[s])
         if given.modes is not None:
             wrenches = _least_reported(mech, st, wrenches, given.modes[s])
-        found = checked_reactions(mech, wrenches)
         whole = s.start == 0 and s.stop == n          # one chunk: its arrays are the columns
+        found = checked_reactions(mech, wrenches, views=not whole)    # (else copied below)
         for name, v in {**found, **applied.outputs}.items():
             if whole and isinstance(v, np.ndarray) and v.shape == (n,) and v.dtype == float:
                 out[name] = v
