@@ -152,9 +152,10 @@ class LinearSolves:
 
     def run_rates(self, t, z):
         """(ż, z̈) at the steps of the last ``run`` (z its answer, solved rows only): those
-        found with the positions, the others solved now."""
+        found with the positions, the others solved now (written into the run's own rows:
+        views of them, not copies; the next ``run`` makes new ones)."""
         n = len(t)
-        zd, zdd = self.zd[:n].copy(), self.zdd[:n].copy()
+        zd, zdd = self.zd[:n], self.zdd[:n]
         missing = np.nonzero(~self.own_rates[:n])[0]
         if missing.size:
             zd[missing], zdd[missing] = self.rates(t[missing], z[missing])
