@@ -136,11 +136,15 @@ def sparse_lu(J, rows, cols, n: int, m: int, nq: int):
 
 
 def residuals(mech, t, q) -> np.ndarray:
-    """Constraint residual C(q, t), (n, m)."""
+    """Constraint residual C(q, t), (n, m): ``equations``' residual, each element's rows
+    written straight into it (without C_t, Cq and the Equations around them)."""
     t, q = np.atleast_1d(np.asarray(t, dtype=float)), np.atleast_2d(q)
-    out = np.empty((len(t), mech.n_equations))
+    out = np.zeros((len(t), mech.n_equations))
     for s in chunks(mech, len(t), most=RESIDUAL_CHUNK):
-        out[s] = equations(mech, State(t[s], q[s], jacobians=False), jacobian=False).residual
+        st, rows_of = State(t[s], q[s], jacobians=False), out[s]
+        for el, rows in zip(mech.constraints, mech.rows):
+            v, target = el.constraint(st)
+            rows_of[:, rows] = v.value - target_values(target, st.t, el.equations)[0]
     return out
 
 
