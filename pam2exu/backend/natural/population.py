@@ -99,7 +99,6 @@ def poses(kinds, K: np.ndarray, guesses: np.ndarray, z, zd, zdd):
               for a in (qT, qdT, qddT)), first)
 
 
-
 class Group:
     """The variants of one pass that were solved to the end, with their x, y, fi: their
     reactions made for all at once when a run first asks (``reactions``).
@@ -131,6 +130,8 @@ class Group:
             return out
         first = plans[handled[0]]
         shape = structure(first.terms)
+        # one reaction structure: the plans share their ``_Shape`` (its arrays, the same
+        # objects) and their frame equations stack
         members = [v for v in handled if plans[v].hat_frames is first.hat_frames
                    and structure(plans[v].terms) == shape]
         found = _reactions(self, members, [plans[v] for v in members])

@@ -35,6 +35,7 @@ def turns(start: np.ndarray, first: np.ndarray) -> np.ndarray:
     turns of ``start`` nearest the first step's atan2 (``Natural._converted``)."""
     return np.rint((start - first) / (2 * np.pi))
 
+
 #: steps between the coarse pass's steps at the start of a run (``_coarse``)
 STRIDE = 4
 #: variant × step columns solved at once by the fill (bounded memory: about 1 kB each for a
@@ -104,7 +105,7 @@ class Answered:
     def converted(self, n: int, start: np.ndarray):
         """(q, q̇, q̈) of the first n steps (copies) for a run from ``start``: the pass's, when
         the start puts the free solids' angles in the same whole turns as the guess did
-        (``population.turns``); else None (converted as usual)."""
+        (``turns``); else None (converted as usual)."""
         if self.q is None:
             return None
         if not np.array_equal(start, self.guess) and not np.array_equal(
