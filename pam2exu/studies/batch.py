@@ -2,10 +2,10 @@
 (``Backend.solved_variants``: the natural backend stacks their equations and runs Newton on
 all of them at once, and turns every variant's answers into x, y, fi at once), then each
 variant's analysis run as a single run would, its positions read from the pass. The checks,
-the rates, the forces and the warnings of every variant are its own run's; what the pass
-shares is Newton's iterations, the conversion to x, y, fi and, on the natural backend, the
-reactions' inverse dynamics (``backend.natural.population``: made for all variants when the
-first run asks, read by each run whose motion is the pass's).
+the force columns and the warnings of every variant are its own run's; what the pass shares
+is Newton's iterations, the conversion to x, y, fi with their rates and, on the natural
+backend, the reactions' inverse dynamics (``backend.natural.population``: made for all
+variants when the first run asks, read by each run whose motion is the pass's).
 
 A variant that does not fit the pass (another structure of equations, a redundant one), or
 fails in it, gets no answers: its run solves it alone and says why it fails, exactly as the
