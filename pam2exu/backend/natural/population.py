@@ -35,7 +35,7 @@ import numpy as np
 from ...errors import Pam2ExuError
 from ..base import Reactions
 from . import inverse
-from .reactions import plan
+from .reactions import in_frames, plan
 from .terms import extended
 from .variants import Stacked, structure, turns
 from .wrenches import wrenches
@@ -192,16 +192,12 @@ def _block(pl, bd, c, mass, terms, frame_terms, grounds, cols, z, zd, zdd, q, ap
     accel = inverse.body_coordinates(bd, zdd, constant=False)    # ζ̈ (R, ns, 4)
     W = _mass_times(mass, accel) - applied
     rhs = -inverse.on_coordinates(bd, W)                           # (R, nz)
-    J = terms.dense_cols(terms.jacobian_cols(z.T)).transpose(2, 0, 1)   # Φ_z (R, m, nz)
+    J = terms.dense(terms.jacobian(z))                             # Φ_z (R, m, nz)
     mu = inverse.transposed_solve(J, rhs)                          # (R, m)
     ok = np.isfinite(mu).all(axis=1)
     zeta = (inverse.body_coordinates(bd, z, constant=False).reshape(-1, V, ns, 4)
             + c).reshape(R, ns, 4)                                 # (R, ns, 4): p, v
-    hat = np.empty((R, frame_terms.nz))
-    hat[:, pl.hat_frames[0]] = zeta.reshape(R, -1)[:, pl.hat_frames[1]]
-    hat[:, pl.hat_angles[0]] = z[:, pl.hat_angles[1]]
-    Jh = frame_terms.dense_cols(frame_terms.jacobian_cols(hat.T)).transpose(2, 0, 1)
-    origins = (q[:, pl.receiver_columns[0]].T, q[:, pl.receiver_columns[1]].T)
+    Jh, origins = in_frames(pl, frame_terms, z, zeta, q)
     rows = copy.copy(pl)                                # each row's ground points
     rows.pins = [pin if pin.columns is not None else replace(pin, constant=grounds[k][:, cols])
                  for k, pin in enumerate(pl.pins)]

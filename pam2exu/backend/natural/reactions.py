@@ -366,6 +366,19 @@ def constraint_wrenches(form: Formulation, t, q, qd, qdd,
     return out
 
 
+def in_frames(pl: Plan, terms: Terms, z, zeta, q):
+    """(Φ_ζ̂ (n, rows, ζ̂), the receivers' origins x, y (nc, n) each): the element rows'
+    Jacobian ``terms`` (the plan's, or one column per step with each step's constants) at
+    ζ̂ = (p, v, fi) of every moving solid, from z and ζ (n, ns, 4), and where each element's
+    wrench is taken about (``wrenches``)."""
+    n = len(z)
+    hat = np.empty((n, terms.nz))                              # ζ̂: (p, v, fi) per solid
+    hat[:, pl.hat_frames[0]] = zeta.reshape(n, -1)[:, pl.hat_frames[1]]
+    hat[:, pl.hat_angles[0]] = z[:, pl.hat_angles[1]]
+    return (terms.dense(terms.jacobian(hat)),
+            (q[:, pl.receiver_columns[0]].T, q[:, pl.receiver_columns[1]].T))
+
+
 def _chunk(pl: Plan, t, q, qd, qdd, extra: int):
     """(wrenches, kinetic energy, self-stress wrenches) of a chunk of steps."""
     form = pl.form
@@ -375,12 +388,7 @@ def _chunk(pl: Plan, t, q, qd, qdd, extra: int):
     J = form.terms.dense(form.terms.jacobian(z))
     mu = inverse.multipliers(form, z, W, extra > 0, jacobian=J)
     zeta = inverse.body_coordinates(bd, z)                     # (n, ns, 4): p, v
-    n = len(t)
-    hat = np.empty((n, pl.terms.nz))                           # ζ̂: (p, v, fi) per solid
-    hat[:, pl.hat_frames[0]] = zeta.reshape(n, -1)[:, pl.hat_frames[1]]
-    hat[:, pl.hat_angles[0]] = z[:, pl.hat_angles[1]]
-    Jh = pl.terms.dense(pl.terms.jacobian(hat))                 # (n, rows, ζ̂)
-    origins = (q[:, pl.receiver_columns[0]].T, q[:, pl.receiver_columns[1]].T)  # (nc, n)
+    Jh, origins = in_frames(pl, pl.terms, z, zeta, q)
     wrench = _wrenches(pl, z, zeta, J, Jh, W, mu, origins)
     modes = None
     if extra:                                                  # the null space of Φ_zᵀ
