@@ -234,20 +234,13 @@ def _scaled(mech, J: np.ndarray) -> np.ndarray:
     return out
 
 
-def _regular(mech, J: np.ndarray, rtol: float) -> bool:
-    """Whether Cq (m, nq) at one configuration is square and of full rank by ``_rank``'s
-    test with a margin: its smallest singular value over twice the threshold. Then
-    ``mobility`` needs no singular vectors (the values alone, from another LAPACK path,
-    differ from theirs by round-off, ~1e-15 of the largest: far below the margin)."""
-    if J.shape[0] != J.shape[1] or J.shape[0] == 0:
-        return False
-    s = np.linalg.svd(_scaled(mech, J), compute_uv=False)
-    return bool(s[-1] > 2 * rtol * max(1.0, s[0]))
-
-
 def _regular_condition(mech, J: np.ndarray, rtol: float) -> tuple[bool, float | None]:
-    """(``_regular``, ``_condition``) of a square Cq (m, nq) of one configuration, the same
-    bits from one SVD call on the two matrices; (False, None) for another Cq."""
+    """(regular, ``_condition``) of a square Cq (m, nq) of one configuration, the same bits
+    from one SVD call on the two matrices: regular when it is of full rank by ``_rank``'s
+    test with a margin, its smallest singular value over twice the threshold (then
+    ``mobility`` needs no singular vectors: the values alone, from another LAPACK path,
+    differ from theirs by round-off, ~1e-15 of the largest, far below the margin); (False,
+    None) for another Cq."""
     m, nq = J.shape
     if m != nq or m == 0:
         return False, None

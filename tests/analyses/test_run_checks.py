@@ -142,11 +142,20 @@ def test_the_default_outputs_do_not_make_the_derived_columns(monkeypatch):
     assert made == [1] and asked.columns == ["coupler.P.x"]
 
 
+def _regular(mech, J, rtol: float) -> bool:
+    """The reference for ``rank._regular_condition``'s test: Cq square, its scaled singular
+    values alone (one SVD of that matrix), the smallest over twice the rank threshold."""
+    if J.shape[0] != J.shape[1] or J.shape[0] == 0:
+        return False
+    s = np.linalg.svd(rank._scaled(mech, J), compute_uv=False)
+    return bool(s[-1] > 2 * rtol * max(1.0, s[0]))
+
+
 @pytest.mark.parametrize("smallest", [None, 3.0, 2.01, 1.99, 0.5, 0.0])
 def test_a_regular_jacobians_mobility_is_the_one_of_the_svd_with_vectors(smallest,
                                                                         monkeypatch):
     """``mobility`` of a square Cq of full rank takes its singular values alone
-    (``_regular``, with the condition number's in one call): the same Mobility, condition number's bits included, as the SVD with
+    (``_regular_condition``, with the condition number's in one call): the same Mobility, condition number's bits included, as the SVD with
     vectors, at the four-bar's guess and with Cq's smallest singular value set to
     ``smallest`` × the rank threshold (1e-9 of the largest) around the margin of 2 (s_max = 4.15)."""
     from pathlib import Path
@@ -160,9 +169,9 @@ def test_a_regular_jacobians_mobility_is_the_one_of_the_svd_with_vectors(smalles
         U, s, Vt = np.linalg.svd(J * scale)
         s[-1] = smallest * 1e-9 * s[0]
         J = (U * s) @ Vt / scale
-    assert rank._regular(mech, J, 1e-9) == (smallest is None or smallest > 2.0)
+    assert _regular(mech, J, 1e-9) == (smallest is None or smallest > 2.0)
     regular, condition = rank._regular_condition(mech, J, 1e-9)    # (one SVD call)
-    assert regular == rank._regular(mech, J, 1e-9)
+    assert regular == _regular(mech, J, 1e-9)
     assert str(condition) == str(rank._condition(mech, 0.0, q0, J))
     fast = rank.mobility(mech, 0.0, q0, jacobian=J)
     monkeypatch.setattr(rank, "_regular_condition", lambda *_: (False, None))
