@@ -69,8 +69,10 @@ def solve_in_parts(job: Job, start: np.ndarray, redundant: bool, rates: bool) ->
         return job.backend.solve_positions(mech, times, start, job.solver,
                                            redundant=redundant, rates=rates)
     firsts = range(0, n - 1, PART_STEPS)
-    # the rows no part gives are made NaN (not every row NaN first: a pass less over each)
-    q = np.empty((n, mech.nq))
+    # the rows no part gives are made NaN (not every row NaN first: a pass less over each);
+    # a column per coordinate, contiguous (order F): the analysis reads q column by column
+    # (the solids' angles and points, the table's columns), a step's row seldom
+    q = np.empty((n, mech.nq), order="F")
     rates_of: dict[str, np.ndarray] = {}          # the backend's qd, qdd if it gives them
     written: dict[str, int] = {}                  # ... and the rows given so far
     solved, error, last, iterations = 0, None, start, 0

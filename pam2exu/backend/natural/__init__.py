@@ -152,7 +152,7 @@ class Natural(Backend):
         fi, with ``rates`` their rates from ż, z̈, with ``forces`` the multipliers;
         ``converted``: (q, q̇, q̈) of z already (the pass's)."""
         n, solved = len(times), len(z)
-        q = np.full((n, mech.nq), np.nan)
+        q = np.full((n, mech.nq), np.nan, order="F")    # as converted: column by column
         with_rates = rates and solved
         if converted is None:
             converted = self._converted(form, mech, z, start, zd if with_rates else None, zdd)
