@@ -298,17 +298,40 @@ def test_a_local_cluster_is_started_and_stopped_by_the_run(tmp_path, payload):
 
 
 @pytest.mark.parametrize("variants, workers, sizes", [
-    (2000, 2, [500] * 4),          # 5 chunks of 400 would leave one worker idle at the end
-    (2000, 1, [400] * 5),
-    (600, 2, [300] * 2),           # every worker gets one
-    (100, 4, [25] * 4),
+    (2000, 2, [500] * 2 + [250] * 2 + [125] * 4),    # the last chunks shrink
+    (2000, 1, [400] * 5),          # one worker: nothing to balance
+    (600, 2, [150] * 4),
+    (100, 4, [25] * 4),            # every worker gets one
 ])
 def test_one_pass_chunks_are_large_and_shared_equally(variants, workers, sizes):
     """A one-pass study's chunks hold at least ``least`` variants (its pass costs less per
-    variant the larger it is), and their number is a multiple of the workers."""
+    variant the larger it is) on one worker; on several, the last ones shrink to ``least``
+    / TAIL_DIVISOR, in rounds of one chunk per worker, so that the workers finish
+    together."""
     chunks = plan_chunks(variants, 0.15, workers, least=400)
     assert [b - a for a, b in chunks] == sizes
     assert chunks[0][0] == 0 and chunks[-1][1] == variants
+
+
+@pytest.mark.parametrize("variants, workers", [(2000, 2), (1_000_003, 2), (5000, 3), (401, 2),
+                                               (3, 4), (2000, 64), (799, 2)])
+def test_one_pass_chunks_on_several_workers_shrink_towards_the_end(variants, workers):
+    """Every chunk holds at most the one-worker plan's largest share (``chunk_size``), the
+    sizes never grow, the last round (one chunk per worker) holds ``least`` /
+    TAIL_DIVISOR to 2 · ``least`` / TAIL_DIVISOR variants each when the study has that
+    many, and the plan is the same whenever it is made."""
+    least = 400
+    chunks = plan_chunks(variants, 0.15, workers, least=least)
+    assert chunks == plan_chunks(variants, 0.15, workers, least=least)
+    assert chunks[0][0] == 0 and chunks[-1][1] == variants
+    assert all(a[1] == b[0] for a, b in zip(chunks, chunks[1:]))
+    sizes = [b - a for a, b in chunks]
+    assert min(sizes) >= 1 and max(sizes) <= parts.chunk_size(0.15, variants, workers, least)
+    assert all(b <= a + 1 for a, b in zip(sizes, sizes[1:]))        # equal split: ± 1
+    tail = least // parts.TAIL_DIVISOR
+    if variants >= 2 * workers * tail:
+        assert len(sizes) % workers == 0
+        assert all(tail <= s <= 2 * tail for s in sizes[-workers:])
 
 
 WORKERS_IMPORT = """
