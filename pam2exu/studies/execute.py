@@ -72,10 +72,13 @@ RETRIES = 2
 #: threads (a Dask client, Exudyn)
 START_METHOD = "forkserver" if "forkserver" in get_all_start_methods() else "spawn"
 #: what a study's worker processes import, once, in the server they are forked from (the
-#: start method "forkserver"): the study's task (``runner.run_variants``) and the analyses
-#: it runs; ``__main__`` as Python's own default (a worker then need not run the main
-#: script again)
-WORKER_MODULES = ("__main__", "pam2exu.studies.runner", "pam2exu.analyses")
+#: start method "forkserver"): the study's task (``runner.run_variants``), the analyses it
+#: runs and the natural backend with the SciPy modules it needs (which every worker would
+#: otherwise import in its first chunk, 0.6–0.9 s of CPU each, all at once on the cores
+#: the chunks need; the server imports them while the caller runs its checks); ``__main__``
+#: as Python's own default (a worker then need not run the main script again)
+WORKER_MODULES = ("__main__", "pam2exu.studies.runner", "pam2exu.analyses",
+                  "pam2exu.backend.natural")
 
 
 class ChunkError(Pam2ExuError):

@@ -342,6 +342,7 @@ from pam2exu.studies.execute import open_executor
 if __name__ == "__main__":
     with open_executor(2) as pool:
         print(pool.submit(chunk_tasks.imported, ["pam2exu.studies.runner", "pam2exu.analyses",
+                                                 "pam2exu.backend.natural",
                                                  "scipy.stats"]).result())
 """
 
@@ -349,9 +350,9 @@ if __name__ == "__main__":
 @pytest.mark.long
 @pytest.mark.skipif(execute.START_METHOD != "forkserver", reason="no fork server here")
 def test_a_pools_workers_start_with_the_studys_modules_imported(tmp_path):
-    """The server a local pool's workers are forked from has imported the study's task and
-    the analyses (``WORKER_MODULES``: a worker does not import pam2exu, NumPy and SciPy
-    itself), and not scipy.stats, which only the study's draws need (in this process); in a
+    """The server a local pool's workers are forked from has imported the study's task,
+    the analyses and the natural backend (``WORKER_MODULES``: a worker does not import
+    pam2exu, NumPy and SciPy itself), and not scipy.stats, which only the study's draws need (in this process); in a
     fresh interpreter, whose fork server the pool starts."""
     import subprocess
     script = tmp_path / "pool.py"
@@ -359,7 +360,7 @@ def test_a_pools_workers_start_with_the_studys_modules_imported(tmp_path):
                                                    str(Path(__file__).parents[2])]))
     out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
                          timeout=120)
-    assert out.stdout.strip() == "[True, True, False]", out.stderr
+    assert out.stdout.strip() == "[True, True, True, False]", out.stderr
 
 
 WARMED = """
