@@ -10,9 +10,13 @@
 - ``cores_free``: the cores two processes get at once on this machine now, the most a pool
   of 2 can gain then;
 - ``sending``: what sending a study's chunks costs a Dask cluster when each chunk carries
-  every variant's values (as before the engine's ``rows``) against its own rows only.
+  every variant's values (as before the engine's ``rows``) against its own rows only;
+- ``timeline``: one fresh run as ``run_fresh``'s, with when each chunk starts and ends in
+  its worker (and the CPU it took), when the parent's nominal run, each chunk's arrival and
+  its part's writing happen, and the parent's CPU time at each.
 
     python benchmarks/workers.py --pool-start 0 --sending 1000000
+    python benchmarks/workers.py --pool-start 0 --timeline 2
 """
 from __future__ import annotations
 
@@ -118,6 +122,76 @@ def pool_ready(after_checks: bool) -> float:
     return float(done.stdout.split()[-1])
 
 
+def timed_variants(payload, start, stop, values):
+    """``runner.run_variants`` with a column ``TIMED`` (on every row: the worker's process
+    id, its clock at the chunk's start and end, the chunk's CPU time), for ``timeline``."""
+    import os
+    from pam2exu.studies.runner import run_variants
+    begin, cpu = time.time(), time.process_time()
+    out = run_variants(payload, start, stop, values)
+    out[TIMED] = np.array([[os.getpid(), begin, time.time(), time.process_time() - cpu]]
+                          * (stop - start))
+    return out
+
+
+TIMED = "__timed__"
+#: ``timeline``'s process: ``FRESH``'s study with ``timed_variants`` as the task; the
+#: parent's events (clock, its CPU time, what) and the workers' printed in time order
+TIMELINE = """
+import sys, time
+import scipy.stats, pam2exu.analyses, pam2exu.backend.natural
+from dataclasses import replace
+from pam2exu.studies import execute, load_study, runner
+from benchmarks.workers import TIMED, timed_variants
+events = []
+def mark(what):
+    events.append((time.time(), time.process_time(), what))
+def wrapped(fn, before, after=None):
+    def call(*args, **kwargs):
+        mark(before(*args))
+        out = fn(*args, **kwargs)
+        if after:
+            mark(after(*args))
+        return out
+    return call
+def arrived(columns, start, stop, *rest):
+    pid, begin, end, cpu = columns.pop(TIMED)[0]
+    events.append((begin, None, f"worker {int(pid)} begins {start}-{stop}"))
+    events.append((end, None, f"worker {int(pid)} ends {start}-{stop} ({cpu:.2f} s CPU)"))
+    return f"arrived {start}-{stop}"
+if __name__ == "__main__":
+    study = replace(load_study(sys.argv[1]), samples=int(sys.argv[3]))
+    workers = int(sys.argv[2])
+    runner.nominal = wrapped(runner.nominal, lambda s: "nominal run begins",
+                             lambda s: "nominal run ends")
+    run_chunks = runner.run_chunks
+    runner.run_chunks = lambda task, *a, **k: (mark("chunks begin"),
+                                               run_chunks(timed_variants, *a, **k))[1]
+    execute.checked_columns = wrapped(execute.checked_columns, arrived)
+    execute.write_part = wrapped(execute.write_part, lambda f, a, b, *r: f"writing {a}-{b}",
+                                 lambda f, a, b, *r: f"written {a}-{b}")
+    print("chunks", runner.chunks_of(runner.prepared(study), workers))
+    mark("open the executor")
+    with execute.open_executor(workers) as executor:
+        runner.study(study, executor=executor, workers=workers)
+        mark("study done")
+    mark("executor closed")
+    zero = events[0][0]
+    for at, cpu, what in sorted(events, key=lambda e: e[0]):
+        print(f"{at - zero:7.3f} s  " + ("" if cpu is None else f"parent CPU {cpu:6.2f} s  ")
+              + what)
+"""
+
+
+def timeline(workers: int, variants: int = 2000) -> str:
+    """The events of one fresh run of STUDY_FILE's study (``TIMELINE``), as printed."""
+    study = ROOT / "examples" / "studies" / "four_bar_tolerance.toml"
+    done = subprocess.run([sys.executable, "-c", TIMELINE, str(study), str(workers),
+                           str(variants)], capture_output=True, text=True, cwd=ROOT,
+                          check=True)
+    return done.stdout
+
+
 def spin(seconds: float) -> float:
     """Wall time [s] this process takes to burn ``seconds`` of CPU in Python."""
     cpu, begin = time.process_time(), time.perf_counter()
@@ -180,7 +254,14 @@ def main(argv=None):
     parser.add_argument("--sending", type=int, default=0, metavar="VARIANTS",
                         help="time sending 100 chunks of a study of VARIANTS variants to a "
                              "Dask cluster, whole values against each chunk's own rows")
+    parser.add_argument("--timeline", type=int, default=0, metavar="WORKERS",
+                        help="one fresh run of the four-bar tolerance study on WORKERS "
+                             "workers: when each chunk starts and ends, what the parent does")
     args = parser.parse_args(argv)
+    if args.timeline:
+        workers_see_this_clone()
+        print(f"load {load_average():.2f}")
+        print(timeline(args.timeline), end="")
     if args.sending:
         took = sending(args.sending)
         print(f"100 chunks of a {args.sending:,}-variant study on a Dask LocalCluster of 2: "
