@@ -152,7 +152,8 @@ class Stacked:
 
     def __init__(self, terms: list[Terms]):
         first = terms[0]
-        if any(structure(t) != structure(first) for t in terms[1:]):
+        shape = structure(first)
+        if any(structure(t) != shape for t in terms[1:]):
             raise ValueError("variants with different equation structures do not stack")
         self.base = copy.copy(first)
         self.base.laws = []                  # the targets are added here, per variant
