@@ -3,6 +3,7 @@ constraints leave and the equations they repeat (``Mobility``), whether redundan
 contradict each other and which element added last makes them, the first singular step."""
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,7 +63,10 @@ def _candidates(A: np.ndarray) -> np.ndarray | None:
 
     The eigenvalues are taken at every PROBE-th step first; a step between them whose κ
     is below their largest lower bound for certain, from its nearest probed step's σ and
-    Weyl's |σ_i(A_k) − σ_i(A_j)| ≤ ‖A_k − A_j‖_F (``_ruled_out``), needs none."""
+    Weyl's |σ_i(A_k) − σ_i(A_j)| ≤ ‖A_k − A_j‖_F (``_ruled_out``), needs none. Within
+    ``references``, the first stack of a shape gets them at every step and becomes its
+    reference; a later one gets them only at the steps its reference's bounds leave
+    (``_referred``), or, when those are more than half, as without one."""
     n = len(A)
     if n == 0 or np.iscomplexobj(A):
         return None
@@ -70,15 +74,24 @@ def _candidates(A: np.ndarray) -> np.ndarray | None:
     if not np.isfinite(size).all():                  # (A has a NaN or an ∞: so has it)
         return None
     error, low, high = GRAM_ERROR * size, np.zeros(n), np.zeros(n)
-    known = np.zeros(n, dtype=bool)
-    known[::PROBE] = known[-1] = True
-    bounded = _bound(A, known, low, high, size)
-    rest = ~known
-    if rest.any() and bounded[known].all():
-        rest[rest] = ~_ruled_out(A, known, rest, low, high, error)
-    if rest.any():
-        bounded = _bound(A, rest, low, high, size)
-        known |= rest
+    known = _referred(A, low, high, size, error)
+    if known is not None:
+        bounded = low > size / BOUNDED ** 2
+    elif (_REFERENCES is not None and A.shape not in _REFERENCES
+          and len(_REFERENCES) < KEPT_REFERENCES and A.nbytes <= REFERENCE_BYTES):
+        known = np.ones(n, dtype=bool)                     # this shape's reference
+        bounded = _bound(A, known, low, high, size)
+        _REFERENCES[A.shape] = _reference(A, low, high, error, bounded)
+    else:
+        known = np.zeros(n, dtype=bool)
+        known[::PROBE] = known[-1] = True
+        bounded = _bound(A, known, low, high, size)
+        rest = ~known
+        if rest.any() and bounded[known].all():
+            rest[rest] = ~_ruled_out(A, known, rest, low, high, error)
+        if rest.any():
+            bounded = _bound(A, rest, low, high, size)
+            known |= rest
     if not bounded.any():
         return None
     with np.errstate(divide="ignore", invalid="ignore"):     # (steps not bounded)
@@ -114,6 +127,66 @@ def _ruled_out(A, known, rest, low, high, error) -> np.ndarray:
     smallest, largest = np.sqrt(low[j] - error[j]) - d, np.sqrt(high[j] + error[j]) + d
     lower = np.sqrt(np.maximum(high[known] - error[known], 0.0) / (low[known] + error[known]))
     return largest * (1 + 2 * SVD_ERROR) < np.max(lower) * (1 - SVD_ERROR) * smallest
+
+
+#: ``references``' stacks: shape → (R, σ_1 ≥, σ_1 ≤, σ_r ≥, σ_r ≤ of every step), or None
+_REFERENCES: dict | None = None
+#: at most this many shapes kept by ``references``, each of at most this many bytes
+KEPT_REFERENCES, REFERENCE_BYTES = 4, 1 << 23
+
+
+@contextmanager
+def references():
+    """Within it, ``largest_condition`` keeps the first equilibrated Cq stack of each shape
+    with its Gram eigenvalues at every step (a reference) and bounds a later stack's κ from
+    it (``_referred``): a study's variants, whose Cq differ little, then need the
+    eigenvalues at a few steps, not at every PROBE-th. What it returns is the same: the
+    references decide only which steps get their SVD, and every step that can be the
+    largest does. Left: the references go."""
+    global _REFERENCES
+    outer = _REFERENCES
+    if outer is None:
+        _REFERENCES = {}
+    try:
+        yield
+    finally:
+        _REFERENCES = outer
+
+
+def _reference(R, low, high, error, bounded) -> tuple:
+    """(R, σ_1 ≥, σ_1 ≤, σ_r ≥, σ_r ≤) at every step of R from its Gram eigenvalues (within
+    ±``error``; σ_r ≥ 0 where they are not tight)."""
+    floor = np.where(bounded, np.sqrt(np.maximum(low - error, 0.0)), 0.0)
+    return (R.copy(), np.sqrt(np.maximum(high - error, 0.0)), np.sqrt(high + error),
+            floor, np.sqrt(low + error))
+
+
+def _referred(A, low, high, size, error) -> np.ndarray | None:
+    """The steps (a mask) whose κ(A) can be the largest by the reference of A's shape
+    (``references``), their Gram eigenvalues put into ``low``, ``high``; None without a
+    reference, or when it leaves more than half of the steps.
+
+    Weyl: |σ_i(A_k) − σ_i(R_k)| ≤ ‖A_k − R_k‖_2 ≤ d_k = ‖A_k − R_k‖_F (1 + SVD_ERROR) (its
+    round-off: ~n ε of it), so κ_k ≤ (σ_1(R_k)≤ + d_k) / (σ_r(R_k)≥ − d_k) where that
+    denominator is positive, and κ_k ≥ (σ_1(R_k)≥ − d_k) / (σ_r(R_k)≤ + d_k): a step whose
+    upper bound × (1 + 2 SVD_ERROR) is below the largest lower bound × (1 − SVD_ERROR) is
+    below the largest κ, with the margins of ``_ruled_out``; the step of the largest κ is
+    never one of those."""
+    ref = None if _REFERENCES is None else _REFERENCES.get(A.shape)
+    if ref is None:
+        return None
+    R, top_low, top_high, bottom_low, bottom_high = ref
+    D = A - R
+    d = np.sqrt(np.einsum("nij,nij->n", D, D)) * (1 + SVD_ERROR)
+    floor = bottom_low - d
+    with np.errstate(divide="ignore", invalid="ignore"):
+        upper = np.where(floor > 0.0, (top_high + d) / floor, np.inf)
+        lower = (top_low - d) / (bottom_high + d)
+    near = upper * (1 + 2 * SVD_ERROR) >= np.max(lower) * (1 - SVD_ERROR)
+    if np.count_nonzero(near) > len(A) // 2:
+        return None
+    _bound(A, near, low, high, size)
+    return near
 
 
 def _equilibrated(J: np.ndarray) -> np.ndarray:

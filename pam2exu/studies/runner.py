@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analyses.rank import references
 from ..errors import (InputWarning, ModelError, OutputError, Pam2ExuError, Problem,
                       warn_outside)
 from ..registry import ANALYSES, analysis_type
@@ -143,15 +144,16 @@ def run_variants(payload: dict, start: int, stop: int, values: np.ndarray
     try:
         if one_pass(payload):              # the chunk's positions in one pass
             (made, solved), frozen = set_apart(lambda: _one_pass(payload, values))
-        for i in range(start, stop):
-            row = values[i - start]
-            reduced, outcome, warned_text, series = run_variant(payload, row, made[i - start],
-                                                                solved[i - start])
-            made[i - start] = solved[i - start] = None       # its objects may go now
-            rows.append(Variant(i, ERROR, outcome, tuple(row), None) if reduced is None
-                        else Variant(i, outcome, "", tuple(row), reduced))
-            warned_rows.append(warned_text)
-            kept.append(series)
+        with references():                 # the condition checks bound κ from the first's
+            for i in range(start, stop):
+                row = values[i - start]
+                reduced, outcome, warned_text, series = run_variant(
+                    payload, row, made[i - start], solved[i - start])
+                made[i - start] = solved[i - start] = None       # its objects may go now
+                rows.append(Variant(i, ERROR, outcome, tuple(row), None) if reduced is None
+                            else Variant(i, outcome, "", tuple(row), reduced))
+                warned_rows.append(warned_text)
+                kept.append(series)
     finally:
         if frozen:
             gc.unfreeze()

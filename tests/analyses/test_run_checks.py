@@ -81,6 +81,37 @@ def test_steps_ruled_out_by_a_probed_neighbour_are_below_the_largest(steps, peak
     assert k in rank._candidates(rank._equilibrated(A))
 
 
+@pytest.mark.parametrize("peak, other", [(3, 3), (50, 3), (99, 60)])
+def test_a_reference_stack_leaves_the_largest_condition_the_same(peak, other, monkeypatch):
+    """Within ``references`` a stack is bounded from the first one of its shape: variants
+    a little apart (their κ peaks where the reference's does, or elsewhere) and a stack
+    far from it (the usual probes then) give every step's SVD's largest κ and its step,
+    the near ones with the eigenvalues at fewer steps than without a reference."""
+    rng = np.random.default_rng(peak + other)
+    A = _smooth(rng, 101, 12, 12, peak)
+    B = _smooth(np.random.default_rng(peak + other), 101, 12, 12, other)
+    near = rank._equilibrated(A + 1e-5 * np.random.default_rng(7).standard_normal(A.shape))
+    far = _smooth(np.random.default_rng(99), 101, 12, 12, 20)
+    sizes, eigvalsh = [], np.linalg.eigvalsh
+    monkeypatch.setattr(np.linalg, "eigvalsh", lambda G: sizes.append(len(G)) or eigvalsh(G))
+
+    class Mech:
+        nq = 12
+
+    def largest(S):
+        every = rank.condition_numbers(Mech, None, None, S)
+        return int(np.argmax(every)), float(every[int(np.argmax(every))])
+
+    with rank.references():
+        assert rank.largest_condition(Mech, None, None, A) == largest(A)    # the reference
+        for S in (near, B, far, A):
+            without = sum(sizes)
+            assert rank.largest_condition(Mech, None, None, S) == largest(S)
+            if S is near or S is A:
+                assert sum(sizes) - without < 101 // 2
+    assert rank._REFERENCES is None
+
+
 def test_the_continuity_defect_is_the_plain_expressions_bits():
     """``continuity_defect`` (buffers reused over its blocks, the rows' largest column by
     column) gives max |q̇_k − q̇_j − dt (q̈_k + q̈_j)/2| / scale bit for bit, over a block
