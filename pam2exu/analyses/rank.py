@@ -4,6 +4,7 @@ contradict each other and which element added last makes them, the first singula
 from __future__ import annotations
 
 from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,14 +75,15 @@ def _candidates(A: np.ndarray) -> np.ndarray | None:
     if not np.isfinite(size).all():                  # (A has a NaN or an ∞: so has it)
         return None
     error, low, high = GRAM_ERROR * size, np.zeros(n), np.zeros(n)
-    known = _referred(A, low, high, size, error)
+    references_ = _REFERENCES.get()
+    known = None if references_ is None else _referred(A, references_, low, high, size, error)
     if known is not None:
         bounded = low > size / BOUNDED ** 2
-    elif (_REFERENCES is not None and A.shape not in _REFERENCES
-          and len(_REFERENCES) < KEPT_REFERENCES and A.nbytes <= REFERENCE_BYTES):
+    elif (references_ is not None and A.shape not in references_
+          and len(references_) < KEPT_REFERENCES and A.nbytes <= REFERENCE_BYTES):
         known = np.ones(n, dtype=bool)                     # this shape's reference
         bounded = _bound(A, known, low, high, size)
-        _REFERENCES[A.shape] = _reference(A, low, high, error, bounded)
+        references_[A.shape] = _reference(A, low, high, error, bounded)
     else:
         known = np.zeros(n, dtype=bool)
         known[::PROBE] = known[-1] = True
@@ -130,7 +132,8 @@ def _ruled_out(A, known, rest, low, high, error) -> np.ndarray:
 
 
 #: ``references``' stacks: shape → (R, σ_1 ≥, σ_1 ≤, σ_r ≥, σ_r ≤ of every step), or None
-_REFERENCES: dict | None = None
+#: outside it (a context variable: each thread its own)
+_REFERENCES: ContextVar[dict | None] = ContextVar("references", default=None)
 #: at most this many shapes kept by ``references``, each of at most this many bytes
 KEPT_REFERENCES, REFERENCE_BYTES = 4, 1 << 23
 
@@ -143,14 +146,11 @@ def references():
     eigenvalues at a few steps, not at every PROBE-th. What it returns is the same: the
     references decide only which steps get their SVD, and every step that can be the
     largest does. Left: the references go."""
-    global _REFERENCES
-    outer = _REFERENCES
-    if outer is None:
-        _REFERENCES = {}
+    token = _REFERENCES.set({} if _REFERENCES.get() is None else _REFERENCES.get())
     try:
         yield
     finally:
-        _REFERENCES = outer
+        _REFERENCES.reset(token)
 
 
 def _reference(R, low, high, error, bounded) -> tuple:
@@ -161,10 +161,10 @@ def _reference(R, low, high, error, bounded) -> tuple:
             floor, np.sqrt(low + error))
 
 
-def _referred(A, low, high, size, error) -> np.ndarray | None:
+def _referred(A, references_: dict, low, high, size, error) -> np.ndarray | None:
     """The steps (a mask) whose κ(A) can be the largest by the reference of A's shape
-    (``references``), their Gram eigenvalues put into ``low``, ``high``; None without a
-    reference, or when it leaves more than half of the steps.
+    among ``references_`` (``references``), their Gram eigenvalues put into ``low``,
+    ``high``; None without a reference, or when it leaves more than half of the steps.
 
     Weyl: |σ_i(A_k) − σ_i(R_k)| ≤ ‖A_k − R_k‖_2 ≤ d_k = ‖A_k − R_k‖_F (1 + SVD_ERROR) (its
     round-off: ~n ε of it), so κ_k ≤ (σ_1(R_k)≤ + d_k) / (σ_r(R_k)≥ − d_k) where that
@@ -172,7 +172,7 @@ def _referred(A, low, high, size, error) -> np.ndarray | None:
     upper bound × (1 + 2 SVD_ERROR) is below the largest lower bound × (1 − SVD_ERROR) is
     below the largest κ, with the margins of ``_ruled_out``; the step of the largest κ is
     never one of those."""
-    ref = None if _REFERENCES is None else _REFERENCES.get(A.shape)
+    ref = references_.get(A.shape)
     if ref is None:
         return None
     R, top_low, top_high, bottom_low, bottom_high = ref

@@ -109,7 +109,7 @@ def test_a_reference_stack_leaves_the_largest_condition_the_same(peak, other, mo
             assert rank.largest_condition(Mech, None, None, S) == largest(S)
             if S is near or S is A:
                 assert sum(sizes) - without < 101 // 2
-    assert rank._REFERENCES is None
+    assert rank._REFERENCES.get() is None
 
 
 def test_the_continuity_defect_is_the_plain_expressions_bits():
