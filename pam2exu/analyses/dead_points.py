@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..kinematics import State
 from .native import equations
@@ -168,6 +167,7 @@ def sign_change(mech, t0: float, t1: float, q0: np.ndarray, scale: float) -> Sin
         if q is None:
             raise ArithmeticError
         return float(np.linalg.det(_jacobian(mech, t, q)[1]))
+    from scipy.optimize import brentq              # (imported when a dead point is bracketed)
     try:
         t = brentq(det, t0, t1, xtol=TIME_TOL, rtol=4 * np.finfo(float).eps)
     except (ArithmeticError, ValueError):

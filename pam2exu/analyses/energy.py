@@ -16,7 +16,6 @@ as ``energy.<quantity>``.
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import cumulative_simpson
 
 from ..kinematics import State
 from ..model import Model, load
@@ -121,4 +120,5 @@ def _since_start(t: np.ndarray, power: np.ndarray) -> np.ndarray:
     """∫_0^t P: cumulative Simpson over the rows (trapezoid with fewer than 3)."""
     if len(t) < 3:
         return np.r_[0.0, np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))]
+    from scipy.integrate import cumulative_simpson   # (a run that asks for no energy: not imported)
     return cumulative_simpson(power, x=t, initial=0.0)

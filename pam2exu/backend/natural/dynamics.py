@@ -28,7 +28,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import DOP853, Radau
 
 from ...errors import SolverError
 from ...kinematics import ANGLES, column
@@ -71,8 +70,15 @@ class Dynamics:
         weight = Loads(form, np.zeros((1, self.nz)), np.zeros((1, mech.nq)))
         weight.gravity(mech.gravity)
         self.weight = weight.on_coordinates()[0]
-        self.method = DOP853
+        self.stiff = False                          # DOP853 until it needs too many steps
         self.evaluations = 0
+
+    @property
+    def method(self):
+        """scipy's integrator: DOP853, Radau once the model is taken as stiff (imported
+        here, not with the module: a study or a kinematic run never integrates)."""
+        from scipy.integrate import DOP853, Radau
+        return Radau if self.stiff else DOP853
 
     # ---- the equations ------------------------------------------------------------------
     def angles(self, z: np.ndarray) -> np.ndarray:
@@ -193,7 +199,7 @@ class Dynamics:
                     "may reach a singular position where the mechanism locks or branches: "
                     "check the model there (pam2exu draw MODEL --t T), or end the interval "
                     "before it", time=float(solver.t))
-            if self.method is DOP853 and steps > STIFF_STEPS:
+            if not self.stiff and steps > STIFF_STEPS:
                 return None, None, steps
             t = solver.t
             last = k
@@ -230,7 +236,7 @@ def motion(backend, form, mech, times, q0, qd0, tolerance: float, verbose: int =
     while True:
         ys, fis, steps = dyn.run(times, y0, r)
         if ys is None:                     # stiff: Radau from the same tolerance
-            dyn.method = Radau
+            dyn.stiff = True
             continue
         found = dyn.to_q(ys, fis, q0)
         if verbose:
