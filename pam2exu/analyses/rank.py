@@ -76,9 +76,10 @@ def _candidates(A: np.ndarray) -> np.ndarray | None:
         return None
     error, low, high = GRAM_ERROR * size, np.zeros(n), np.zeros(n)
     references_ = _REFERENCES.get()
-    known = None if references_ is None else _referred(A, references_, low, high, size, error)
-    if known is not None:
-        bounded = low > size / BOUNDED ** 2
+    referred = None if references_ is None else _referred(A, references_, low, high, size,
+                                                          error)
+    if referred is not None:
+        known, bounded = referred
     elif (references_ is not None and A.shape not in references_
           and len(references_) < KEPT_REFERENCES and A.nbytes <= REFERENCE_BYTES):
         known = np.ones(n, dtype=bool)                     # this shape's reference
@@ -161,10 +162,11 @@ def _reference(R, low, high, error, bounded) -> tuple:
             floor, np.sqrt(low + error))
 
 
-def _referred(A, references_: dict, low, high, size, error) -> np.ndarray | None:
-    """The steps (a mask) whose κ(A) can be the largest by the reference of A's shape
+def _referred(A, references_: dict, low, high, size, error) -> tuple | None:
+    """(the steps (a mask) whose κ(A) can be the largest by the reference of A's shape
     among ``references_`` (``references``), their Gram eigenvalues put into ``low``,
-    ``high``; None without a reference, or when it leaves more than half of the steps.
+    ``high``; the steps whose bounds are tight, ``_bound``'s); None without a reference, or
+    when it leaves more than half of the steps.
 
     Weyl: |σ_i(A_k) − σ_i(R_k)| ≤ ‖A_k − R_k‖_2 ≤ d_k = ‖A_k − R_k‖_F (1 + SVD_ERROR) (its
     round-off: ~n ε of it), so κ_k ≤ (σ_1(R_k)≤ + d_k) / (σ_r(R_k)≥ − d_k) where that
@@ -185,8 +187,7 @@ def _referred(A, references_: dict, low, high, size, error) -> np.ndarray | None
     near = upper * (1 + 2 * SVD_ERROR) >= np.max(lower) * (1 - SVD_ERROR)
     if np.count_nonzero(near) > len(A) // 2:
         return None
-    _bound(A, near, low, high, size)
-    return near
+    return near, _bound(A, near, low, high, size)
 
 
 def _equilibrated(J: np.ndarray) -> np.ndarray:
