@@ -139,8 +139,9 @@ def copied(dest: Path) -> None:
 
 
 def totals(out: Path) -> dict[str, int]:
-    """{dump's trigger name: its count} of the callgrind files ``out``.*: instructions, or
-    with the cache simulated the estimated cycles (``estimated``)."""
+    """{dump's trigger name: its count, summed over the dumps of that name} of the
+    callgrind files ``out``.*: instructions, or with the cache simulated the estimated
+    cycles (``estimated``)."""
     found = {}
     for path in sorted(out.parent.glob(out.name + ".*")):
         name = events = counts = None
@@ -152,7 +153,7 @@ def totals(out: Path) -> dict[str, int]:
             elif line.startswith(("totals: ", "summary: ")):
                 counts = [int(v) for v in line.split()[1:]]
         if name is not None and counts is not None:
-            found[name] = estimated(dict(zip(events or ["Ir"], counts)))
+            found[name] = found.get(name, 0) + estimated(dict(zip(events or ["Ir"], counts)))
     return found
 
 

@@ -28,7 +28,7 @@ from pathlib import Path
 if __name__ == "__main__":
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.instructions import ROOT, TRIGGER, client_library  # noqa: E402
+from benchmarks.instructions import ROOT, client_library, totals  # noqa: E402
 
 #: (module, function or Class.method, the part's name) in the order of the table
 PARTS = (
@@ -103,21 +103,6 @@ print(sorted({name for _, _, name in PARTS} - entered))   # parts never entered
 '''
 
 
-def summed(out: Path) -> Counter:
-    """{part: instructions} summed over the callgrind dumps ``out``.* of each name."""
-    found: Counter = Counter()
-    for path in out.parent.glob(out.name + ".*"):
-        name = count = None
-        for line in path.read_text(errors="replace").splitlines():
-            if line.startswith(TRIGGER):
-                name = line[len(TRIGGER):]
-            elif line.startswith(("totals: ", "summary: ")):
-                count = int(line.split()[1])
-        if name is not None and count is not None:
-            found[name] += count
-    return found
-
-
 def table(parts: Counter, variants: int) -> list[str]:
     """The parts as Markdown rows, largest first: M instructions a variant and share."""
     whole = sum(parts.values())
@@ -150,7 +135,7 @@ def main(argv=None) -> None:
         missed = done.stdout.strip().splitlines()[-1]
         if missed != "[]":
             print(f"parts never entered (PARTS no longer names what the run calls): {missed}")
-        print("\n".join(table(summed(out), args.variants)))
+        print("\n".join(table(Counter(totals(out)), args.variants)))
 
 
 if __name__ == "__main__":
