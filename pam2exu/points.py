@@ -64,6 +64,9 @@ OPT_IN = frozenset(v.name for v in CENTRE_OUTPUTS + COUPLER_OUTPUTS)
 #: an instantaneous centre farther than this many mechanism lengths is at infinity
 #: (the solid translates): |v| / |Dfi| > FAR · L gives NaN
 FAR = 1e9
+#: a relative motion smaller than this fraction of the mechanism's fastest motion is the
+#: roundoff of two solids moving together (``relative_field``)
+STILL = 1e-12
 
 
 def is_opt_in(column: str) -> bool:
@@ -172,6 +175,24 @@ def velocity_field(r, v, dfi) -> np.ndarray:
     r, v = np.asarray(r, dtype=float), np.asarray(v, dtype=float)
     u = v - dfi * perp(r)
     return np.array([-u[1], u[0], dfi])
+
+
+def relative_field(h_i, h_j, fastest: float, length: float = 1.0) -> np.ndarray:
+    """h_i − h_j, exactly 0 where |Ω u| + |ω| L ≤ ``STILL`` · fastest: two solids moving together.
+
+    ``fastest`` [m/s] is the largest |Ω u| + |ω| L of the mechanism's solids: two solids at
+    rest in a mechanism that moves differ by roundoff (1e-17 m/s), and that roundoff must not
+    give them a centre (its point would be anywhere).
+
+    Examples
+    --------
+    >>> relative_field([2e-17, 0.0, 4e-17], [0.0, 0.0, 0.0], fastest=0.2) + 0.0
+    array([0., 0., 0.])
+    """
+    h = np.asarray(h_i, dtype=float) - np.asarray(h_j, dtype=float)
+    if np.hypot(h[0], h[1]) + abs(h[2]) * length <= STILL * fastest:
+        return np.zeros(3)
+    return h
 
 
 def relative_centre(h_i, h_j, length: float = 1.0) -> np.ndarray:

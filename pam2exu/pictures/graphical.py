@@ -28,7 +28,8 @@ import numpy as np
 
 from ..kinematics import perp, rotate
 from ..points import (collinearity, in_frame, inflection_circle, instantaneous_centre,
-                      off_line, point_motion, relative_centre, velocity_field)
+                      off_line, point_motion, relative_centre, relative_field,
+                      velocity_field)
 from ..results.plot import PictureError
 from .poses import _model
 from .vectors import _row
@@ -264,18 +265,26 @@ def kennedy_residual(a: Centre, b: Centre, c: Centre) -> float | None:
 
 
 def all_centres(model, t: float) -> Centres:
-    """The n (n − 1) / 2 instantaneous centres of the mechanism's n bodies at time t [s]
-    (``points.relative_centre``) and the Kennedy lines of every three bodies."""
+    """The n (n − 1) / 2 instantaneous centres of the mechanism's n bodies at time t [s] and
+    the Kennedy lines of every three bodies (``kennedy``)."""
     mech, _, moving = motions(model, t)
-    length = mech.scale()
     held = sorted(mech.held)
     ground = [] if not held else [(mech.solids[held[0]].name, np.zeros(3))]
     bodies = ground + [(m.name, velocity_field(m.r, m.v, m.dfi)) for m in moving
                        if m.index not in mech.held]
+    return kennedy(bodies, t, mech.scale())
+
+
+def kennedy(bodies, t: float, length: float) -> Centres:
+    """The centres and Kennedy lines of ``bodies``, [(name, h)] with h their
+    ``points.velocity_field``s (the ground first): the centre of each two
+    (``points.relative_centre``; none for two moving together to roundoff:
+    ``points.relative_field``), the line of each three."""
+    fastest = max(np.hypot(h[0], h[1]) + abs(h[2]) * length for _, h in bodies)
     found = []
     for (i, (ni, hi)), (j, (nj, hj)) in combinations(enumerate(bodies, start=1), 2):
-        point = relative_centre(hi, hj, length)
-        h = hi - hj
+        h = relative_field(hi, hj, fastest, length)
+        point = relative_centre(h, np.zeros(3), length)
         direction = None
         if not np.all(np.isfinite(point)):
             size = float(np.hypot(h[0], h[1]))

@@ -17,7 +17,7 @@ import pam2exu
 from pam2exu.cli import _parser, main
 from pam2exu.pictures import Pen, draw
 from pam2exu.pictures.constructions import draw_centres, draw_polygon
-from pam2exu.pictures.graphical import all_centres, centrodes, polygon
+from pam2exu.pictures.graphical import all_centres, centrodes, kennedy, polygon
 from pam2exu.results.plot import PictureError, figure
 
 T = 0.1                  # [s]: crank at 36°
@@ -197,6 +197,25 @@ def test_every_centre_of_twelve_bodies(examples):
     sun, planet = _xy(res, "sun"), _xy(res, "planet")
     gears = found.centre(found.bodies.index("sun") + 1, found.bodies.index("planet") + 1)
     np.testing.assert_allclose(gears.point, sun + 0.6 * (planet - sun), rtol=0, atol=1e-9)
+
+
+def test_solids_at_rest_to_roundoff_move_together():
+    """The fields of examples/all_elements.toml at t = 0.05 s that a run gave once (CI of
+    stop 37, this test's reason): the sun at rest with the ground but for roundoff
+    (2.2e-17, 0, 3.7e-17), the slider translating at 0.164 m/s. Taken at face value the
+    sun's roundoff gives it a centre with the ground at (0.6, 0) and the line of the ground,
+    slider and sun two centres at infinity (no residual); below 1e-12 of the fastest motion
+    the sun and the ground move together (``points.relative_field``), as the sun and a
+    solid held still exactly. A real relative motion of 1e-6 of the fastest is kept."""
+    ground, slider = np.zeros(3), np.array([0.0, 0.16435874, 0.0])
+    for sun, together in ((np.array([2.22044605e-17, 0.0, 3.70074342e-17]), True),
+                          (np.zeros(3), True),
+                          (np.array([0.0, 0.0, 1.64e-7]), False)):
+        found = kennedy([("ground", ground), ("slider", slider), ("sun", sun)], 0.05, 1.0)
+        assert found.centre(1, 3).defined is not together
+        (line,) = found.lines
+        assert line.residual == 0.0 if together else line.residual <= 1e-9
+    np.testing.assert_array_equal(found.centre(1, 3).point, [0.0, 0.0])
 
 
 def _circle_through(p, q, r):
