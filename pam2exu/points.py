@@ -177,10 +177,15 @@ def velocity_field(r, v, dfi) -> np.ndarray:
     return np.array([-u[1], u[0], dfi])
 
 
-def relative_field(h_i, h_j, fastest: float, length: float = 1.0) -> np.ndarray:
-    """h_i − h_j, exactly 0 where |Ω u| + |ω| L ≤ ``STILL`` · fastest: two solids moving together.
+def motion_size(h, length: float = 1.0) -> float:
+    """|Ω u| + |ω| L [m/s] of a ``velocity_field`` h = (Ω u, ω), L the length scale [m]."""
+    return float(np.hypot(h[0], h[1]) + abs(h[2]) * length)
 
-    ``fastest`` [m/s] is the largest |Ω u| + |ω| L of the mechanism's solids: two solids at
+
+def relative_field(h_i, h_j, fastest: float, length: float = 1.0) -> np.ndarray:
+    """h_i − h_j, exactly 0 where ``motion_size`` ≤ ``STILL`` · fastest (moving together).
+
+    ``fastest`` [m/s] is the largest ``motion_size`` of the mechanism's solids: two solids at
     rest in a mechanism that moves differ by roundoff (1e-17 m/s), and that roundoff must not
     give them a centre (its point would be anywhere).
 
@@ -190,7 +195,7 @@ def relative_field(h_i, h_j, fastest: float, length: float = 1.0) -> np.ndarray:
     array([0., 0., 0.])
     """
     h = np.asarray(h_i, dtype=float) - np.asarray(h_j, dtype=float)
-    if np.hypot(h[0], h[1]) + abs(h[2]) * length <= STILL * fastest:
+    if motion_size(h, length) <= STILL * fastest:
         return np.zeros(3)
     return h
 

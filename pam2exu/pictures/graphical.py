@@ -28,8 +28,8 @@ import numpy as np
 
 from ..kinematics import perp, rotate
 from ..points import (collinearity, in_frame, inflection_circle, instantaneous_centre,
-                      off_line, point_motion, relative_centre, relative_field,
-                      velocity_field)
+                      motion_size, off_line, point_motion, relative_centre,
+                      relative_field, velocity_field)
 from ..results.plot import PictureError
 from .poses import _model
 from .vectors import _row
@@ -280,7 +280,7 @@ def kennedy(bodies, t: float, length: float) -> Centres:
     ``points.velocity_field``s (the ground first): the centre of each two
     (``points.relative_centre``; none for two moving together to roundoff:
     ``points.relative_field``), the line of each three."""
-    fastest = max(np.hypot(h[0], h[1]) + abs(h[2]) * length for _, h in bodies)
+    fastest = max(motion_size(h, length) for _, h in bodies)
     found = []
     for (i, (ni, hi)), (j, (nj, hj)) in combinations(enumerate(bodies, start=1), 2):
         h = relative_field(hi, hj, fastest, length)
