@@ -9,10 +9,11 @@ from ..kinematics import State
 from . import native
 
 
-#: the work the least-squares search of a failure's diagnosis may do, in equations
-#: evaluated (residuals and Jacobians, each counting the mechanism's equations): a bound on
-#: work, not on time, so that a diagnosis says the same on a busy machine as on an idle
-#: one (all_elements' 36 equations: 555 evaluations, about 2 s on two loaded cores)
+#: the work the least-squares search of a failure's diagnosis may do, in residuals and
+#: Jacobians asked, each counting the mechanism's equations (a Jacobian at the point whose
+#: residual was just asked comes from the same evaluation): a bound on work, not on time,
+#: so that a diagnosis says the same on a busy machine as on an idle one (all_elements' 36
+#: equations: 555 asked)
 DIAGNOSIS_WORK = 20_000
 
 
@@ -55,12 +56,20 @@ def closest_violation(mech, t: float, q_start: np.ndarray, keep: np.ndarray | No
         weight[rows] *= 1e3 if el.drives or el.grounds else 1.0
     budget = Budget(mech) if budget is None else budget
     best = [np.inf, q_start, None]
+    last: list = [None, None]          # the last q evaluated and its C, Cq (``evaluated``)
+
+    def evaluated(q):
+        """C and Cq at q, from one evaluation: least squares asks the Jacobian at the
+        point whose residual it has just asked (the same bits as evaluating C alone)."""
+        if last[0] is None or not np.array_equal(q, last[0]):
+            with np.errstate(all="ignore"):
+                last[:] = q.copy(), native.equations(mech, State([t], q[None]))
+        return last[1]
 
     def fun(q):
-        budget.spend()
+        budget.spend()                 # (the budget counts residuals and Jacobians asked)
         with np.errstate(all="ignore"):
-            st = State([t], q[None], jacobians=False)
-            f = weight * native.equations(mech, st, jacobian=False).residual[0]
+            f = weight * evaluated(q).residual[0]
         size = float(np.dot(f, f))
         if size < best[0]:
             best[:] = size, q.copy(), f
@@ -69,7 +78,7 @@ def closest_violation(mech, t: float, q_start: np.ndarray, keep: np.ndarray | No
     def jac(q):
         budget.spend()
         with np.errstate(all="ignore"):
-            return weight[:, None] * native.equations(mech, State([t], q[None])).jacobian[0]
+            return weight[:, None] * evaluated(q).jacobian[0]
 
     try:
         sol = least_squares(fun, q_start, jac=jac, method="lm" if mech.n_equations >= mech.nq

@@ -164,6 +164,53 @@ def test_the_diagnosis_of_a_failure_stops_when_its_work_is_done(monkeypatch):
     assert len(calls) < 50                       # the search's first call ended it
 
 
+@pytest.mark.parametrize("points", [{"coupler": [0.1, 0.0], "rocker": [0.1, 0.0]},
+                                    {"coupler": [0.2, 0.05]}])
+def test_the_diagnosis_search_evaluates_each_point_once(monkeypatch, points):
+    """Least squares asks the Jacobian at the point whose residual it has just asked: one
+    evaluation of the equations gives both (fuzz seed 50320, a loop that cannot close:
+    2,784 evaluations before, 1,412 after, the same diagnosis). Reference: the search with
+    its residual and its Jacobian evaluated apart, as before, written here; the budget
+    counts what is asked, so the search stops where it did."""
+    from scipy.optimize import least_squares
+    from pam2exu.kinematics import State
+    from pam2exu.model import Mechanism
+
+    model = pam2exu.load(EXAMPLES / "four_bar.toml")
+    for solid, point in points.items():
+        model[solid].points["B"] = point
+    mech = Mechanism(model)
+    q0, t = mech.initial_q(), 0.0
+    weight = np.ones(mech.n_equations)
+    for el, rows in zip(mech.constraints, mech.rows):
+        weight[rows] *= 1e3 if el.drives or el.grounds else 1.0
+
+    def fun(q):
+        st = State([t], q[None], jacobians=False)
+        return weight * native.equations(mech, st, jacobian=False).residual[0]
+
+    def jac(q):
+        return weight[:, None] * native.equations(mech, State([t], q[None])).jacobian[0]
+
+    with np.errstate(all="ignore"):
+        apart = least_squares(fun, q0, jac=jac, method="lm", max_nfev=200 * mech.nq,
+                              xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    calls = []
+    real = native.equations
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(native, "equations", counted)
+    left, found, converged = closest.closest_violation(mech, t, q0)
+    assert np.array_equal(found, apart.x) and converged == (apart.status > 0)
+    # one evaluation per point whose residual is asked (least_squares' own first one
+    # included): no Jacobian evaluated apart (before: one per njev besides)
+    assert apart.njev > 0 and len(calls) <= apart.nfev + 1
+    assert np.array_equal(left, native.residuals(mech, np.array([t]), found[None])[0])
+
+
 def test_a_driven_solid_also_fixed_is_a_contradiction_not_an_internal_error(tmp_path):
     """Fuzz seed 6295: a crank held by a fixed link and turned by a motor. Exudyn, told to
     ignore the singular Jacobian of the redundant constraints, stops on a configuration
