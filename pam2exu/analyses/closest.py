@@ -61,9 +61,8 @@ def closest_violation(mech, t: float, q_start: np.ndarray, keep: np.ndarray | No
     def evaluated(q):
         """C and Cq at q, from one evaluation: least squares asks the Jacobian at the
         point whose residual it has just asked (the same bits as evaluating C alone)."""
-        if last[0] is None or not np.array_equal(q, last[0]):
-            with np.errstate(all="ignore"):
-                last[:] = q.copy(), native.equations(mech, State([t], q[None]))
+        if last[0] is None or not np.array_equal(q, last[0]):   # (within np.errstate)
+            last[:] = q.copy(), native.equations(mech, State([t], q[None]))
         return last[1]
 
     def fun(q):
