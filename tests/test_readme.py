@@ -206,3 +206,11 @@ def test_docs_model_blocks_equal_the_shipped_example(page, example, block):
 def test_docs_show_the_shipped_examples():
     assert {example for _, example, _ in _shipped_blocks()} >= {
         "examples/scotch_yoke.toml", "examples/pam_crank.toml"}
+
+
+def test_ci_runs_exactly_the_readmes_test_command():
+    """`.ci/run` calls the README's test command, word for word (the brief's set-up rule)."""
+    readme = [c for c, _ in _commands(ROOT / "README.md") if "pytest" in c]
+    ci = [line.strip() for line in (ROOT / ".ci" / "run").read_text().splitlines()
+          if "pytest" in line and not line.lstrip().startswith("#")]
+    assert readme[:1] == ci and len(ci) == 1, (readme, ci)
