@@ -9,7 +9,8 @@ them (docs/model-format.md, "Output variables"), so default tables do not change
   a = |(DDx, DDy)| of the point declared in the solid's ``points`` (``point_motion``:
   exact, from the solid's own x … DDfi of the same pass, no differencing).
 - ``<solid>.ICx``, ``<solid>.ICy`` [m]: the instantaneous centre of every solid not held
-  by a ``fixed`` link (``instantaneous_centre``); NaN where it translates (Dfi = 0).
+  by a ``fixed`` link (``instantaneous_centre``); NaN where it translates (Dfi = 0) or is
+  at rest to round-off (``motion_sizes`` ≤ ``STILL`` · the fastest solid's).
 - ``<coupler>.transmission_angle`` [rad]: of a solid joined by two revolutes to a driven
   input and to a rocker or a slider (``couplers``, ``transmission_angle``).
 
@@ -117,12 +118,13 @@ def point_motion(r, v, a, fi, dfi, ddfi, p):
     return x, vel, acc
 
 
-def instantaneous_centre(r, v, dfi, length: float = 1.0) -> np.ndarray:
+def instantaneous_centre(r, v, dfi, length: float = 1.0, fastest=None) -> np.ndarray:
     """I = r + Ω v / Dfi: the point of the solid's plane at rest, v_I = v + Dfi Ω (I − r) = 0.
 
     Ω v = (−vy, vx), so I = (x − Dy/Dfi, y + Dx/Dfi). Where the solid translates (Dfi = 0,
     or I farther than ``FAR`` · ``length`` from r: |v| > FAR · length · |Dfi|) there is no
-    centre: NaN.
+    centre: NaN. With ``fastest``, also where the solid is at rest but for round-off: its
+    ``motion_sizes`` at most ``STILL`` · fastest (its centre would be anywhere).
 
     Parameters
     ----------
@@ -132,6 +134,8 @@ def instantaneous_centre(r, v, dfi, length: float = 1.0) -> np.ndarray:
         The solid's angular velocity [rad/s].
     length : float
         The mechanism's length scale [m] (``Mechanism.scale()``), for "at infinity".
+    fastest : array_like (n,), optional
+        The largest ``motion_sizes`` of the mechanism's solids at each row [m/s].
 
     Returns
     -------
@@ -148,6 +152,8 @@ def instantaneous_centre(r, v, dfi, length: float = 1.0) -> np.ndarray:
     speed = hypot(v[:, 0], v[:, 1])
     # (decided on the real parts: complex in the complex step)
     defined = (np.real(dfi) != 0.0) & (np.real(speed) <= FAR * length * np.abs(np.real(dfi)))
+    if fastest is not None:
+        defined &= motion_sizes(r, v, dfi, length) > STILL * np.asarray(fastest)
     out = np.full(r.shape, np.nan, dtype=number_type(r, v, dfi))
     out[defined] = r[defined] + perp(v[defined]) / dfi[defined, None]
     return out
@@ -162,24 +168,39 @@ def velocity_field(r, v, dfi) -> np.ndarray:
 
     Parameters
     ----------
-    r, v : array_like (2,)
+    r, v : array_like (2,) or (n, 2)
         Any point of the solid (its frame's origin) [m] and that point's velocity [m/s].
-    dfi : float
-        The solid's angular velocity [rad/s].
+    dfi : float or array_like (n,)
+        The solid's angular velocity [rad/s]; rows give a field (n, 3) per row.
 
     Examples
     --------
     >>> velocity_field([1.0, 0.0], [0.0, 2.0], 2.0) + 0.0  # turning about the origin
     array([0., 0., 2.])
     """
-    r, v = np.asarray(r, dtype=float), np.asarray(v, dtype=float)
-    u = v - dfi * perp(r)
-    return np.array([-u[1], u[0], dfi])
+    r, v, dfi = (np.asarray(a, dtype=float) for a in (r, v, dfi))
+    u = v - dfi[..., None] * perp(r)
+    return np.stack([-u[..., 1], u[..., 0], dfi], axis=-1)
 
 
-def motion_size(h, length: float = 1.0) -> float:
-    """|Ω u| + |ω| L [m/s] of a ``velocity_field`` h = (Ω u, ω), L the length scale [m]."""
-    return float(np.hypot(h[0], h[1]) + abs(h[2]) * length)
+def motion_size(h, length: float = 1.0):
+    """|Ω u| + |ω| L [m/s] of a ``velocity_field`` h = (Ω u, ω), L the length scale [m]: a
+    float, or one per row of fields (n, 3).
+
+    Examples
+    --------
+    >>> motion_size(velocity_field([[1.0, 0.0]], [[0.0, 2.0]], [2.0]), length=0.5)
+    array([1.])
+    """
+    h = np.asarray(h, dtype=float)
+    size = np.hypot(h[..., 0], h[..., 1]) + np.abs(h[..., 2]) * length
+    return float(size) if size.ndim == 0 else size
+
+
+def motion_sizes(r, v, dfi, length: float = 1.0) -> np.ndarray:
+    """``motion_size`` of a solid's ``velocity_field`` at every row (r, v (n, 2), dfi (n,)),
+    from their real parts (complex in the complex step)."""
+    return motion_size(velocity_field(*(np.real(a) for a in (r, v, dfi))), length)
 
 
 def relative_field(h_i, h_j, fastest: float, length: float = 1.0) -> np.ndarray:
@@ -402,16 +423,23 @@ def columns(mech, t, q, qd, qdd, wanted) -> tuple[dict[str, np.ndarray], list[st
             if st is None:
                 st = State(t, q, jacobians=False)
             out[name] = c.angle(st)
+    fastest = None
+    centres = {v.name for v in CENTRE_OUTPUTS}
+    if qd is not None and any(c.rpartition(".")[2] in centres for c in wanted):
+        fastest = np.max([motion_sizes(q[:, pose(i)][:, :2], qd[:, pose(i)][:, :2],
+                                       qd[:, pose(i)][:, 2], length)
+                          for i in range(len(mech.solids))], axis=0)
     for i, s in enumerate(mech.solids):
         x, dx, ddx = (None if a is None else a[:, pose(i)] for a in (q, qd, qdd))
         if f"{s.name}.ICx" in wanted or f"{s.name}.ICy" in wanted:
-            centre = instantaneous_centre(x[:, :2], dx[:, :2], dx[:, 2], length)
+            centre = instantaneous_centre(x[:, :2], dx[:, :2], dx[:, 2], length, fastest)
             out[f"{s.name}.ICx"], out[f"{s.name}.ICy"] = centre[:, 0], centre[:, 1]
             nan = np.flatnonzero(np.isnan(centre[:, 0]))
             if nan.size:
                 notes.append(f"{s.name}.ICx, {s.name}.ICy are NaN at {nan.size} of {len(t)} "
                              f"rows, first t = {t[nan[0]]:.6g} s: there the solid translates or "
-                             f"is at rest (Dfi = 0) and has no instantaneous centre")
+                             f"is at rest (Dfi = 0, or its motion below {STILL:g} of the "
+                             f"fastest solid's: round-off) and has no instantaneous centre")
         for p, local in s.points.items():
             prefix = f"{s.name}.{p}."
             names = {v.name for v in POINT_OUTPUTS if prefix + v.name in wanted}

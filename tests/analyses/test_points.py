@@ -125,6 +125,42 @@ def test_slider_crank_centre_and_angle():
                                np.arccos(np.abs(r * np.sin(th) / l)), rtol=0, atol=1e-13)
 
 
+@pytest.mark.parametrize("backend", list(pam2exu.registry.BACKENDS))
+def test_a_solid_at_rest_but_for_round_off_has_no_centre(backend):
+    """examples/all_elements.toml: the sun's ramp turns it from t = 0.2 s to 0.8 s (0.5 rad,
+    0.833 rad/s) and holds it before and after, where its Dfi is round-off (≤ 6e-16 rad/s
+    on either backend). Its centre is then undefined: NaN at exactly those 81 of 201 rows,
+    the same on both backends, and said in ``info['undefined']``. (Before, round-off Dfi
+    gave it its pivot, (0.6, 0), at some of those rows and NaN where Dfi happened to be 0:
+    6 rows of 40 on Exudyn, 20 on the natural backend, stop 37's CI.)"""
+    res = pam2exu.run(EXAMPLES / "all_elements.toml", analysis="kinematic", backend=backend,
+                      outputs=["sun.IC*", "sun.Dfi"])
+    held = (res.t < 0.2 - 1e-9) | (res.t > 0.8 - 1e-9)
+    assert np.count_nonzero(held) == 81
+    assert np.abs(res["sun.Dfi"][held]).max() < 1e-14
+    np.testing.assert_allclose(res["sun.Dfi"][~held], 0.5 / 0.6, rtol=1e-12)
+    np.testing.assert_array_equal(np.isnan(res["sun.ICx"]), held)
+    np.testing.assert_array_equal(np.isnan(res["sun.ICy"]), held)
+    np.testing.assert_allclose(res["sun.ICx"][~held], 0.6, rtol=0, atol=1e-15)
+    assert "sun.ICx, sun.ICy are NaN at 81 of 201 rows, first t = 0 s" in res.info["undefined"]
+
+
+def test_round_off_motion_is_rest_and_a_slow_one_is_kept():
+    """``instantaneous_centre`` with the mechanism's fastest motion (0.2 m/s): a solid whose
+    velocity field is round-off (|u| + |Dfi| L = 4e-17 m/s) has no centre, one turning at
+    1e-6 of the fastest about (0.3, 0.1) keeps it (to round-off), and one translating has
+    none either way."""
+    r = np.array([[1.0, 0.0], [1.0, 0.0], [1.0, 0.0]])
+    w = np.array([3.7e-17, 2e-7, 0.0])
+    v = np.array([[0.0, 0.0], [0.0, 0.0], [0.1, 0.0]])
+    v[1] = w[1] * np.array([-(r[1, 1] - 0.1), r[1, 0] - 0.3])       # ω Ω (r − c)
+    got = instantaneous_centre(r, v, w, 1.0, fastest=np.full(3, 0.2))
+    assert np.isnan(got[0]).all() and np.isnan(got[2]).all()
+    np.testing.assert_allclose(got[1], [0.3, 0.1], rtol=0, atol=1e-15)
+    without = instantaneous_centre(r, v, w, 1.0)
+    np.testing.assert_array_equal(without[0], r[0])       # round-off's centre: anywhere
+
+
 def test_points_are_opt_in(examples):
     """The default columns have no point, centre or transmission angle; ``coupler.*``,
     ``*``, ``x`` and ``*x`` choose none either; three-part patterns choose points,
