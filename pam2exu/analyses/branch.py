@@ -166,6 +166,8 @@ def motion(job: Job, redundant: bool, accelerations: bool = True, singular_ok: b
             own = _joined(own, k, part_found, len(t))
         solved, found = k + part_solved, part_found
     job.info["branch_resolves"] = resolves
+    if singular.any() and not singular_ok:     # numerically singular steps, found above
+        raise singular_error(job, int(np.argmax(singular)))
     if singular.any():
         qd, qdd = _interpolate_singular(t, qd, qdd, singular)
         times = ", ".join(f"{t[i]:.6g}" for i in np.nonzero(singular)[0][:5])

@@ -7,12 +7,12 @@ import time as _time
 import numpy as np
 
 from ..backend import Positions
-from ..elements import ACCELERATION, VELOCITY
+from ..elements import VELOCITY
 from ..kinematics import ANGLES, State
 from ..progress import Progress
-from . import continuity, native, rank
+from . import continuity, native
 from .checks import check_residual
-from .failure import position_failure, singular_error
+from .failure import position_failure
 from .job import Job, warn_redundant
 
 #: steps solved by one call of the backend: a longer run is solved in parts, one tick of its
@@ -141,15 +141,3 @@ def rates(job: Job, t, q, redundant: bool, found: Positions | None = None,
         return native.rates(job.mech, t, q, accelerations, redundant, with_jacobian)
 
 
-def velocities(job: Job, q: np.ndarray, redundant: bool):
-    """(qd, qdd) from the native pass, after the residual check of the backend's positions;
-    SolverError at a singular position (``branch.motion`` follows the branch instead)."""
-    mech, t = job.mech, job.times
-    accelerations = ACCELERATION in job.levels
-    job.stage = "computing velocities and accelerations"
-    qd, qdd, residual = rates(job, t, q, redundant, accelerations=accelerations)
-    check_residual(mech, t, q, job, residual)
-    bad = ~continuity.finite_rows(qd, *(() if qdd is None else (qdd,)))
-    if bad.any():
-        raise singular_error(job, min(int(np.argmax(bad)), rank.first_singular(mech, t, q)))
-    return qd, qdd

@@ -9,7 +9,8 @@ from ..errors import TranslationError
 from ..kinematics import State
 from . import force_pass, native
 from .job import Job, check_mobility, collect
-from .positions import positions, velocities
+from .branch import motion
+from .positions import positions
 
 #: the backend's multipliers must satisfy the native equilibrium to this, relative to the forces
 EQUILIBRIUM_TOLERANCE = 1e-9
@@ -21,7 +22,8 @@ def quasi_static(job: Job):
     """x, y, fi, f(t), ro, fi_rel, every reaction, spring and actuator force; no rates.
 
     Contract: every degree of freedom is driven, so the configurations do not depend on the
-    forces: they come from the backend's solver on the constraints (as kinematic), and
+    forces: they come from the backend's solver on the constraints, the branch followed
+    on the rates (``branch.motion``, as kinematic: its rates are not reported), and
     the reactions from the native equilibrium Cqᵀ λ = −Q_applied at every step (gravity,
     torsors and springs, no damper terms; ``force_pass.over_time``). The backend's static
     solver with the masses and force elements in the model checks them at
@@ -34,8 +36,9 @@ def quasi_static(job: Job):
     redundant = mob.redundant > 0
     if FORCE not in job.levels:
         return collect(job, positions(job, redundant))
-    q = positions(job, redundant, check=False)
-    velocities(job, q, redundant)      # raises at a singular position: reactions undefined
+    # the branch followed as kinematic follows it; a singular position (exact, or a change
+    # point the backend solved to round-off) is an error: the reactions are undefined there
+    q, _, _ = motion(job, redundant, accelerations=False, singular_ok=False)
     job.stage = "computing the reactions (static equilibrium)"
     out, _ = force_pass.over_time(job.mech, job.times, q, redundant)
     if redundant:

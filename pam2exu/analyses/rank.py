@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import MobilityError, ModelError, Problem
 from ..kinematics import State
-from .native import chunks, equations, residuals
+from .native import equations, residuals
 
 
 def condition_numbers(mech, t, q, jacobian: np.ndarray | None = None) -> np.ndarray:
@@ -443,16 +443,3 @@ def require_driven(mech, mob: Mobility, analysis: str) -> None:
         f"(or a fixed link) for each free degree of freedom, or run an analysis that "
         f"lets them go: assembly (the pose nearest the guess), equilibrium (at rest under "
         f"the loads) or dynamic (in motion)."), mech.model.source)
-
-
-def first_singular(mech, t, q, rtol: float = 1e-10) -> int:
-    """Index of the first step where Cq is (numerically) rank-deficient, else the last step."""
-    n = len(t)
-    for s in chunks(mech, n):
-        J = equations(mech, State(t[s], q[s])).jacobian
-        sv = np.linalg.svd(J, compute_uv=False)
-        rank = np.sum(sv > rtol * sv[:, :1], axis=1)
-        bad = np.nonzero(rank < mech.nq)[0]
-        if bad.size:
-            return s.start + int(bad[0])
-    return n - 1
