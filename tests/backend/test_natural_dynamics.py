@@ -9,7 +9,9 @@ slider driven by bezier_c2 (I_O θ̈ = m d sin θ ẍ_s − m g d cos θ); the e
 free four-bar from the result columns; and the Exudyn backend's integration of the same
 models (``pam2exu.verify``: two integrations within the verify rule, docs/verify.md).
 """
+import io
 import math
+import sys
 import warnings
 from pathlib import Path
 
@@ -189,3 +191,23 @@ def test_the_error_estimate_bounds_the_error_of_the_rows():
     error = max(float(np.max(np.abs(res[c] - r) / (1 + np.abs(r))))
                 for c, r in (("lever.fi", ref[0]), ("lever.Dfi", ref[1])))
     assert 0 < error <= res.info["integration_error"] <= tolerance
+
+
+class _Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_a_long_integration_shows_its_progress_on_a_terminal(monkeypatch):
+    """Each of the integrator's runs draws a bar on a terminal (``progress.Progress``: its
+    label names the method and the run's tolerance), erased when the run ends; the rows are
+    those of the same run off a terminal, bit for bit."""
+    monkeypatch.delenv("PAM2EXU_PROGRESS", raising=False)
+    quiet = _run(pendulum(0.3), t_end=0.4, steps=8)
+    tty = _Terminal()
+    monkeypatch.setattr(sys, "stderr", tty)
+    shown = _run(pendulum(0.3), t_end=0.4, steps=8)
+    bars = tty.getvalue()
+    assert "integrating the motion (DOP853, tolerance 1e-" in bars and "] 100%" in bars
+    assert bars.endswith("\r")                              # erased at the end
+    np.testing.assert_array_equal(shown.to_numpy(), quiet.to_numpy())

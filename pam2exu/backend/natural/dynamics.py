@@ -31,6 +31,7 @@ import numpy as np
 
 from ...errors import SolverError
 from ...kinematics import ANGLES, column
+from ...progress import Progress
 from .loads import Loads
 
 #: the first run's rtol and atol, times the tolerance
@@ -43,6 +44,8 @@ SMALLEST = 1e-13
 STIFF_STEPS = 20_000
 #: steps of one run at most
 MOST_STEPS = 2 ** 21
+#: units of the progress bar of one integration over the interval (per mille)
+PROGRESS_UNITS = 1000
 #: Gauss–Newton iterations of the projection onto Φ = 0
 PROJECTIONS = 4
 
@@ -187,11 +190,19 @@ class Dynamics:
         out[0], fis[0] = y0, self.fi
         solver = self.method(self.rhs, float(times[0]), y0.copy(), float(times[-1]),
                              rtol=max(r, SMALLEST), atol=r)
+        with Progress(PROGRESS_UNITS, f"integrating the motion ({self.method.__name__}, "
+                                      f"tolerance {r:.2g})") as bar:
+            return self._stepped(solver, times, out, fis, bar)
+
+    def _stepped(self, solver, times, out, fis, bar):
+        """``run``'s steps of ``solver`` until the last time, each reported to ``bar``."""
+        n, t0 = len(times), float(times[0])
         k, steps = 1, 0
         end = float(times[-1])
         while k < n:
             message = solver.step()
             steps += 1
+            bar.update(int(PROGRESS_UNITS * (solver.t - t0) / (end - t0)))
             if solver.status == "failed" or steps > MOST_STEPS:
                 raise SolverError(
                     f"t={solver.t:g}: the natural backend's integrator ({self.method.__name__}) "
