@@ -6,8 +6,8 @@ equations of motion of the constrained system are
     M z̈ + Φ_zᵀ μ = Q(z, ż, t),    Φ(z, t) = 0,
 
 Q the forces of gravity, the torsors and the spring-dampers on the natural coordinates
-(``loads.Loads.on_coordinates``; the dampers from the rates). Differentiating the
-constraints twice (index 1) gives, at every state,
+(``inverse.on_coordinates`` of ``loads.Loads``; the dampers from the rates).
+Differentiating the constraints twice (index 1) gives, at every state,
 
     [M   Φ_zᵀ] [z̈]   [Q]
     [Φ_z  0  ] [μ] = [γ],    γ = g'' − (d/dt Φ_z) ż   (``Terms.gamma``),
@@ -32,6 +32,7 @@ import numpy as np
 from ...errors import SolverError
 from ...kinematics import ANGLES, column
 from ...progress import Progress
+from .inverse import bodies, on_coordinates
 from .loads import Loads
 
 #: the first run's rtol and atol, times the tolerance
@@ -72,7 +73,8 @@ class Dynamics:
         # gravity acts at fixed points of the solids (a, b constant): Q_z is constant
         weight = Loads(form, np.zeros((1, self.nz)), np.zeros((1, mech.nq)))
         weight.gravity(mech.gravity)
-        self.weight = weight.on_coordinates()[0]
+        self.bodies = bodies(form)                  # Q on (p, v) -> Q on z
+        self.weight = on_coordinates(self.bodies, weight.Q)[0]
         self.stiff = False                          # DOP853 until it needs too many steps
         self.evaluations = 0
 
@@ -101,7 +103,7 @@ class Dynamics:
         loads = Loads(self.form, z[None], q, zd[None], t=t)
         for el in self.mech.elements:
             el.natural_loads(loads)
-        return self.weight + loads.on_coordinates()[0]
+        return self.weight + on_coordinates(self.bodies, loads.Q)[0]
 
     def jacobian(self, z: np.ndarray) -> np.ndarray:
         """Φ_z (m, nz) at one configuration."""

@@ -6,7 +6,8 @@ F at s does the virtual work F·(δp + a δv + b Ω δv), so it is (F, a F − b
 solid's (p, v); a moment M does M δfi = M (Ω v)·δv / |v|². On x, y, fi (p = R + A s_p,
 v = A d): Q_xy = Q_p, Q_fi = Q_p·Ω(p − R) + Q_v·Ω v. The multipliers then follow from
 pam2exu's own Cqᵀ λ = −Q (least squares, minimum norm), in its row order. On z itself
-(the dynamic analysis, ``dynamics``): Q_z = Σ Pᵀ Q_p + Vᵀ Q_v, with ṗ = P ż and v̇ = V ż.
+(the dynamic analysis, ``dynamics``): Q_z = Σ Pᵀ Q_p + Vᵀ Q_v, with ṗ = P ż and v̇ = V ż
+(``inverse.on_coordinates`` of ``Loads.Q``).
 
 Given the rates ż, the dampers (C4) see the rates of the points and angles
 (``point_rate``, ``angle_rate``); without them every rate is zero (static).
@@ -115,14 +116,6 @@ class Loads:
             at = slice(solids[0], solids[-1] + 1) if solids[-1] - solids[0] == len(solids) - 1 \
                 else solids
             self.Q[:, at] += np.concatenate([weight, _on_v(a, b, weight)], axis=1)  # (p, v)
-
-    def on_coordinates(self) -> np.ndarray:
-        """Q (n, nz) on the natural coordinates: Σ Pᵀ Q_p + Vᵀ Q_v over the solids."""
-        out = np.zeros((self.n, self.form.nz))
-        for i in range(len(self.form.frames)):
-            out += self.Qp[:, i] @ self.form.affine(i, None, "p")[0] + \
-                self.Qv[:, i] @ self.form.affine(i, None, "v")[0]
-        return out
 
     def on_pose(self) -> np.ndarray:
         """Q (n, nq) on x, y, fi of every solid."""

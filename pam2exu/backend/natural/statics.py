@@ -2,7 +2,8 @@
 backend (``Natural.static_equilibrium``).
 
 With Q(z) the generalized forces of gravity, the torsors and the springs (no dampers) on
-the natural coordinates (``loads.Loads.on_coordinates``), an equilibrium at time t is
+the natural coordinates (``inverse.on_coordinates`` of ``loads.Loads``), an equilibrium at
+time t is
 
     Q(z) − Φ_zᵀ λ = 0,    Φ(z, t) = 0,
 
@@ -27,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...kinematics import ANGLES, PER_SOLID, column
+from .inverse import bodies, on_coordinates
 from .loads import Loads
 
 #: the central differences' step of ∂Q/∂z: points × the length scale, vectors and angles
@@ -71,7 +73,8 @@ class Statics:
         # gravity acts at fixed points of the solids (a, b constant): its Q is constant
         weight = Loads(form, np.zeros((1, form.nz)), np.zeros((1, mech.nq)))
         weight.gravity(mech.gravity)
-        self.weight_forces = weight.on_coordinates()[0]
+        self.bodies = bodies(form)
+        self.weight_forces = on_coordinates(self.bodies, weight.Q)[0]
 
     def angles(self, z: np.ndarray) -> np.ndarray:
         """fi (n, solids) of configurations z (n, nz): atan2 of each solid's vector, in the
@@ -92,7 +95,7 @@ class Statics:
         loads = Loads(self.form, z, q, t=self.t[0])
         for el in self.mech.elements:
             el.natural_loads(loads)
-        return self.weight_forces + loads.on_coordinates()
+        return self.weight_forces + on_coordinates(self.bodies, loads.Q)
 
     def balance(self, z: np.ndarray, h: np.ndarray | None = None):
         """Q − k Aᵀ W g (nz,): the loads and the springs on z; with steps h (nz,), also
