@@ -323,11 +323,12 @@ class ConsistencyWarning(UserWarning):
 class ConditionWarning(UserWarning):
     """The mechanism passes at or near a singular position: results there are less exact.
 
-    Issued by the kinematic and kinetostatic analyses when the constraint Jacobian is
-    ill-conditioned somewhere in the interval (with the time [s], the condition number and
-    the relative error to expect), or when a step is exactly at a singular position (a
-    change point), where velocities and accelerations are interpolated from the
-    neighbouring steps. The run follows the branch it starts on. The text is also kept in
+    Issued by the quasi_static, kinematic and kinetostatic analyses when the constraint
+    Jacobian is ill-conditioned somewhere in the interval (with the time [s], the condition
+    number and the relative error to expect), and by the kinematic analysis when a step is
+    exactly at a singular position (a change point), where velocities and accelerations
+    are interpolated from the neighbouring steps (the force analyses stop there with a
+    ``SolverError``: the reactions are undefined). The run follows the branch it starts on. The text is also kept in
     ``Results.warnings``; ``Results.info["max_condition_number"]`` is the worst condition
     number sampled.
 
