@@ -81,6 +81,12 @@ WORKER_MODULES = ("__main__", "pam2exu.studies.runner", "pam2exu.analyses",
                   "pam2exu.backend.natural")
 
 
+#: where a ``LocalCluster``'s scheduler serves HTTP (health, metrics; the dashboard stays
+#: off): a free loopback port, not Dask's default 8787, which another cluster may hold (Dask
+#: then warns, "Port 8787 is already in use")
+LOCAL_HTTP = "127.0.0.1:0"
+
+
 class ChunkError(Pam2ExuError):
     """A chunk of a study could not be computed: its task raised (a bug; the error it
     raised is the cause) or its worker was lost more often than the retries allow. Names
@@ -191,7 +197,8 @@ def open_executor(workers: int | None = None, dask: str | None = None,
         with dask_module("dask").config.set(
                 {"distributed.scheduler.allowed-failures": int(retries)}):
             cluster = distributed.LocalCluster(n_workers=int(dask_local), threads_per_worker=1,
-                                               processes=True, dashboard_address=None)
+                                               processes=True, dashboard_address=None,
+                                               scheduler_kwargs={"dashboard_address": LOCAL_HTTP})
         try:
             with distributed.Client(cluster) as client:
                 yield client

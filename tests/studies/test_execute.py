@@ -8,7 +8,9 @@ a lost worker costs that chunk's retry. The Dask cluster is a real scheduler and
 worker processes over TCP on 127.0.0.1, started once for the module.
 """
 import doctest
+import socket
 import sys
+import warnings
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from multiprocessing import get_context
 from pathlib import Path
@@ -31,7 +33,8 @@ CHUNKS = [(0, 5), (5, 10), (10, 15), (15, 20), (20, 23)]
 def cluster():
     """A Dask LocalCluster of two single-threaded worker processes on 127.0.0.1."""
     local = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                     host="127.0.0.1", dashboard_address=None)
+                                     host="127.0.0.1", dashboard_address=None,
+                                     scheduler_kwargs={"dashboard_address": execute.LOCAL_HTTP})
     yield local
     local.close()
 
@@ -296,6 +299,28 @@ def test_a_local_cluster_is_started_and_stopped_by_the_run(tmp_path, payload):
                        executor=client)
     assert client.status == "closed"
 
+
+
+def test_a_local_cluster_serves_http_on_a_free_port():
+    """Dask's scheduler serves HTTP (health, metrics) on port 8787 unless told otherwise, and
+    warns when another cluster holds it ("Port 8787 is already in use"); the cluster of
+    ``--dask-local`` takes a free loopback port: with 8787 held, no warning."""
+    held = socket.socket()
+    try:
+        held.bind(("127.0.0.1", 8787))
+        held.listen()
+    except OSError:
+        pass                                   # held by another process: busy either way
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with open_executor(dask_local=1) as client:
+                assert client.submit(int, "41").result() == 41
+                port = client.cluster.scheduler.http_server.port
+        assert port != 8787
+        assert not [w for w in caught if "8787" in str(w.message)]
+    finally:
+        held.close()
 
 @pytest.mark.parametrize("variants, workers, sizes", [
     (2000, 2, [500] * 2 + [250] * 2 + [125] * 4),    # the last chunks shrink
