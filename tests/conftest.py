@@ -1,4 +1,5 @@
 """Shared fixtures: paths of the shipped models, and a rigidly moved copy of a model."""
+import io
 from pathlib import Path
 
 import numpy as np
@@ -7,6 +8,13 @@ import pytest
 import pam2exu
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+class Terminal(io.StringIO):
+    """A text stream that says it is a terminal: what ``progress.Progress`` draws on."""
+
+    def isatty(self):
+        return True
 
 
 @pytest.fixture

@@ -20,6 +20,7 @@ from pam2exu.progress import Progress
 from pam2exu.results import plot, read_csv
 from pam2exu.results.plot import DPI, MARGIN, PANEL, WIDTH, PictureError
 from pam2exu.results.units import unit_of
+from tests.conftest import Terminal
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -208,10 +209,6 @@ def test_cli_plot_draw_animate(examples, tmp_path, capsys):
 
 # --- progress bar ---------------------------------------------------------------------------
 
-class _Terminal(io.StringIO):
-    def isatty(self):
-        return True
-
 
 def test_progress_bar_only_on_a_terminal(monkeypatch):
     monkeypatch.delenv("PAM2EXU_PROGRESS", raising=False)
@@ -220,7 +217,7 @@ def test_progress_bar_only_on_a_terminal(monkeypatch):
         for k in range(10):
             bar.update(k + 1)
     assert piped.getvalue() == ""
-    tty = _Terminal()
+    tty = Terminal()
     with Progress(4, "frames", stream=tty) as bar:
         for k in range(4):
             bar.update(k + 1)
@@ -228,11 +225,11 @@ def test_progress_bar_only_on_a_terminal(monkeypatch):
     assert "frames [" in text and " 50%" in text and "100%" in text
     assert text.endswith("\r") and "\n" not in text            # the line is erased at the end
     monkeypatch.setenv("PAM2EXU_PROGRESS", "0")
-    off = _Terminal()
+    off = Terminal()
     with Progress(4, "frames", stream=off) as bar:
         bar.update(2)
     assert off.getvalue() == ""
-    assert not Progress(1, "one chunk", stream=_Terminal()).enabled
+    assert not Progress(1, "one chunk", stream=Terminal()).enabled
 
 
 def test_progress_bar_reaches_the_native_pass(monkeypatch, examples):
@@ -242,7 +239,7 @@ def test_progress_bar_reaches_the_native_pass(monkeypatch, examples):
     from pam2exu.analyses import native
     monkeypatch.delenv("PAM2EXU_PROGRESS", raising=False)
     monkeypatch.setattr(native, "CHUNK_BYTES", 8 * 9 * 12 * 10)   # 10 steps a chunk
-    tty = _Terminal()
+    tty = Terminal()
     monkeypatch.setattr(sys, "stderr", tty)
     res = pam2exu.run(examples / "slider_crank.toml", analysis="kinematic", steps=50)
     assert "velocities and accelerations [" in tty.getvalue()

@@ -4,11 +4,8 @@ units done, their rate and the time left, computed by hand from a clock the test
 import io
 
 from pam2exu.progress import Progress
+from tests.conftest import Terminal
 
-
-class Terminal(io.StringIO):
-    def isatty(self):
-        return True
 
 
 def test_the_rate_and_time_left_count_from_the_first_update(monkeypatch):

@@ -9,7 +9,6 @@ slider driven by bezier_c2 (I_O θ̈ = m d sin θ ẍ_s − m g d cos θ); the e
 free four-bar from the result columns; and the Exudyn backend's integration of the same
 models (``pam2exu.verify``: two integrations within the verify rule, docs/verify.md).
 """
-import io
 import math
 import sys
 import warnings
@@ -24,6 +23,7 @@ from pam2exu.cli import main
 from pam2exu.laws import Law
 
 from references.pendulum import D, G, IO, M, pendulum_toml, reference, slider_toml
+from tests.conftest import Terminal
 
 ROOT = Path(__file__).resolve().parents[2]
 FOUR_BAR = ROOT / "examples/equilibrium/spring_four_bar.toml"
@@ -193,10 +193,6 @@ def test_the_error_estimate_bounds_the_error_of_the_rows():
     assert 0 < error <= res.info["integration_error"] <= tolerance
 
 
-class _Terminal(io.StringIO):
-    def isatty(self):
-        return True
-
 
 def test_a_long_integration_shows_its_progress_on_a_terminal(monkeypatch):
     """Each of the integrator's runs draws a bar on a terminal (``progress.Progress``: its
@@ -204,7 +200,7 @@ def test_a_long_integration_shows_its_progress_on_a_terminal(monkeypatch):
     those of the same run off a terminal, bit for bit."""
     monkeypatch.delenv("PAM2EXU_PROGRESS", raising=False)
     quiet = _run(pendulum(0.3), t_end=0.4, steps=8)
-    tty = _Terminal()
+    tty = Terminal()
     monkeypatch.setattr(sys, "stderr", tty)
     shown = _run(pendulum(0.3), t_end=0.4, steps=8)
     bars = tty.getvalue()

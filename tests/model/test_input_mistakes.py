@@ -258,17 +258,13 @@ def test_a_long_run_shows_its_progress_on_stderr(monkeypatch):
     """A run of several parts (PART_STEPS made 7 here: the rule, not a time, decides) draws
     a bar on stderr when it is a terminal; the results are those of one part to within
     Newton's tolerance."""
-    import io
     import sys
 
     import numpy as np
 
     import pam2exu
     from pam2exu.analyses import positions
-
-    class Terminal(io.StringIO):
-        def isatty(self):
-            return True
+    from tests.conftest import Terminal
 
     monkeypatch.delenv("PAM2EXU_PROGRESS", raising=False)
     path = ROOT / "examples" / "four_bar.toml"
