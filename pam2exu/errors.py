@@ -328,9 +328,9 @@ class ConditionWarning(UserWarning):
     number and the relative error to expect), and by the kinematic analysis when a step is
     exactly at a singular position (a change point), where velocities and accelerations
     are interpolated from the neighbouring steps (the force analyses stop there with a
-    ``SolverError``: the reactions are undefined). The run follows the branch it starts on. The text is also kept in
-    ``Results.warnings``; ``Results.info["max_condition_number"]`` is the worst condition
-    number sampled.
+    ``SolverError``: the reactions are undefined). The run follows the branch it starts
+    on. The text is also kept in ``Results.warnings``;
+    ``Results.info["max_condition_number"]`` is the worst condition number sampled.
 
     Parameters
     ----------
