@@ -201,6 +201,33 @@ def test_a_large_system_gets_its_rates_with_its_positions():
         assert np.max(np.abs(mine - fresh)) <= 1e-10 * np.max(np.abs(fresh))
 
 
+@pytest.mark.parametrize("mech_of", [
+    lambda: pam2exu.load(ROOT / "examples" / "four_bar.toml").mechanism(),
+    lambda: chain_model(12).mechanism()], ids=["four-bar, dense", "chain of 12, sparse"])
+def test_a_run_without_rates_solves_none_in_its_fill(mech_of):
+    """A run asked for positions only (``Solver(rates=False)``: a kinematic run whose
+    outputs are x, y, fi) solves ż, z̈ at the coarse steps alone, which its predictor needs,
+    not at the filled ones; its positions are the same bits as with the rates."""
+    mech = mech_of()
+    t = np.linspace(0.0, 0.5, 1001)
+    runs = {}
+    for rates in (True, False):
+        backend = Natural()
+        form = backend.formulation(mech)
+        solver = Solver(form.terms, backend.weights(form, mech), NaturalSettings(), False,
+                        rates=rates)
+        z0, ok = solver.newton(t[:1], form.from_q(mech.initial_q()[None]))
+        z, solved = solver.run(t, z0[0])
+        assert solved == len(t)
+        runs[rates] = z, solver
+    (z, with_rates), (z_only, without) = runs[True], runs[False]
+    assert z.tobytes() == z_only.tobytes()
+    coarse = {0} | {j for _, j, _ in without.intervals}
+    assert with_rates.own_rates.all()
+    assert set(np.nonzero(without.own_rates)[0]) == coarse
+    assert len(coarse) < len(t) // 4
+
+
 def test_newton_stops_where_quadratic_convergence_says_the_next_step_is_below(
         four_bar_mech, monkeypatch):
     """Newton at one time stops after the step whose successor, step³ / last², would be 1000

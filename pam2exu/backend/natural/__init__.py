@@ -85,7 +85,7 @@ class Natural(Backend):
                 z, zd, zdd = given
                 return self._found(form, mech, times, start, z, forces, rates, zd, zdd,
                                    converted=self.answered.converted(len(z), start))
-        solver = Solver(form.terms, w, settings, least_squares=redundant)
+        solver = Solver(form.terms, w, settings, least_squares=redundant, rates=rates)
         n = len(times)
         q = np.full((n, mech.nq), np.nan)
         plain = not (redundant or anchor_stiffness)

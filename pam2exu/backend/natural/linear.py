@@ -36,7 +36,8 @@ CHUNK_BYTES = 64 * 2**20
 
 class LinearSolves:
     """The linear algebra of ``Solver`` (a base class: it uses the solver's ``terms``,
-    ``w``, ``settings``, ``least_squares``, ``order`` and counts ``iterations``)."""
+    ``w``, ``settings``, ``least_squares``, ``order``, ``fill_rates`` and counts
+    ``iterations``)."""
 
     def rows_per_chunk(self) -> int:
         """Steps solved at once: the Jacobians, their terms and the solves' copies of a
@@ -193,11 +194,13 @@ class LinearSolves:
         """(z, ż, z̈, ok) for a block of steps of a small square system from good guesses
         (z (nz, n), one column per step, as the answers): each Newton solve also solves
         Φ_z ż = g' (two right-hand sides, one factorisation), and the last one's Jacobian
-        (at z within the tolerance) gives z̈; None where a Jacobian is singular."""
+        (at z within the tolerance) gives z̈; ż, z̈ None without ``fill_rates`` (one
+        right-hand side); None where a Jacobian is singular."""
         terms, tol = self.terms, self.settings.tolerance
         z = np.array(z, dtype=float)
-        rhs = np.empty((terms.m, 2, len(t)))
-        rhs[:, 1] = terms.velocity_rhs_cols(t)[order]
+        rhs = np.empty((terms.m, 2 if self.fill_rates else 1, len(t)))
+        if self.fill_rates:
+            rhs[:, 1] = terms.velocity_rhs_cols(t)[order]
         w = self.w[:, None]
         g = terms.targets(t, 0)
         with np.errstate(all="ignore"):
@@ -214,14 +217,16 @@ class LinearSolves:
                 step = np.max(np.abs(x[:, 0]) * w, axis=0, initial=0.0)
                 if np.all(step <= tol):
                     break
+            if not self.fill_rates:
+                return z, None, None, step <= tol
             zd = x[:, 1]
             zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
         return z, zd, zdd, step <= tol
 
     def _bulk_sparse(self, t, z, iterations: int = 4):
         """``_bulk`` for a large system: each Newton iteration one sparse LU of the steps'
-        block-diagonal Φ_z, the last one's factors also giving ż and z̈ (z (nz, n), one
-        column per step); None where a Jacobian is singular."""
+        block-diagonal Φ_z, the last one's factors also giving ż and z̈ (with
+        ``fill_rates``; z (nz, n), one column per step); None where a Jacobian is singular."""
         terms, tol = self.terms, self.settings.tolerance
         z = np.array(z, dtype=float)
         n, w = len(t), self.w[:, None]
@@ -244,6 +249,8 @@ class LinearSolves:
                 step = np.max(np.abs(dz) * w, axis=0, initial=0.0)
                 if np.all(step <= tol):
                     break
+            if not self.fill_rates:
+                return z, None, None, step <= tol
             zd = solve(lu, terms.velocity_rhs_cols(t))
             zdd = solve(lu, terms.gamma_cols(t, z, zd))
         if not (np.isfinite(zd).all() and np.isfinite(zdd).all()):

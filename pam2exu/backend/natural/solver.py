@@ -129,9 +129,12 @@ class Solver(LinearSolves):
     """Newton's method for one ``Formulation`` (``terms``), with step weights ``w``."""
 
     def __init__(self, terms, weights: np.ndarray, settings: NaturalSettings,
-                 least_squares: bool):
+                 least_squares: bool, rates: bool = True):
         self.terms, self.w, self.settings = terms, weights, settings
         self.least_squares = least_squares or terms.m != terms.nz
+        #: whether the fill also solves ż, z̈ at its steps (the run's caller wants its rates);
+        #: the coarse pass's steps have theirs whatever it is (its predictor needs them)
+        self.fill_rates = rates
         self.iterations = 0
         self.floor = MAGNITUDE_FLOOR * terms.magnitude_at(1.0 / weights)[:, None]
         #: the equations in the order of the pivots at the run's start (``pivot_orders``)
@@ -375,8 +378,9 @@ class Solver(LinearSolves):
                 zi = zi.T
             else:
                 zi, zd, zdd, ok = found
-                self.own_rates[part] = True
-                self.zd[part], self.zdd[part] = zd.T, zdd.T
+                if zd is not None:
+                    self.own_rates[part] = True
+                    self.zd[part], self.zdd[part] = zd.T, zdd.T
             self.miss[part] = np.max(np.abs(zi - guess) * self.w[:, None], axis=0)
             far = self.miss[part] > allowed[at]
             z[part] = zi.T
