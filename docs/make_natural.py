@@ -900,7 +900,9 @@ INVERSE = """\
 The `kinetostatic` analysis on this backend takes its reactions and actuator forces from
 the natural coordinates (`pam2exu/backend/natural/inverse.py` and `reactions.py`, what
 `Natural.reactions` answers when the analysis asks: `Backend.gives_reactions`), not from the
-reference-point pass the Exudyn backend's runs use. Each solid's base point and base vector
+reference-point pass the Exudyn backend's runs use. So does the `quasi_static` analysis:
+its equilibrium Cqᵀ λ = −Q_applied is the inverse dynamics of its configurations at rest
+(ż = z̈ = 0: no inertia force, and a damper at rest applies none). Each solid's base point and base vector
 are ζ_b = (p, v) = A_b z + c_b, and its kinetic energy a constant quadratic form in ζ̇_b, so
 what its joints apply to it has no velocity term:
 
@@ -929,8 +931,9 @@ reference-point pass's choice, so both backends report the same reactions. Every
 array over the steps, the solids' constants arrays over the solids. The forces equal the
 reference-point pass's to round-off (`tests/backend/test_natural_inverse.py`: the four-bar,
 the slider-crank, `examples/all_elements.toml`, a redundant parallelogram and a six-bar,
-every force column within 1e-9, measured 7e-14), so `pam2exu verify MODEL -a kinetostatic` now compares
-forces from two formulations as well. A revolute whose points could not share a basic point,
+every force column within 1e-9, measured 7e-14; the quasi-static runs of the same models at
+rest, measured 5e-14), so `pam2exu verify MODEL -a kinetostatic` (or `-a quasi_static`) now
+compares forces from two formulations as well. A revolute whose points could not share a basic point,
 a solid pinned to the ground at two points, or an element between ground solids alone is
 left to the reference-point pass (`res.info["reactions_from"]` says which computed them)."""
 

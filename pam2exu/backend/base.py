@@ -159,7 +159,8 @@ class Backend(ABC):
                                           for every constraint element's wrench from the
                                           backend's own inverse dynamics, instead of
                                           solving Cqᵀ λ = Q_inertia − Q_applied natively
-                                          (a None answer: it does)
+                                          (a None answer: it does); the quasi-static one
+                                          asks them at rest (q̇ = q̈ = 0)
            =============================  =================================================
 
         5. Keep the console quiet unless ``settings.verbose`` (or ``verbose``) is > 0.
@@ -415,7 +416,8 @@ class Backend(ABC):
                   qdd: np.ndarray, redundant: bool = False) -> Reactions | None:
         """Every constraint element's wrench on its receiving solid at every step, from the
         backend's own inverse dynamics of the motion (with ``gives_reactions``): what the
-        ``kinetostatic`` analysis calls instead of its native pass.
+        ``kinetostatic`` analysis calls instead of its native pass, and the ``quasi_static``
+        one with q̇ = q̈ = 0 (its static equilibrium: the inverse dynamics at rest).
 
         The wrenches are the constraint forces that make the motion: with the masses,
         gravity, the torsors, the springs and the dampers, the same as the native pass's

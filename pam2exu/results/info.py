@@ -43,8 +43,9 @@ class RunInfo(MutableMapping):
         quasi_static, equilibrium: the backend's multipliers against the native equilibrium at the
         checked steps, relative [-].
     reactions_from : str
-        quasi_static, equilibrium: how the reactions were computed; kinetostatic: set when
-        the backend's own inverse dynamics computed them (``Backend.gives_reactions``).
+        quasi_static, equilibrium: how the reactions were computed (quasi_static: the native
+        solve, or the backend's own inverse dynamics at rest); kinetostatic: set when the
+        backend's own inverse dynamics computed them (``Backend.gives_reactions``).
     power_balance_error : float
         kinetostatic, dynamic: largest violation of the power balance [W].
     power_balance_tolerance : float

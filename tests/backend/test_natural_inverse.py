@@ -190,6 +190,43 @@ def test_kinetostatic_reactions_equal_the_reference_point_pass(name, monkeypatch
     assert natural.info["power_balance_error"] <= natural.info["power_balance_tolerance"]
 
 
+@pytest.mark.parametrize("name", list(MODELS))
+def test_quasi_static_reactions_are_the_inverse_dynamics_at_rest(name, monkeypatch):
+    """The quasi-static equilibrium Cqᵀ λ = −Q_applied is the inverse dynamics of the
+    configurations at rest (q̇ = q̈ = 0: no inertia, no damper force): the natural backend's
+    quasi-static run takes its reactions from its own inverse dynamics at rest
+    (``reactions_from``), and every force column equals the reference-point pass's static
+    solve on the same motion (the backend declaring no reactions of its own) to 1e-9 of the
+    largest of its element's columns, plus round-off of the run's largest (1e-13 of it: a
+    column that is round-off on both, as all_elements' gear mesh, which transmits nothing
+    at rest, 1.1e-17 N on each) (measured: ≤ 5.3e-14 of its element's largest, the
+    redundant parallelogram's least norm; all_elements' spring-damper and its torsional
+    one at rest: no damper force in either)."""
+    model, redundant = MODELS[name]()
+    runs = {}
+    for gives in (True, False):
+        with monkeypatch.context() as patch:
+            patch.setattr(Natural, "gives_reactions", gives)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                runs[gives] = pam2exu.run(model, analysis="quasi_static", steps=STEPS,
+                                          backend="natural")
+    natural, native = runs[True], runs[False]
+    assert natural.info["reactions_from"].startswith(
+        "the natural-coordinate backend's inverse dynamics at rest")
+    assert native.info["reactions_from"].startswith("native")
+    assert list(natural.columns) == list(native.columns)
+    forces = [c for c in native.columns if c.split(".")[-1] in ("Fx", "Fy", "Mz", "F", "M")]
+    assert forces
+    largest = max(np.abs(native[c]).max() for c in forces)
+    for column in native.columns:
+        element = column.split(".")[0]
+        scale = max(np.abs(native[c]).max() for c in native.columns
+                    if c.startswith(element + "."))
+        np.testing.assert_allclose(natural[column], native[column], rtol=0,
+                                   atol=1e-9 * scale + 1e-13 * largest, err_msg=column)
+
+
 def test_a_mechanism_whose_every_solid_is_held_gets_the_reference_point_pass():
     """No natural coordinate at all (every solid held by a fixed link): the natural backend
     leaves the reactions to the reference-point pass, which holds the bar's weight (m g at

@@ -258,3 +258,31 @@ def test_the_pass_makes_the_reactions_of_its_variants(monkeypatch):
     status = table["status"].tolist()
     assert status.count("ok") + status.count("rejected") == 2
     assert own == []                          # the 4 others fail before their forces
+
+
+def test_quasi_static_variants_share_their_reactions_at_rest(monkeypatch):
+    """A quasi-static study on the natural backend: the pass's variants take their reactions
+    from its one inverse dynamics of them all at rest (``population.Group.reactions``,
+    ż = z̈ = 0), none computes its own, and every reduced output, status and warning equals
+    the study with each variant alone (which solves its own inverse dynamics at rest)."""
+    import pam2exu.backend.natural as natural
+    from pam2exu.studies.runner import run_variants
+    text = FOUR_BAR.replace('analysis = "kinetostatic"', 'analysis = "quasi_static"').replace(
+        ', "coupler.P.DDx"', "")
+    s = loads_study(text, folder=EXAMPLES)
+    values = np.asarray(s.variants())
+    model = nominal(s)[0]
+    own = []
+    original = natural.constraint_wrenches
+    with monkeypatch.context() as patch:
+        patch.setattr(natural, "constraint_wrenches",
+                      lambda form, *a, **k: own.append(form.mech) or original(form, *a, **k))
+        for batched in (True, False):
+            p = payload(dataclasses.replace(s, batched=batched), model)
+            table = run_variants(p, 0, len(values), values)
+            status = table["status"].tolist()
+            assert status.count("ok") + status.count("rejected") == 2
+            # in one pass none of its own (the 4 others fail before their forces); alone,
+            # each of the 2 that get there its own
+            assert len(own) == (0 if batched else 2)
+    _same(*_both(text))

@@ -18,7 +18,8 @@ per column:
   two agree to round-off): W_b = M_b ζ̈_b − Q_b with each row's masses and loads,
   Φ_zᵀ μ = −Σ A_bᵀ W_b with one LU per row (its own pivots), the elements' wrenches
   (``wrenches.wrenches``) with each row's ground points. ``Group.reactions`` makes them
-  the first time a run asks (a kinematic study never does).
+  the first time a run asks (a kinematic study never does); a quasi-static run asks for
+  those of its configurations at rest (ż = z̈ = 0: no inertia, no damper force).
 
 Every operation is elementwise over the rows, or a sum in a fixed order: no variant's numbers
 depend on which others share its chunk. A variant whose reactions cannot be had here (its
@@ -110,16 +111,18 @@ class Group:
     def __init__(self, forms, times, z, zd, zdd, q):
         self.forms, self.times = forms, times
         self.z, self.zd, self.zdd, self.q = z, zd, zdd, q
-        self._made: list | None = None
+        #: every variant's reactions, of the motion (False) and at rest (True), once made
+        self._made: dict[bool, list] = {}
 
-    def reactions(self, v: int) -> Reactions | None:
-        """Variant v's ``Reactions`` (None: its run computes its own)."""
-        if self._made is None:               # inside the run of the variant that asks first:
+    def reactions(self, v: int, at_rest: bool = False) -> Reactions | None:
+        """Variant v's ``Reactions`` (None: its run computes its own) of its motion, or with
+        ``at_rest`` of its configurations at rest (ż = z̈ = 0: the quasi-static equilibrium)."""
+        if at_rest not in self._made:        # inside the run of the variant that asks first:
             with np.errstate(all="ignore"):  # no floating-point warning of another's rows
-                self._made = self._make()   # (a row that is not finite: that variant's None)
-        return self._made[v]
+                self._made[at_rest] = self._make(at_rest)   # (a row not finite: its None)
+        return self._made[at_rest][v]
 
-    def _make(self) -> list:
+    def _make(self, at_rest: bool) -> list:
         """Every variant's reactions: those of the first handled variant's structure at
         once, the others None."""
         plans = [plan(f) for f in self.forms]
@@ -134,15 +137,15 @@ class Group:
         # objects) and their frame equations stack
         members = [v for v in handled if plans[v].hat_frames is first.hat_frames
                    and structure(plans[v].terms) == shape]
-        found = _reactions(self, members, [plans[v] for v in members])
+        found = _reactions(self, members, [plans[v] for v in members], at_rest)
         for v, given in zip(members, found):
             out[v] = given
         return out
 
 
-def _reactions(group: Group, members: list[int], plans: list) -> list:
+def _reactions(group: Group, members: list[int], plans: list, at_rest: bool) -> list:
     """The ``Reactions`` of the variants ``members`` (one plan structure), None where one
-    fails (module doc)."""
+    fails (module doc); ``at_rest``: of their configurations with ż = z̈ = 0."""
     forms = [group.forms[v] for v in members]
     first, V = plans[0], len(members)
     n = len(group.times)
@@ -155,6 +158,8 @@ def _reactions(group: Group, members: list[int], plans: list) -> list:
     grounds = {k: np.stack([pl.pins[k].constant for pl in plans], axis=1)
                for k, pin in enumerate(first.pins) if pin.columns is None}   # (2, V)
     z, zd, zdd = (a[:, :, members] for a in (group.z, group.zd, group.zdd))
+    if at_rest:
+        zd = zdd = np.zeros_like(z)
     q = group.q[members]
     nc = len(first.mech.constraints)
     wrench_out = np.empty((V, n, nc, 3))

@@ -116,12 +116,17 @@ class Answered:
 
     def reactions(self, times: np.ndarray, q, qd, qdd):
         """The ``Reactions`` of this motion from the pass's group when it is the pass's own
-        (the run's times, x, y, fi and rates as the pass found them), else None."""
+        (the run's times, x, y, fi and rates as the pass found them), or its configurations
+        at rest (the pass's times and x, y, fi, q̇ = q̈ = 0: the quasi-static equilibrium),
+        else None."""
         if self.group is None or self.q is None or not (
-                np.array_equal(times, self.times) and np.array_equal(q, self.q)
-                and np.array_equal(qd, self.qd) and np.array_equal(qdd, self.qdd)):
+                np.array_equal(times, self.times) and np.array_equal(q, self.q)):
             return None
-        return self.group.reactions(self.index)
+        if np.array_equal(qd, self.qd) and np.array_equal(qdd, self.qdd):
+            return self.group.reactions(self.index)
+        if not (np.any(qd) or np.any(qdd)):
+            return self.group.reactions(self.index, at_rest=True)
+        return None
 
     def positions(self, form, times: np.ndarray, start: np.ndarray, w: np.ndarray,
                   tolerance: float):
