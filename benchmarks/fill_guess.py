@@ -2,8 +2,9 @@
 ż, paired in one interpreter (docs/performance.md, "The fill's first guess").
 
 A run's fill (``solver.Solver._fill``) starts the steps between its coarse steps from the
-quintic where an interval of the block missed by more than ``solver.QUINTIC_MISS``; setting
-the constant to infinity gives the cubic everywhere, the code as it was. A study's pass
+quintic where the block's largest coarse miss says so (``solver.quintic_guess``: above
+``QUINTIC_MISS``, or small enough for the quintic to be within the tolerance); patching it
+to answer False gives the cubic everywhere, the code as it was. A study's pass
 (``variants._fill``) always takes the quintic; the cubic is patched in for the comparison
 (its Newton iteration, ``variants.solve``, on the variants' stacked equations).
 Each pair runs the two in alternation, their order swapped every round, CPU seconds of this
@@ -86,10 +87,10 @@ def paired(run, set_cubic, rounds: int):
 def single_runs(rounds: int) -> list[str]:
     """One row per run of ``RUNS``: its positions and rates on the natural backend."""
     lines = []
-    quintic_miss = solver.QUINTIC_MISS
+    quintic_guess = solver.quintic_guess
 
     def set_cubic(flag):
-        solver.QUINTIC_MISS = float("inf") if flag else quintic_miss
+        solver.quintic_guess = (lambda miss, tolerance: False) if flag else quintic_guess
 
     for model, steps in RUNS:
         job = prepare(ROOT / "examples" / f"{model}.toml", analysis="kinematic", steps=steps,

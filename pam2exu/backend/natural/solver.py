@@ -11,9 +11,10 @@ A run is solved in two passes (vectorised over steps, sequential only where it m
    jump to a nearby branch (a pass with intervals ten times longer, tried, did so next to
    a change point: tests/analyses/test_hard_cases.py);
 2. every step in between at once: Newton started from the cubic Hermite interpolation of
-   z and ż at the ends of its interval (error O(h⁴)), or where the coarse pass's intervals
-   are long for the motion from the quintic through z, ż and z̈ (error O(h⁶):
-   ``QUINTIC_MISS``), Jacobians and solves batched over the
+   z and ż at the ends of its interval (error O(h⁴)), or from the quintic through z, ż
+   and z̈ (error O(h⁶)) where the coarse pass's intervals are long for the motion (the
+   cubic would take a third Newton iteration) or so short that the quintic is within the
+   tolerance (one iteration: ``quintic_guess``), Jacobians and solves batched over the
    steps (``batched``: blocks of BLOCK steps, the equations ordered as the pivots at the
    start of their interval, so that rows are seldom exchanged; a large system: one sparse
    block-diagonal LU per iteration, ``linear``). A step that does not
@@ -65,6 +66,13 @@ BLOCK = 8192
 #: iterations a step with the cubic, 2.05 with the quintic); below it the quintic's two more
 #: terms would only cost (the four-bar at 10,000 steps and more: 1e-5, 2.0 either way)
 QUINTIC_MISS = 3e-5
+#: ... and where its interval's miss is so small that the quintic's error (about the miss
+#: squared: O(h⁶) against O(h³)) is within the tolerance, miss² ≤ QUINTIC_ONE × tolerance:
+#: its steps then take one Newton iteration instead of two (the four-bar, a part of 50,000
+#: steps solved with positions only: 2.00 iterations a step from either guess at misses of
+#: ~1e-5 (COARSE intervals of 0.01 s), 1.34 from the quintic at ~1.3e-6 (0.005 s: a run of
+#: 100,000 steps, in two parts), 1.62 at ~2.1e-6, 2.00 at ~3.6e-6)
+QUINTIC_ONE = 200.0
 #: a step that failed is cut into at most this many sub-steps
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
@@ -74,6 +82,13 @@ COARSE_GAP = 64
 CONVERGED = 1e-3
 #: the machine epsilon (the size of round-off relative to a value)
 EPS = float(np.finfo(float).eps)
+
+
+def quintic_guess(miss: float, tolerance: float) -> bool:
+    """Whether the fill's steps start from the quintic: miss > QUINTIC_MISS (the cubic would
+    take a third Newton iteration) or miss² ≤ QUINTIC_ONE · tolerance (the quintic takes one,
+    the cubic two); else the cubic, two terms fewer, two iterations either way."""
+    return miss > QUINTIC_MISS or miss * miss <= QUINTIC_ONE * tolerance
 
 
 def cubic_hermite(u, h):
@@ -353,7 +368,7 @@ class Solver(LinearSolves):
 
     def _fill(self, t, z, intervals) -> list[int]:
         """Solve the steps inside every interval at once from Hermite guesses (the quintic
-        where some interval of the block has a coarse miss above QUINTIC_MISS); the
+        where the block's largest coarse miss says so: ``quintic_guess``); the
         numbers of the intervals where some step failed or left its guess far behind (more
         than 10 times its interval's miss)."""
         if not intervals:
@@ -368,7 +383,8 @@ class Solver(LinearSolves):
         for a, b, order in self._blocks(z, k, owner):
             part, at = steps[a:b], owner[a:b]
             guess = self._hermite(t, z, part, k[at], j[at],
-                                  quintic=bool(np.max(miss[at]) > QUINTIC_MISS))
+                                  quintic=quintic_guess(float(np.max(miss[at])),
+                                                        self.settings.tolerance))
             if order is not None:
                 found = self._bulk(t[part], guess, order)
             else:
