@@ -32,6 +32,10 @@ BATCHED_FROM = 64
 PIVOT_THRESHOLD = 0.5
 #: bytes of Jacobians kept at once (the steps are solved in chunks)
 CHUNK_BYTES = 64 * 2**20
+#: a ``_bulk`` block of this many steps or more iterates only its steps still moving once
+#: most have stopped (a smaller one as a whole: gathering its few steps costs more than
+#: their iteration)
+NARROW_FROM = 512
 
 
 class LinearSolves:
@@ -193,35 +197,72 @@ class LinearSolves:
     def _bulk(self, t, z, order, iterations: int = 4):
         """(z, ż, z̈, ok) for a block of steps of a small square system from good guesses
         (z (nz, n), one column per step, as the answers): each Newton solve also solves
-        Φ_z ż = g' (two right-hand sides, one factorisation), and the last one's Jacobian
-        (at z within the tolerance) gives z̈; ż, z̈ None without ``fill_rates`` (one
-        right-hand side); None where a Jacobian is singular."""
-        terms, tol = self.terms, self.settings.tolerance
+        Φ_z ż = g' (two right-hand sides, one factorisation), and a step's last one (its
+        Jacobian at z within the tolerance) gives its z̈; ż, z̈ None without
+        ``fill_rates`` (one right-hand side); None where a Jacobian is singular. In a block
+        of NARROW_FROM steps or more, once at least half of the steps have a Newton step
+        below the tolerance they stop there and the next iterations solve only the steps
+        still moving (each step's arithmetic is its own, whichever others share the solve);
+        a smaller block, or one where most steps still move, iterates as a whole (fewer,
+        larger numpy calls: gathering the few or the many costs more than it saves)."""
+        terms, tol, rates = self.terms, self.settings.tolerance, self.fill_rates
         z = np.array(z, dtype=float)
-        rhs = np.empty((terms.m, 2 if self.fill_rates else 1, len(t)))
-        if self.fill_rates:
-            rhs[:, 1] = terms.velocity_rhs_cols(t)[order]
-        w = self.w[:, None]
+        n, w = len(t), self.w[:, None]
         g = terms.targets(t, 0)
+        velocity = terms.velocity_rhs_cols(t)[order] if rates else None
+        zd = zdd = None
+        step = np.full(n, np.inf)
+        active = np.arange(n)                 # the steps still iterating
+        whole = True                          # ... all of them, as views
         with np.errstate(all="ignore"):
             for _ in range(iterations):
-                phi, data = terms.residual_jacobian_cols(t, z, g)
+                ta, za, ga = (t, z, g) if whole else (t[active], z[:, active], g[:, active])
+                phi, data = terms.residual_jacobian_cols(ta, za, ga)
                 A = terms.dense_cols(data, order)
+                rhs = np.empty((terms.m, 2 if rates else 1, len(ta)))
                 rhs[:, 0] = -phi[order]
+                if rates:
+                    rhs[:, 1] = velocity if whole else velocity[:, active]
                 swaps, regular = lu_factor(A, PIVOT_THRESHOLD)
                 if not regular.all():
                     return None
                 x = lu_solve(A, swaps, rhs)
-                self.iterations += len(t)
-                z += x[:, 0]
-                step = np.max(np.abs(x[:, 0]) * w, axis=0, initial=0.0)
-                if np.all(step <= tol):
+                self.iterations += len(ta)
+                za += x[:, 0]
+                moved = np.max(np.abs(x[:, 0]) * w, axis=0, initial=0.0)
+                if whole:
+                    step = moved
+                else:
+                    z[:, active], step[active] = za, moved
+                done = moved <= tol
+                if done.all():
                     break
-            if not self.fill_rates:
+                if n >= NARROW_FROM and 2 * np.count_nonzero(done) >= len(done):
+                    # most have stopped: the others go on without them
+                    if rates and whole:       # every step's rates from these factors (the
+                        zd = x[:, 1]          # others' replaced where they stop)
+                        zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
+                    elif rates:
+                        self._bulk_rates(t, z, zd, zdd, order, active[done], x[:, :, done],
+                                         A[:, :, done], swaps[:, done])
+                    active, whole = active[~done], False
+            if not rates:
                 return z, None, None, step <= tol
-            zd = x[:, 1]
-            zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
+            # the last solve's steps (converged, or the iterations spent): ż from it, z̈ from
+            # its factors
+            if whole:
+                zd = x[:, 1]
+                zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
+            else:
+                self._bulk_rates(t, z, zd, zdd, order, active, x, A, swaps)
         return z, zd, zdd, step <= tol
+
+    def _bulk_rates(self, t, z, zd, zdd, order, steps, x, A, swaps) -> None:
+        """ż (the second right-hand side of x) and z̈ (from the factors A, swaps) of the
+        ``steps`` of ``_bulk`` whose last Newton solve these are, written into zd, zdd."""
+        zd[:, steps] = x[:, 1]
+        gamma = self.terms.gamma_cols(t[steps], z[:, steps], zd[:, steps])[order]
+        zdd[:, steps] = lu_solve(A, swaps, gamma)
 
     def _bulk_sparse(self, t, z, iterations: int = 4):
         """``_bulk`` for a large system: each Newton iteration one sparse LU of the steps'

@@ -17,7 +17,8 @@ A run is solved in two passes (vectorised over steps, sequential only where it m
    tolerance (one iteration: ``quintic_guess``), Jacobians and solves batched over the
    steps (``batched``: blocks of BLOCK steps, the equations ordered as the pivots at the
    start of their interval, so that rows are seldom exchanged; a large system: one sparse
-   block-diagonal LU per iteration, ``linear``). A step that does not
+   block-diagonal LU per iteration, ``linear``); a step stops iterating once its Newton
+   step is below the tolerance, the others go on without it. A step that does not
    converge, or converges far from its guess (another branch), has its interval solved
    step by step.
 
