@@ -902,9 +902,11 @@ the natural coordinates (`pam2exu/backend/natural/inverse.py` and `reactions.py`
 `Natural.reactions` answers when the analysis asks: `Backend.gives_reactions`), not from the
 reference-point pass the Exudyn backend's runs use. So does the `quasi_static` analysis:
 its equilibrium Cqᵀ λ = −Q_applied is the inverse dynamics of its configurations at rest
-(ż = z̈ = 0: no inertia force, and a damper at rest applies none). Each solid's base point and base vector
-are ζ_b = (p, v) = A_b z + c_b, and its kinetic energy a constant quadratic form in ζ̇_b, so
-what its joints apply to it has no velocity term:
+(ż = z̈ = 0: no inertia force, and a damper at rest applies none).
+
+Each solid's base point and base vector are ζ_b = (p, v) = A_b z + c_b, and its kinetic
+energy a constant quadratic form in ζ̇_b, so what its joints apply to it has no velocity
+term:
 
 ```text
 W_b = M_b ζ̈_b − Q_b,   M_b = [[m I, m G], [m Gᵀ, J_p / |d|² I]],   G = a_G I + b_G Ω
