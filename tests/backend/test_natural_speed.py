@@ -180,6 +180,29 @@ def test_the_fill_iterates_only_the_steps_still_moving():
     assert np.max(np.abs(again - z) * solver.w) <= NaturalSettings().tolerance
 
 
+@pytest.mark.parametrize("iterations", [2, 3])
+def test_a_fill_block_out_of_iterations_leaves_its_last_steps_to_the_step_by_step_pass(
+        iterations, monkeypatch):
+    """all_elements at 1,000 steps with the fill's blocks allowed 2 or 3 Newton iterations
+    (4 by default): after the steps that stopped early, those still moving when the
+    iterations run out (a few next to the laws' breakpoints) take their rates from the
+    last solve and their intervals are solved again step by step; the run equals the
+    default one to 1e-12 of each column's largest value."""
+    from pam2exu.backend.natural import linear
+    model = pam2exu.load(ROOT / "examples" / "all_elements.toml")
+    reference = pam2exu.run(model, analysis="kinematic", steps=1000, backend="natural")
+    bulk = linear.LinearSolves._bulk
+    monkeypatch.setattr(linear.LinearSolves, "_bulk",
+                        lambda self, t, z, order, iterations_=4: bulk(self, t, z, order,
+                                                                      iterations))
+    res = pam2exu.run(model, analysis="kinematic", steps=1000, backend="natural")
+    for column in reference.columns:
+        a, b = np.asarray(res[column]), np.asarray(reference[column])
+        scale = max(1.0, np.nanmax(np.abs(b), initial=0.0))
+        assert np.array_equal(np.isnan(a), np.isnan(b)), column
+        assert np.nanmax(np.abs(a - b), initial=0.0) <= 1e-12 * scale, column
+
+
 def test_a_step_of_a_larger_system_is_solved_dense():
     """One step of the chain of 12 loops (49 coordinates, at least SPARSE_FROM) is solved by
     a dense factorisation, not a sparse LU (before: ``_sparse``), to numpy's answer."""

@@ -215,7 +215,7 @@ class LinearSolves:
         active = np.arange(n)                 # the steps still iterating
         whole = True                          # ... all of them, as views
         with np.errstate(all="ignore"):
-            for _ in range(iterations):
+            for left in range(iterations - 1, -1, -1):
                 ta, za, ga = (t, z, g) if whole else (t[active], z[:, active], g[:, active])
                 phi, data = terms.residual_jacobian_cols(ta, za, ga)
                 A = terms.dense_cols(data, order)
@@ -237,8 +237,9 @@ class LinearSolves:
                 done = moved <= tol
                 if done.all():
                     break
-                if n >= NARROW_FROM and 2 * np.count_nonzero(done) >= len(done):
-                    # most have stopped: the others go on without them
+                if left and n >= NARROW_FROM and 2 * np.count_nonzero(done) >= len(done):
+                    # most have stopped: the others go on without them (x, A are then
+                    # the last solve's of the steps still active whenever the loop ends)
                     if rates and whole:       # every step's rates from these factors (the
                         zd = x[:, 1]          # others' replaced where they stop)
                         zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
