@@ -37,7 +37,6 @@ from ...errors import Pam2ExuError
 from ..base import Reactions
 from . import inverse
 from .reactions import in_frames, plan
-from .terms import extended
 from .variants import Stacked, structure, turns
 from .wrenches import wrenches
 
