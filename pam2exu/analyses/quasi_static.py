@@ -87,10 +87,11 @@ def backend_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float
     """Largest ``equilibrium_error`` of the backend's multipliers at the given steps.
 
     At each step, the backend's static solver with the masses and force elements (no
-    dampers) starts from the configuration found and gives its multipliers.
+    dampers) starts from the configuration found and gives its multipliers; pam2exu's own
+    forces and Jacobian are then evaluated at all those configurations at once.
     """
     mech = job.mech
-    worst = 0.0
+    found_q, found_lam = [], []
     for k in rows:
         found = job.backend.solve_positions(mech, job.times[k:k + 1], q[k], job.solver,
                                             forces=True)
@@ -100,18 +101,25 @@ def backend_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float
                 f"at t = {job.times[k]:.6g} s from the configuration found without them: the "
                 f"translation is wrong. Please report it with the model file. "
                 f"{job.backend.label} said: {found.error}")
-        st = State(job.times[k:k + 1], found.q)
-        applied = force_pass.applied_forces(mech, st, damping=False)
-        jacobian = native.equations(mech, st).jacobian
-        worst = max(worst, equilibrium_error(mech, st, found.multipliers, applied.force,
-                                             jacobian))
-    return worst
+        found_q.append(found.q[0])
+        found_lam.append(found.multipliers[0])
+    if not rows:
+        return 0.0
+    st = State(job.times[rows], np.array(found_q))
+    applied = force_pass.applied_forces(mech, st, damping=False)
+    jacobian = native.equations(mech, st).jacobian
+    return equilibrium_error(mech, st, np.array(found_lam), applied.force, jacobian)
 
 
 def equilibrium_error(mech, st, lam, applied, jacobian) -> float:
-    """max |Cqᵀ λ + Q_applied| relative to the largest force (moments divided by the length scale)."""
+    """max over the steps of |Cqᵀ λ + Q_applied| relative to the step's largest force
+    (moments divided by the length scale; 0 at a step without forces)."""
     per_length = np.tile([1.0, 1.0, 1.0 / mech.scale()], len(mech.solids))
     residual = force_pass.equilibrium_residual(mech, st, lam, -applied, jacobian) * per_length
-    size = max(np.max(np.abs(applied * per_length), initial=0.0),
-               np.max(np.abs(np.einsum("nmq,nm->nq", jacobian, lam) * per_length), initial=0.0))
-    return float(np.max(np.abs(residual), initial=0.0) / size) if size > 0 else 0.0
+    size = np.maximum(
+        np.max(np.abs(applied * per_length), axis=1, initial=0.0),
+        np.max(np.abs(np.einsum("nmq,nm->nq", jacobian, lam) * per_length), axis=1,
+               initial=0.0))
+    error = np.max(np.abs(residual), axis=1, initial=0.0)
+    return float(np.max(np.divide(error, size, out=np.zeros_like(error), where=size > 0),
+                        initial=0.0))
