@@ -29,6 +29,37 @@ def _force_columns(res):
             {"Fx", "Fy", "Mz", "Fnormal", "Parell", "Força"}]
 
 
+@pytest.mark.parametrize("backend", ["exudyn", "natural"])
+def test_the_backend_check_evaluates_pams_forces_once_for_its_steps(backend, monkeypatch):
+    """The quasi-static check solves the backend's static equilibrium at each of its 3
+    steps, then evaluates pam2exu's own Jacobian and applied forces at the 3 configurations
+    in one call each; its error is the largest per-step relative one, the same number as 3
+    one-step evaluations give (reference: ``equilibrium_error`` step by step)."""
+    from pam2exu.analyses import native, quasi_static
+    from pam2exu.analyses.job import prepare
+    job = prepare(ALL, analysis="quasi_static", steps=40, backend=backend)
+    res = pam2exu.run(ALL, analysis="quasi_static", steps=40, backend=backend)
+    q = job.mech.coordinates(res)
+    rows = quasi_static.checked_steps(len(job.times))
+    calls = []
+    equations = native.equations
+    with monkeypatch.context() as patch:
+        patch.setattr(native, "equations",
+                      lambda mech, st, **k: calls.append(st.n) or equations(mech, st, **k))
+        worst = quasi_static.backend_equilibrium_error(job, q, rows)
+    assert calls.count(len(rows)) == 1 and len(rows) == 3
+    steps = []
+    for k in rows:
+        found = job.backend.solve_positions(job.mech, job.times[k:k + 1], q[k], job.solver,
+                                            forces=True)
+        st = State(job.times[k:k + 1], found.q)
+        steps.append(quasi_static.equilibrium_error(
+            job.mech, st, found.multipliers,
+            forces.applied_forces(job.mech, st, damping=False).force,
+            native.equations(job.mech, st).jacobian))
+    assert worst == max(steps) and 0 < worst < 1e-12
+
+
 @pytest.mark.parametrize("path", [ALL, ROOT / "examples" / "slider_crank.toml"])
 def test_quasi_static_reactions_from_exudyn_equal_the_native_solve(path):
     """Exudyn's multipliers (static solver) and the native solve of Cqᵀ λ = −Q_applied
