@@ -103,8 +103,6 @@ def backend_equilibrium_error(job: Job, q: np.ndarray, rows: list[int]) -> float
                 f"{job.backend.label} said: {found.error}")
         found_q.append(found.q[0])
         found_lam.append(found.multipliers[0])
-    if not rows:
-        return 0.0
     st = State(job.times[rows], np.array(found_q))
     applied = force_pass.applied_forces(mech, st, damping=False)
     jacobian = native.equations(mech, st).jacobian

@@ -157,12 +157,12 @@ def test_an_angular_actuator_s_multiplier_is_its_reference_point_one(motion):
 
 # ---- the kinetostatic analysis through them (backend/natural/reactions.py) -----------------
 
-def _kinetostatic(model, gives_reactions, monkeypatch):
+def _natural(model, gives_reactions, monkeypatch, analysis="kinetostatic"):
     with monkeypatch.context() as patch:
         patch.setattr(Natural, "gives_reactions", gives_reactions)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return pam2exu.run(model, analysis="kinetostatic", steps=STEPS, backend="natural")
+            return pam2exu.run(model, analysis=analysis, steps=STEPS, backend="natural")
 
 
 @pytest.mark.parametrize("name", list(MODELS))
@@ -175,8 +175,8 @@ def test_kinetostatic_reactions_equal_the_reference_point_pass(name, monkeypatch
     guide.Mz; the redundant parallelogram's least norm 2.6e-14), and the power balance is
     checked on both."""
     model, _ = MODELS[name]()
-    natural = _kinetostatic(model, True, monkeypatch)
-    native = _kinetostatic(model, False, monkeypatch)
+    natural = _natural(model, True, monkeypatch)
+    native = _natural(model, False, monkeypatch)
     assert natural.info["reactions_from"] == "the natural-coordinate backend's inverse dynamics"
     assert "reactions_from" not in native.info
     assert list(natural.columns) == list(native.columns)
@@ -202,16 +202,9 @@ def test_quasi_static_reactions_are_the_inverse_dynamics_at_rest(name, monkeypat
     at rest, 1.1e-17 N on each) (measured: ≤ 5.3e-14 of its element's largest, the
     redundant parallelogram's least norm; all_elements' spring-damper and its torsional
     one at rest: no damper force in either)."""
-    model, redundant = MODELS[name]()
-    runs = {}
-    for gives in (True, False):
-        with monkeypatch.context() as patch:
-            patch.setattr(Natural, "gives_reactions", gives)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                runs[gives] = pam2exu.run(model, analysis="quasi_static", steps=STEPS,
-                                          backend="natural")
-    natural, native = runs[True], runs[False]
+    model, _ = MODELS[name]()
+    natural, native = (_natural(model, gives, monkeypatch, "quasi_static")
+                       for gives in (True, False))
     assert natural.info["reactions_from"].startswith(
         "the natural-coordinate backend's inverse dynamics at rest")
     assert native.info["reactions_from"].startswith("native")

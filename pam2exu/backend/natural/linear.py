@@ -240,30 +240,31 @@ class LinearSolves:
                 if left and n >= NARROW_FROM and 2 * np.count_nonzero(done) >= len(done):
                     # most have stopped: the others go on without them (x, A are then
                     # the last solve's of the steps still active whenever the loop ends)
-                    if rates and whole:       # every step's rates from these factors (the
-                        zd = x[:, 1]          # others' replaced where they stop)
-                        zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
-                    elif rates:
-                        self._bulk_rates(t, z, zd, zdd, order, active[done], x[:, :, done],
-                                         A[:, :, done], swaps[:, done])
+                    if rates:                 # the stopped steps' (whole: every step's,
+                        part = slice(None) if whole else done   # the others' replaced)
+                        zd, zdd = self._bulk_rates(t, z, order, x[:, :, part],
+                                                   A[:, :, part], swaps[:, part],
+                                                   None if whole else (zd, zdd, active[done]))
                     active, whole = active[~done], False
             if not rates:
                 return z, None, None, step <= tol
-            # the last solve's steps (converged, or the iterations spent): ż from it, z̈ from
-            # its factors
-            if whole:
-                zd = x[:, 1]
-                zdd = lu_solve(A, swaps, terms.gamma_cols(t, z, zd)[order])
-            else:
-                self._bulk_rates(t, z, zd, zdd, order, active, x, A, swaps)
+            # the last solve's steps (converged, or the iterations spent)
+            zd, zdd = self._bulk_rates(t, z, order, x, A, swaps,
+                                       None if whole else (zd, zdd, active))
         return z, zd, zdd, step <= tol
 
-    def _bulk_rates(self, t, z, zd, zdd, order, steps, x, A, swaps) -> None:
-        """ż (the second right-hand side of x) and z̈ (from the factors A, swaps) of the
-        ``steps`` of ``_bulk`` whose last Newton solve these are, written into zd, zdd."""
+    def _bulk_rates(self, t, z, order, x, A, swaps, into=None):
+        """(ż, z̈) from one of ``_bulk``'s solves: ż its second right-hand side x[:, 1], z̈
+        from its factors A, swaps. ``into`` None: the solve is of every step of the block
+        (ż a view of x); else (zd, zdd, steps): of those steps, written into zd, zdd."""
+        if into is None:
+            zd = x[:, 1]
+            return zd, lu_solve(A, swaps, self.terms.gamma_cols(t, z, zd)[order])
+        zd, zdd, steps = into
         zd[:, steps] = x[:, 1]
         gamma = self.terms.gamma_cols(t[steps], z[:, steps], zd[:, steps])[order]
         zdd[:, steps] = lu_solve(A, swaps, gamma)
+        return zd, zdd
 
     def _bulk_sparse(self, t, z, iterations: int = 4):
         """``_bulk`` for a large system: each Newton iteration one sparse LU of the steps'
