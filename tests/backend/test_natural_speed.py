@@ -24,10 +24,11 @@ from references.closed_form import FOUR_BAR, four_bar
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def solver_of(mech):
+def solver_of(mech, rates: bool = True):
     backend = Natural()
     form = backend.formulation(mech)
-    return form, Solver(form.terms, backend.weights(form, mech), NaturalSettings(), False)
+    return form, Solver(form.terms, backend.weights(form, mech), NaturalSettings(), False,
+                        rates=rates)
 
 
 @pytest.fixture(scope="module")
@@ -267,10 +268,7 @@ def test_a_run_without_rates_solves_none_in_its_fill(mech_of):
     t = np.linspace(0.0, 0.5, 1001)
     runs = {}
     for rates in (True, False):
-        backend = Natural()
-        form = backend.formulation(mech)
-        solver = Solver(form.terms, backend.weights(form, mech), NaturalSettings(), False,
-                        rates=rates)
+        form, solver = solver_of(mech, rates)
         z0, ok = solver.newton(t[:1], form.from_q(mech.initial_q()[None]))
         z, solved = solver.run(t, z0[0])
         assert solved == len(t)
