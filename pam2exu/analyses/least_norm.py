@@ -141,11 +141,14 @@ def newton_rows(evaluate_rows: EvaluateRows, Fj: np.ndarray, times: np.ndarray,
 
 def strict_minimum_rows(Fj: np.ndarray, Fq: np.ndarray, W: np.ndarray):
     """(σ_min/σ_max of [F_j F_q], the smallest eigenvalue of the reduced Hessian) of every
-    row: ``applicability``'s ``ratio_i`` and ``hessian`` at each, in batches."""
+    row: ``applicability``'s ``ratio_i`` and ``hessian`` at each, in batches, to round-off
+    (the kernel's basis is another, ``kernel_rows``; the reduced Hessian's eigenvalues do not
+    depend on it): the screen of ``clearance._first_lost``, whose rows near a limit
+    ``applicability`` decides."""
     n, m, nq = Fq.shape
     p = Fj.shape[1]
     A = np.concatenate([np.broadcast_to(Fj, (n, m, p)), Fq], axis=2)
-    _, s, Vt = np.linalg.svd(A)
+    s = np.linalg.svd(A, compute_uv=False)
     top = s[:, 0]
     smallest = np.zeros(n) if m > min(m, p + nq) else s[:, -1]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -157,11 +160,22 @@ def strict_minimum_rows(Fj: np.ndarray, Fq: np.ndarray, W: np.ndarray):
     full[:, p:, p:] = W
     for r in np.unique(rank):
         rows = np.nonzero(rank == r)[0]
-        Z = np.transpose(Vt[rows, r:], (0, 2, 1))
+        Z = kernel_rows(A[rows], int(r))
         if Z.shape[2]:
             reduced = np.transpose(Z, (0, 2, 1)) @ full[rows] @ Z
             hessian[rows] = np.linalg.eigvalsh(reduced)[:, 0]
     return ratio, hessian
+
+
+def kernel_rows(A: np.ndarray, rank: int) -> np.ndarray:
+    """An orthonormal basis of ker A_k (k, columns − rank) of every matrix of the stack A (n,
+    rows, columns) of that rank: of full row rank, the last columns of the complete QR of
+    A_kᵀ (its range is A_k's row space; a third of the full SVD's work), else the last
+    right singular vectors."""
+    n, rows, columns = A.shape
+    if rank == rows < columns:
+        return np.linalg.qr(np.transpose(A, (0, 2, 1)), mode="complete").Q[:, :, rank:]
+    return np.transpose(np.linalg.svd(A)[2][:, rank:], (0, 2, 1))
 
 
 @dataclass

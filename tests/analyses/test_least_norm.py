@@ -205,3 +205,42 @@ def test_a_condition_fails_at_the_contracts_rank_ratio_1e_9(ratio, holds):
     assert found.hessian == pytest.approx(1.0, abs=1e-12)
     assert bool(found.holds) is holds
     assert found.free.shape[1] == (0 if holds else 1)
+
+
+def test_the_kernel_of_every_row_is_orthonormal_and_annihilated():
+    """``kernel_rows``: of full row rank from the QR of Aᵀ, of lower rank from the SVD;
+    reference: scipy.linalg.null_space of each matrix (the same subspace: the projectors
+    agree)."""
+    rng = np.random.default_rng(11)
+    full = rng.standard_normal((5, 3, 6))                   # rank 3 of 6 columns
+    low = full.copy()
+    low[:, 2] = low[:, 0] - 2 * low[:, 1]                    # rank 2: the third row repeats
+    for stack, rank in ((full, 3), (low, 2)):
+        Z = ln.kernel_rows(stack, rank)
+        assert Z.shape == (5, 6, 6 - rank)
+        for A, z in zip(stack, Z):
+            assert np.max(np.abs(A @ z)) < 1e-14 * np.max(np.abs(A))
+            np.testing.assert_allclose(z.T @ z, np.eye(6 - rank), rtol=0, atol=1e-14)
+            N = null_space(A, rcond=1e-12)
+            np.testing.assert_allclose(z @ z.T, N @ N.T, rtol=0, atol=1e-13)
+
+
+def test_the_strict_minimum_of_many_rows_equals_the_conditions_row_by_row():
+    """``strict_minimum_rows`` (the clearance run's screen) against ``applicability`` at each
+    row, rows of full rank and one whose [F_j F_q] lost a rank among them; the reduced
+    Hessian's eigenvalue does not depend on the kernel's basis (QR or SVD), so the two
+    agree to round-off."""
+    rng = np.random.default_rng(5)
+    n, m, p, nq = 6, 4, 2, 5
+    Fj = rng.standard_normal((m, p))
+    Fj[3] = Fj[0] + Fj[1]                 # F_j's rows dependent: F_q's make them independent
+    Fq = rng.standard_normal((n, m, nq))
+    Fq[3, 3] = Fq[3, 0] + Fq[3, 1]        # … except at row 3: [F_j F_q] of rank 3 there
+    W = rng.standard_normal((n, nq, nq))
+    W = W + np.transpose(W, (0, 2, 1))
+    ratio, hessian = ln.strict_minimum_rows(Fj, Fq, W)
+    assert ratio[3] < 1e-15 and np.all(np.delete(ratio, 3) > 1e-3)
+    for k in range(n):
+        found = ln.applicability(ln.Closure(np.zeros(m), Fq[k], Fj, W[k]))
+        assert ratio[k] == pytest.approx(found.ratio_i, rel=1e-12, abs=1e-15)
+        assert hessian[k] == pytest.approx(found.hessian, rel=1e-12, abs=1e-13)
