@@ -3,6 +3,7 @@ checkout against an earlier commit.
 
     python benchmarks/instructions.py --against 19ef917            # every workload
     python benchmarks/instructions.py --against 19ef917 --only study
+    python benchmarks/instructions.py --against 19ef917 --only clearance   # not in "every"
 
 A 2-core machine shared with other jobs times the same run a fifth apart from one minute to
 the next (docs/performance.md); a change of a few percent is lost in that. Callgrind
@@ -83,6 +84,13 @@ if "study" in only:
     p, values = payload(study, nominal(study)[0]), study.variants()
     chunk = lambda: run_variants(p, 0, n, values[:n])
     work.append(("study, four-bar tolerance, per variant", n, chunk, chunk))
+if "clearance" in only:
+    n = 6
+    study = replace(load_study("examples/studies/locomotive_clearance.toml"), samples=n,
+                    steps=100)
+    p, values = payload(study, nominal(study)[0]), study.variants()
+    chunk = lambda: run_variants(p, 0, n, values[:n])
+    work.append(("clearance study, locomotive, 100 steps, per variant", n, chunk, chunk))
 model = load("examples/four_bar.toml")
 if "short" in only:
     for backend in ("natural", "exudyn"):
@@ -200,14 +208,15 @@ def main(argv=None) -> None:
                         help="simulate the caches and count estimated cycles (Ir + 10 × "
                              "first-level misses + 100 × last-level misses; ~2× slower)")
     parser.add_argument("--only", default="study,short,long",
-                        help="the workloads, comma-separated: study, short, long "
-                             "(default all)")
+                        help="the workloads, comma-separated: study, short, long, "
+                             "clearance (a clearance study's chunk: ~5 min under "
+                             "valgrind; default study, short, long)")
     args = parser.parse_args(argv)
     only = [w.strip() for w in args.only.split(",") if w.strip()]
-    unknown = set(only) - {"study", "short", "long"}
+    unknown = set(only) - {"study", "short", "long", "clearance"}
     if unknown:
         parser.error(f"unknown workload(s) {', '.join(sorted(unknown))}: "
-                     "choose among study, short, long")
+                     "choose among study, short, long, clearance")
     with tempfile.TemporaryDirectory(prefix="pam2exu-instructions-") as tmp:
         folder = Path(tmp)
         library = client_library(folder)

@@ -28,6 +28,7 @@ from ..registry import ANALYSES, analysis_type
 from .batch import answered, one_pass, one_pass_of
 from .execute import open_executor, run_chunks, warm, workers_of
 from .messages import WARNINGS, kind
+from .nominal import shares_nominal, sharing
 from .parameters import varied
 from .parts import clear_parts, plan_chunks
 from .linear import LinearResult, sensitivities
@@ -64,14 +65,15 @@ def error_text(exc: BaseException) -> str:
     return f"{head}: {exc}"
 
 
-def run_variant(payload: dict, values: np.ndarray, made=None, solved=None):
+def run_variant(payload: dict, values: np.ndarray, made=None, solved=None, engine=None):
     """One variant's (reduced outputs, status, warnings, series), or (None, error text,
     warnings, None): an ``Exception`` of the variant is never raised (KeyboardInterrupt and
     SystemExit pass), its warnings are not issued but returned (``warned``). The series
     (``series.variant_series``: t, then each output) only when the payload asks for them,
     else None. ``made``: (its model, the warnings making it gave) from ``made_variant``
     (None: made here); ``solved``: (its mechanism, the backend holding its answers) from
-    ``batch.answered`` (None: the payload's backend by name solves it)."""
+    ``batch.answered``; else ``engine``, the chunk's backend (``nominal.sharing``), solves
+    it, or None: the payload's backend by name."""
     from ..analyses import run
     model, early = made if made is not None else (None, [])
     with warnings.catch_warnings(record=True) as caught:   # each variant's: not the study's
@@ -79,8 +81,8 @@ def run_variant(payload: dict, values: np.ndarray, made=None, solved=None):
         try:
             if model is None:
                 model = variant_model(payload, values)
-            subject, backend = solved if solved is not None else (model,
-                                                                  payload.get("backend"))
+            subject, backend = solved if solved is not None else (
+                model, engine if engine is not None else payload.get("backend"))
             res = run(subject, payload["analysis"], t_end=payload["t_end"],
                       steps=payload["steps"], outputs=payload["outputs"], backend=backend)
             reduced = reduce_run(res, payload["outputs"], payload["reduce"])
@@ -141,6 +143,7 @@ def run_variants(payload: dict, start: int, stop: int, values: np.ndarray
     rows, warned_rows, kept = [], [], []
     made = solved = [None] * (stop - start)
     frozen = False
+    engine = sharing(payload["backend"]) if payload.get("shares_nominal") else None
     try:
         if one_pass(payload):              # the chunk's positions in one pass
             (made, solved), frozen = set_apart(lambda: _one_pass(payload, values))
@@ -148,7 +151,7 @@ def run_variants(payload: dict, start: int, stop: int, values: np.ndarray
             for i in range(start, stop):
                 row = values[i - start]
                 reduced, outcome, warned_text, series = run_variant(
-                    payload, row, made[i - start], solved[i - start])
+                    payload, row, made[i - start], solved[i - start], engine)
                 made[i - start] = solved[i - start] = None       # its objects may go now
                 rows.append(Variant(i, ERROR, outcome, tuple(row), None) if reduced is None
                             else Variant(i, outcome, "", tuple(row), reduced))
@@ -205,6 +208,7 @@ def payload(study: Study, reduced: list[str]) -> dict:
             "series": series_rows(analysis_type(study.analysis).at_start, study.steps)
             if study.series else None,
             "as_made": analysis_type(study.analysis).parts_as_made,
+            "shares_nominal": shares_nominal(study),
             "backend": study.backend, "batched": study.batched}
 
 
