@@ -4,18 +4,20 @@ regeneration.
 A script that writes one section alone (dynamics.py, studies.py, clearance_speed.py,
 natural_speed.py, predictor.py, targets.py) puts it between two marker lines,
 ``<!-- NAME: written by benchmarks/SCRIPT ... -->`` and ``<!-- end of NAME -->``
-(``dynamics.replace_section``). ``keep_sections`` gives a regenerated page every such
-section of the old page that the new one does not write itself, unchanged and where it was:
-before the first heading or marker line that followed it on the old page and is on the new
-one, or at the end.
+(``dynamics.replace_section``); a section written by hand from measurements it names
+between ``<!-- NAME: written by hand ... -->`` and the same end line. ``keep_sections``
+gives a regenerated page every such section of the old page that the new one does not
+write itself, unchanged and where it was: before the first heading or marker line that
+followed it on the old page and is on the new one, or at the end.
 """
 from __future__ import annotations
 
 import re
 from pathlib import Path
 
-#: one separately written section: its first marker line, its lines, its end marker line
-SECTION = re.compile(r"^<!-- (?P<name>[^:\n]+): written by benchmarks/[^\n]*-->$"
+#: one separately written section (by a script or by hand): its first marker line, its
+#: lines, its end marker line
+SECTION = re.compile(r"^<!-- (?P<name>[^:\n]+): written by (?:benchmarks/|hand)[^\n]*-->$"
                      r".*?^<!-- end of (?P=name) -->$", re.M | re.S)
 #: a line a kept section may be put before: a heading, or a section's first marker line
 ANCHOR = re.compile(r"^(#{1,3} |<!-- (?!end of ))")

@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
 from benchmarks import targets
 from benchmarks.dynamics import replace_section
-from benchmarks.page import write_page
+from benchmarks.page import sections, write_page
 
 OLD = """# Performance
 
@@ -60,6 +61,8 @@ new study
 <!-- end of section 9 -->
 """
 
+ROOT = Path(__file__).resolve().parents[1]
+
 
 def block(text, name):
     return re.search(rf"<!-- {name}: written.*?<!-- end of {name} -->", text, re.S).group(0)
@@ -81,6 +84,25 @@ def test_a_full_regeneration_keeps_the_sections_written_alone(tmp_path):
     assert "old study" not in expected and "old numbers" not in expected
     write_page(page, NEW)                       # a second regeneration: the same page
     assert page.read_text(encoding="utf-8") == expected
+
+
+def test_a_full_regeneration_keeps_the_sections_written_by_hand(tmp_path):
+    """A section written by hand from the measurements it names is kept as a script's is
+    (before: only ``written by benchmarks/`` markers were, and a regeneration would have
+    dropped the page's ~1,100 lines of hand-written analysis)."""
+    hand = ("<!-- fixed costs: written by hand from `python benchmarks/fixed_costs.py` -->\n"
+            "## Fixed costs\nmeasured by hand\n<!-- end of fixed costs -->")
+    page = tmp_path / "performance.md"
+    page.write_text(OLD.replace("<!-- section 9:", hand + "\n\n<!-- section 9:"),
+                    encoding="utf-8")
+    write_page(page, NEW)
+    text = page.read_text(encoding="utf-8")
+    assert hand in text and text.index(hand) < text.index("## 9. Studies")
+    # the page itself: every hand-written section is one that a regeneration keeps
+    real = (ROOT / "docs" / "performance.md").read_text(encoding="utf-8")
+    marked = re.findall(r"^<!-- ([^:\n]+): written by hand", real, re.M)
+    assert {"rows not met", "studies on 2 workers", "fixed costs"} <= set(marked)
+    assert set(marked) <= set(sections(real))
 
 
 def test_a_new_section_goes_before_the_line_asked(tmp_path):
