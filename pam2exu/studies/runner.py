@@ -143,7 +143,8 @@ def run_variants(payload: dict, start: int, stop: int, values: np.ndarray
     rows, warned_rows, kept = [], [], []
     made = solved = [None] * (stop - start)
     frozen = False
-    engine = sharing(payload["backend"]) if payload.get("shares_nominal") else None
+    engine = (sharing(payload["backend"])   # (no backend named: each run's own, alone)
+              if payload.get("shares_nominal") and payload.get("backend") else None)
     try:
         if one_pass(payload):              # the chunk's positions in one pass
             (made, solved), frozen = set_apart(lambda: _one_pass(payload, values))
