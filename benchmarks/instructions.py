@@ -76,21 +76,22 @@ from pam2exu.model import load
 from pam2exu.studies import load_study
 from pam2exu.studies.runner import nominal, payload, run_variants
 client.pam2exu_start()
+
+
+def chunk_of(path, n):
+    """A worker's task on the first n variants of the study at path, 100 steps."""
+    study = replace(load_study(path), samples=n, steps=100)
+    p, values = payload(study, nominal(study)[0]), study.variants()
+    return lambda: run_variants(p, 0, n, values[:n])
+
+
 work = []                                   # (name, divisor, counted run, warm-up)
 if "study" in only:
-    n = 100
-    study = replace(load_study("examples/studies/four_bar_tolerance.toml"), samples=n,
-                    steps=100)
-    p, values = payload(study, nominal(study)[0]), study.variants()
-    chunk = lambda: run_variants(p, 0, n, values[:n])
-    work.append(("study, four-bar tolerance, per variant", n, chunk, chunk))
+    chunk = chunk_of("examples/studies/four_bar_tolerance.toml", 100)
+    work.append(("study, four-bar tolerance, per variant", 100, chunk, chunk))
 if "clearance" in only:
-    n = 6
-    study = replace(load_study("examples/studies/locomotive_clearance.toml"), samples=n,
-                    steps=100)
-    p, values = payload(study, nominal(study)[0]), study.variants()
-    chunk = lambda: run_variants(p, 0, n, values[:n])
-    work.append(("clearance study, locomotive, 100 steps, per variant", n, chunk, chunk))
+    chunk = chunk_of("examples/studies/locomotive_clearance.toml", 6)
+    work.append(("clearance study, locomotive, 100 steps, per variant", 6, chunk, chunk))
 model = load("examples/four_bar.toml")
 if "short" in only:
     for backend in ("natural", "exudyn"):
