@@ -367,3 +367,31 @@ def test_variants_of_one_structure_share_their_terms_indices(four_bar_mech):
     for got, want in ((b.residual(t, z), fresh.residual(t, z)),
                       (b.jacobian(z), fresh.jacobian(z))):
         assert got.tobytes() == want.tobytes()
+
+
+def test_the_damped_iteration_gives_up_where_its_line_searches_find_no_descent(monkeypatch):
+    """A four-bar whose coupler (0.7 m) cannot close the loop at t = 0 (the crank 0.3 m from
+    the rocker's axle, the rocker 0.3 m long): |Φ| has a minimum that is
+    not 0. From the model's guess the damped iteration reaches it, its line searches then
+    find no descent, and it stops after STALLED_SEARCHES of them, not after its 200
+    iterations (a redundant parallelogram driven 1e5 s a step spent 20 s in 51 such
+    solves): the same answer, not solved, for a fraction of the residuals."""
+    from pam2exu.backend.natural import solver as solver_module
+    text = (ROOT / "examples" / "four_bar.toml").read_text(encoding="utf-8")
+    mech = pam2exu.loads(text.replace("B = [0.35, 0.0]", "B = [0.7, 0.0]")).mechanism()
+    form, solver = solver_of(mech)
+    z0 = form.from_q(mech.initial_q())[0]
+    counted = []
+    residual = form.terms.residual
+    monkeypatch.setattr(form.terms, "residual", lambda *a: counted.append(1) or residual(*a))
+    monkeypatch.setattr(solver_module, "STALLED_SEARCHES", 10 ** 9)        # as before
+    z_all, ok_all = solver.damped(0.0, z0)
+    before = len(counted)
+    counted.clear()
+    monkeypatch.setattr(solver_module, "STALLED_SEARCHES", 3)
+    z_now, ok_now = solver.damped(0.0, z0)
+    assert not ok_all and not ok_now
+    assert before > 1000 and len(counted) < before / 10
+    # where it stopped, |Φ| is as low as 200 iterations took it, to the line search's 1e-4
+    size = lambda z: np.linalg.norm(residual(np.array([0.0]), z[None])[0])      # noqa: E731
+    assert size(z_now) <= size(z_all) * (1 + 1e-3)

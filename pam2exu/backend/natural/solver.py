@@ -74,6 +74,10 @@ QUINTIC_MISS = 3e-5
 #: ~1e-5 (COARSE intervals of 0.01 s), 1.34 from the quintic at ~1.3e-6 (0.005 s: a run of
 #: 100,000 steps, in two parts), 1.62 at ~2.1e-6, 2.00 at ~3.6e-6)
 QUINTIC_ONE = 200.0
+#: ``Solver.damped`` gives up after this many line searches in a row that found no descent
+#: (each a step of 1e-6 of Newton's, from nearly the same z: the same direction again); a
+#: redundant parallelogram driven 1e5 s a step spent 20 s in 51 such solves of 200 iterations
+STALLED_SEARCHES = 3
 #: a step that failed is cut into at most this many sub-steps
 MAX_SUBSTEPS = 64
 #: the extrapolation of a step looks back this many times 8 steps for solved ones
@@ -252,7 +256,9 @@ class Solver(LinearSolves):
 
     def damped(self, t: float, z: np.ndarray, iterations: int = 200):
         """(z, ok): Newton's iteration at one time from a poor guess, each step shortened
-        until it lowers |Φ| (backtracking), then full steps near the solution."""
+        until it lowers |Φ| (backtracking), then full steps near the solution; not solved
+        after ``iterations`` steps, or ``STALLED_SEARCHES`` line searches in a row without
+        descent (|Φ| at a minimum that is not 0: no configuration there)."""
         terms = self.terms
         t = np.array([t])
 
@@ -262,6 +268,7 @@ class Solver(LinearSolves):
                 return float(np.sqrt(np.sum((phi / (1.0 + terms.magnitude(t, x[None])[0])) ** 2)))
 
         now = size(z)
+        failed = 0                               # line searches in a row that found no descent
         for _ in range(iterations):
             with np.errstate(all="ignore"):
                 dz = self.solve(terms.jacobian(z[None]), -terms.residual(t, z[None]))[0]
@@ -270,6 +277,9 @@ class Solver(LinearSolves):
             alpha = 1.0
             while alpha > 1e-6 and not size(z + alpha * dz) <= (1 - 1e-4 * alpha) * now:
                 alpha *= 0.5
+            failed = 0 if alpha > 1e-6 else failed + 1   # (the search ends there on descent)
+            if failed >= STALLED_SEARCHES:       # stuck: the same direction from the same z
+                return z, False
             z = z + alpha * dz
             now = size(z)
             if alpha == 1.0:
