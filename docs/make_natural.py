@@ -868,7 +868,11 @@ lets the constraints drift, so after every accepted step, and at every output ti
 method's dense output), the state is projected back onto Φ = 0 (least-norm Gauss–Newton) and
 Φ_z ż = g′. The accuracy is on demand: runs at rtol = atol = 0.1 · tolerance, then 16 times
 smaller, until two successive runs differ by at most tolerance · (1 + |value|) on every
-x, y, fi and rate; the finer one is kept. The analysis does the rest (law breakpoints'
+x, y, fi and rate; the finer one is kept. A run that would need more than 2,097,152 steps
+stops; so does one whose pace over its first 1,000, 2,000, 4,000 … steps would need 64
+times that to reach the end of the interval. That is an interval far longer than the
+motion's time scale, such as one meant in milliseconds. The message gives the time
+reached and the pace. The analysis does the rest (law breakpoints'
 impulses, accelerations, reactions), as for Exudyn, so `pam2exu verify MODEL -a dynamic`
 compares two independent integrations (rule in [verify.md](verify.md))."""
 

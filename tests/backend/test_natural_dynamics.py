@@ -110,6 +110,22 @@ def test_radau_when_dop853_takes_too_many_steps(monkeypatch):
     assert _within(res["lever.Dfi"], ref.y[1], 1e-6) <= 1
 
 
+def test_an_interval_far_longer_than_the_motion_stops_at_its_pace():
+    """A pendulum of 1 s swings asked over 1e9 s: at the pace of its first PACE_STEPS steps
+    the run would need some 1e11 steps, so it stops there with the time reached and what to
+    change, instead of integrating up to MOST_STEPS steps (Andrews' mechanism over 1e7 s,
+    fuzz seed 77251: over 120 s; 6 s now)."""
+    import pam2exu.backend.natural.dynamics as nd
+    with pytest.raises(pam2exu.SolverError) as caught:
+        _run(pendulum(0.3), t_end=1e9, steps=4, tolerance=1e-8)
+    text = str(caught.value)
+    assert f"took {nd.PACE_STEPS:,} steps to reach t = " in text
+    assert "of the interval's 1e+09 s: at that pace it would need about" in text
+    assert "end it earlier ([analysis] t_end), check that it is in seconds" in text
+    t = caught.value.time
+    assert 0 < t < 1e9 * nd.PACE_STEPS / (nd.PACE_FACTOR * nd.MOST_STEPS)
+
+
 @pytest.mark.parametrize("tolerance", [5e-324, 1e-300])
 def test_a_tolerance_below_the_integrators_floor_stops_at_the_floor(monkeypatch, tolerance):
     """A valid tolerance no integrator meets (a subnormal 5e-324: 0.1 · tol underflowed to

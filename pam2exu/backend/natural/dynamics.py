@@ -45,6 +45,14 @@ SMALLEST = 1e-13
 STIFF_STEPS = 20_000
 #: steps of one run at most
 MOST_STEPS = 2 ** 21
+#: a run's pace (the interval's share its steps have covered) is extrapolated to the end of
+#: the interval after this many steps, then after twice as many, … : at a pace that needs
+#: more than PACE_FACTOR × MOST_STEPS it stops there (an interval of 1e7 s for Andrews'
+#: mechanism, 4 ms a step: over a minute before DOP853 even handed over to Radau), not at
+#: MOST_STEPS; a run whose later steps are longer than its first by less than PACE_FACTOR
+#: (a motion that settles) never meets it
+PACE_STEPS = 1000
+PACE_FACTOR = 64
 #: units of the progress bar of one integration over the interval (per mille)
 PROGRESS_UNITS = 1000
 #: Gauss–Newton iterations of the projection onto Φ = 0
@@ -196,15 +204,32 @@ class Dynamics:
                                       f"tolerance {r:.2g})") as bar:
             return self._stepped(solver, times, out, fis, bar)
 
+    def _check_pace(self, steps: int, t0: float, t: float, end: float) -> None:
+        """SolverError when ``steps`` steps from t0 to t, at that pace, would need more than
+        PACE_FACTOR × MOST_STEPS steps to reach ``end``."""
+        needed = steps * (end - t0) / (t - t0) if t > t0 else math.inf
+        if needed > PACE_FACTOR * MOST_STEPS:
+            raise SolverError(
+                f"t={t:g}: the natural backend's integrator ({self.method.__name__}) took "
+                f"{steps:,} steps to reach t = {t:.3g} s of the interval's {end:g} s: at that "
+                f"pace it would need about {needed:.1g} steps, far more than the "
+                f"{MOST_STEPS:,} a run may take. The interval is far longer than the "
+                f"motion's time scale (a step of about {(t - t0) / steps:.1g} s): end it "
+                f"earlier ([analysis] t_end), check that it is in seconds, or loosen the "
+                f"tolerance", time=t)
+
     def _stepped(self, solver, times, out, fis, bar):
         """``run``'s steps of ``solver`` until the last time, each reported to ``bar``."""
         n, t0 = len(times), float(times[0])
-        k, steps = 1, 0
+        k, steps, pace = 1, 0, PACE_STEPS
         end = float(times[-1])
         while k < n:
             message = solver.step()
             steps += 1
             bar.update(int(PROGRESS_UNITS * (solver.t - t0) / (end - t0)))
+            if steps == pace:
+                pace *= 2
+                self._check_pace(steps, t0, float(solver.t), end)
             if solver.status == "failed" or steps > MOST_STEPS:
                 raise SolverError(
                     f"t={solver.t:g}: the natural backend's integrator ({self.method.__name__}) "
