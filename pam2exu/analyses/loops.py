@@ -346,12 +346,14 @@ def _mask(mech, elements) -> np.ndarray:
 
 def rigid(mech, jac, elements, new: set[int]) -> bool:
     """Whether the equations of ``elements`` fix the solids ``new`` once the others they
-    touch are placed: their Jacobian columns (angles times the length scale) have full rank."""
+    touch are placed: their Jacobian columns (angles times the length scale) have full rank.
+    False where those columns are not finite (the rank cannot be told there: a law constant
+    of 5e-324 made one infinite, fuzz seed 60675, and the SVD raised)."""
     if not new:
         return True
     cols = [3 * s + k for s in sorted(new) for k in range(3)]
     J = jac[_mask(mech, elements)][:, cols] * np.tile([1.0, 1.0, 1.0 / mech.scale()], len(new))
-    if J.shape[0] < J.shape[1]:
+    if J.shape[0] < J.shape[1] or not np.isfinite(J).all():
         return False
     sv = np.linalg.svd(J, compute_uv=False)
     return bool(sv[-1] > 1e-9 * max(1.0, sv[0]))
@@ -395,7 +397,8 @@ def first_open(mech, t: float, q_start: np.ndarray, can_hold: float,
     by = _placers(mech, False)
     budget = closest.Budget(mech, OPEN_BUDGET)
     while True:
-        jac = native.equations(mech, State([t], q[None])).jacobian[0]
+        with np.errstate(all="ignore"):     # (two points of a distance that coincide: NaN,
+            jac = native.equations(mech, State([t], q[None])).jacobian[0]   # ``rigid`` says)
         choices = []
         for order, unit in enumerate(units):
             if unit.ties <= built:
