@@ -31,16 +31,31 @@ def kinetostatic(job: Job):
 def inverse_dynamics(job: Job, q, qd, qdd, redundant: bool) -> dict[str, np.ndarray]:
     """Reactions, spring and actuator forces at every step, then the power balance check."""
     job.stage = "computing the reactions and actuator forces (inverse dynamics)"
-    given = (job.backend.reactions(job.mech, job.times, q, qd, qdd, redundant)
-             if job.backend.gives_reactions else None)
-    if given is None:
-        out, e = force_pass.over_time(job.mech, job.times, q, redundant, qd, qdd)
-    else:
-        out, e = force_pass.over_time_given(job.mech, job.times, q, qd, given)
-        job.info["reactions_from"] = f"{job.backend.label}'s inverse dynamics"
+    out, e, who = reactions(job, q, qd, qdd, redundant)
+    if who is not None:
+        job.info["reactions_from"] = who
     power = force_pass.actuator_power(job.mech, State(job.times, q), out)
     check_power_balance(job, power, e.energy, e.dissipation, e.external)
     return out
+
+
+def reactions(job: Job, q, qd=None, qdd=None, redundant: bool = False):
+    """(every reaction, spring and actuator force at every step, the energies or None, who
+    computed them) of the motion q, q̇, q̈, or without rates of the configurations at rest
+    (the quasi-static equilibrium Cqᵀ λ = −Q_applied is the inverse dynamics at q̇ = q̈ = 0:
+    no inertia, no damper force). A backend that ``gives_reactions`` gives them from its
+    own inverse dynamics (who: "<label>'s inverse dynamics", "… at rest"); else, or where
+    it does not handle the model, ``force_pass.over_time`` (who: None)."""
+    mech, t = job.mech, job.times
+    if job.backend.gives_reactions:
+        rates = (qd, qdd) if qdd is not None else (np.zeros_like(q),) * 2
+        given = job.backend.reactions(mech, t, q, *rates, redundant)
+        if given is not None:
+            out, e = force_pass.over_time_given(mech, t, q, rates[0], given)
+            return out, e, (f"{job.backend.label}'s inverse dynamics"
+                             + ("" if qdd is not None else " at rest"))
+    out, e = force_pass.over_time(mech, t, q, redundant, qd, qdd)
+    return out, e, None
 
 
 def check_power_balance(job: Job, power, energy, dissipation, external) -> None:

@@ -9,6 +9,7 @@ from ..errors import TranslationError
 from ..kinematics import State
 from . import force_pass, native
 from .job import Job, check_mobility, collect
+from .kinetostatic import reactions
 from .branch import motion
 from .positions import positions
 
@@ -25,8 +26,8 @@ def quasi_static(job: Job):
     forces: they come from the backend's solver on the constraints, the branch followed
     on the rates (``branch.motion``, as kinematic: its rates are not reported), and
     the reactions from the equilibrium Cqᵀ λ = −Q_applied at every step (gravity,
-    torsors and springs, no damper terms; ``equilibrium_reactions``: the backend's inverse
-    dynamics at rest where it gives reactions, else ``force_pass.over_time``). The backend's
+    torsors and springs, no damper terms; ``kinetostatic.reactions`` at rest: the backend's
+    inverse dynamics where it gives reactions, else ``force_pass.over_time``). The backend's
     static solver with the masses and force elements in the model checks them at
     ``CHECKED_STEPS`` steps (its multipliers λ, f + Cqᵀ λ = 0, must satisfy the native
     equilibrium). With redundant constraints λ is not unique: the reactions are the
@@ -41,7 +42,7 @@ def quasi_static(job: Job):
     # point the backend solved to round-off) is an error: the reactions are undefined there
     q, _, _ = motion(job, redundant, accelerations=False, singular_ok=False)
     job.stage = "computing the reactions (static equilibrium)"
-    out, source = equilibrium_reactions(job, q, redundant)
+    out, _, source = reactions(job, q, redundant=redundant)
     if redundant:
         job.info["reactions_from"] = ("native minimum-norm solve" if source is None
                                       else f"{source}, minimum norm")
@@ -60,21 +61,6 @@ def quasi_static(job: Job):
                 f"{EQUILIBRIUM_TOLERANCE:g}): the translation of a force element for {label} "
                 "is wrong. Please report it with the model file.")
     return collect(job, q, extra=out)
-
-
-def equilibrium_reactions(job: Job, q: np.ndarray, redundant: bool):
-    """(every reaction, spring and actuator force at every step, who solved them): the static
-    equilibrium Cqᵀ λ = −Q_applied is the inverse dynamics of the configurations at rest
-    (q̇ = q̈ = 0: no inertia force, no damper force), so a backend that ``gives_reactions``
-    gives them from its own inverse dynamics at rest (who: "<label>'s inverse dynamics at
-    rest"); else, or where it does not handle the model, the native solve (who: None)."""
-    rest = np.zeros_like(q)
-    given = (job.backend.reactions(job.mech, job.times, q, rest, rest, redundant)
-             if job.backend.gives_reactions else None)
-    if given is None:
-        return force_pass.over_time(job.mech, job.times, q, redundant)[0], None
-    out, _ = force_pass.over_time_given(job.mech, job.times, q, rest, given)
-    return out, f"{job.backend.label}'s inverse dynamics at rest"
 
 
 def checked_steps(n: int) -> list[int]:
